@@ -1,0 +1,31 @@
+"""gearjax — differentiable gear design in JAX.
+
+Importing gearjax enables 64-bit floats in JAX (``jax_enable_x64``): micrometre
+geometry on 100 mm parts and arc-second transmission errors need float64.
+
+Architecture (imports flow downwards only; gear families and applications import
+the core, never the other way round)::
+
+    gearjax/newton.py      implicit-differentiated, batched Newton solver
+    gearjax/frames.py      4x4 homogeneous transforms from elementary motions
+    gearjax/surfaces.py    autodiff differential geometry of explicit and
+                           enveloped (generated) surfaces
+    gearjax/kinematics.py  eigenfunction kinematics of conjugate surfaces
+                           (seed 000, section 1): q, p, Phi_I, Phi_II, u1, u2,
+                           u_e, u_s, SRR, K_II, R_eff, limit normal
+    gearjax/gears/         gear families; involute.py: rack-generated spur and
+                           helical pairs and their path-of-contact kinematics
+    gearjax/errors.py      exception types and boundary validation helpers
+    gearjax/cli.py         the ``gearjax`` command
+
+Units inside the library: mm, N, s, rad.  Degrees appear only at the boundary
+(CLI flags, design files, printed tables).
+"""
+
+import jax as _jax
+
+_jax.config.update("jax_enable_x64", True)
+
+__version__ = "0.1.0"
+
+__all__ = ["__version__"]

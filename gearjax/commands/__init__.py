@@ -1,0 +1,1 @@
+"""Sub-commands of the ``gearjax`` CLI, one module each (see ``gearjax/cli.py``)."""

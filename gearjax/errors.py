@@ -1,0 +1,79 @@
+"""Exception types and validation helpers used at the library boundary.
+
+Validation happens on concrete values (constructors meant for users, file loaders,
+the CLI) before anything is traced; traced code never validates.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+
+class ConvergenceError(RuntimeError):
+    """A solver did not converge where a valid result was required."""
+
+
+def _fmt(value: Any) -> str:
+    try:
+        return f"{float(value):g}"
+    except (TypeError, ValueError):
+        return repr(value)
+
+
+def check_range(name: str, value: Any, lo: float | None = None, hi: float | None = None,
+                *, lo_open: bool = False, hi_open: bool = False, unit: str = "") -> float:
+    """Return ``float(value)`` or raise ``ValueError`` naming the parameter and range.
+
+    ``lo``/``hi`` are the bounds (None for unbounded); ``lo_open``/``hi_open`` make a
+    bound exclusive.
+    """
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number, got {value!r}") from None
+    ok = math.isfinite(v)
+    if ok and lo is not None:
+        ok = v > lo if lo_open else v >= lo
+    if ok and hi is not None:
+        ok = v < hi if hi_open else v <= hi
+    if not ok:
+        left = "(" if (lo_open or lo is None) else "["
+        right = ")" if (hi_open or hi is None) else "]"
+        lo_s = "-inf" if lo is None else _fmt(lo)
+        hi_s = "inf" if hi is None else _fmt(hi)
+        u = f" {unit}" if unit else ""
+        raise ValueError(f"{name} = {_fmt(value)}{u} is outside the allowed range "
+                         f"{left}{lo_s}, {hi_s}{right}{u}")
+    return v
+
+
+def check_positive(name: str, value: Any, unit: str = "") -> float:
+    """Raise ``ValueError`` unless ``value`` is a finite number > 0."""
+    return check_range(name, value, 0.0, None, lo_open=True, unit=unit)
+
+
+def check_int(name: str, value: Any, lo: int | None = None, hi: int | None = None) -> int:
+    """Return ``int(value)`` or raise ``ValueError`` if not an integer in [lo, hi]."""
+    if isinstance(value, bool) or not float(np.asarray(value)).is_integer():
+        raise ValueError(f"{name} = {value!r} must be an integer"
+                         + (f" >= {lo}" if lo is not None else ""))
+    v = int(np.asarray(value))
+    if (lo is not None and v < lo) or (hi is not None and v > hi):
+        rng = f"[{lo if lo is not None else '-inf'}, {hi if hi is not None else 'inf'}]"
+        raise ValueError(f"{name} = {v} is outside the allowed range {rng}")
+    return v
+
+
+def require_converged(converged: Any, what: str, residual: Any = None) -> None:
+    """Raise ``ConvergenceError`` unless every entry of ``converged`` is True."""
+    c = np.asarray(converged)
+    if not bool(np.all(c)):
+        n_bad = int(c.size - np.count_nonzero(c))
+        msg = f"{what}: {n_bad} of {c.size} solves did not converge"
+        if residual is not None:
+            r = np.asarray(residual)
+            msg += f" (worst residual {float(np.nanmax(np.where(np.isfinite(r), r, np.inf))):.3g})"
+        raise ConvergenceError(msg + "; pass strict=False to get masks instead")

@@ -1,0 +1,96 @@
+"""Newton solver: roots, implicit derivatives (forward and reverse), batching, failure flags."""
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+from gearjax.newton import newton_solve
+
+
+def cube_root_system(x, th):
+    # root: x0 = th0**(1/3), x1 = th1 * x0**2  (closed form)
+    return jnp.stack([x[0] ** 3 - th[0], x[1] - th[1] * x[0] ** 2])
+
+
+def solve(th):
+    return newton_solve(cube_root_system, jnp.array([1.0, 1.0]), th).x
+
+
+def exact(th):
+    x0 = th[0] ** (1 / 3)
+    return jnp.stack([x0, th[1] * x0 ** 2])
+
+
+TH = jnp.array([2.7, -0.8])
+
+
+def test_root_and_diagnostics():
+    res = newton_solve(cube_root_system, jnp.array([1.0, 1.0]), TH)
+    assert bool(res.converged)
+    assert float(res.residual) < 1e-14
+    assert 0 < int(res.steps) < 20
+    np.testing.assert_allclose(res.x, exact(TH), rtol=1e-14)
+
+
+@pytest.mark.parametrize("jac", [jax.jacfwd, jax.jacrev])
+def test_jacobian_matches_analytic(jac):
+    np.testing.assert_allclose(jac(solve)(TH), jax.jacfwd(exact)(TH), rtol=1e-12)
+
+
+def test_jvp_and_grad_match_central_differences():
+    d = jnp.array([0.3, -1.1])
+    _, t = jax.jvp(solve, (TH,), (d,))
+    h = 1e-6
+    fd = (solve(TH + h * d) - solve(TH - h * d)) / (2 * h)
+    np.testing.assert_allclose(t, fd, rtol=1e-8)
+    g = jax.grad(lambda th: jnp.sum(solve(th) ** 2))(TH)
+    e = jnp.eye(2)
+    fd = jnp.array([(jnp.sum(solve(TH + h * e[i]) ** 2) - jnp.sum(solve(TH - h * e[i]) ** 2)) / (2 * h)
+                    for i in range(2)])
+    np.testing.assert_allclose(g, fd, rtol=1e-8)
+
+
+def test_second_derivative():
+    f = lambda a: newton_solve(lambda x, t: x ** 2 - t, 1.0, a).x  # noqa: E731
+    np.testing.assert_allclose(jax.grad(jax.grad(f))(2.0), -0.25 * 2.0 ** -1.5, rtol=1e-12)
+    np.testing.assert_allclose(jax.hessian(lambda th: solve(th)[1])(TH),
+                               jax.hessian(lambda th: exact(th)[1])(TH), rtol=1e-10)
+
+
+def test_vmap_of_grad_and_jit():
+    f = lambda a: newton_solve(lambda x, t: x ** 2 - t, 1.0, a).x  # noqa: E731
+    a = jnp.array([1.0, 4.0, 9.0, 0.25])
+    np.testing.assert_allclose(jax.jit(jax.vmap(jax.grad(f)))(a), 0.5 / jnp.sqrt(a), rtol=1e-13)
+    res = jax.vmap(lambda t: newton_solve(lambda x, s: x ** 2 - s, 1.0, t))(a)
+    assert res.converged.shape == (4,) and bool(jnp.all(res.converged))
+
+
+def test_closure_over_traced_values_is_differentiated():
+    def root(a):
+        return newton_solve(lambda x, th: jnp.sin(x) - a * th, 0.1, 0.5).x
+
+    a = 0.6
+    np.testing.assert_allclose(jax.grad(root)(a), 0.5 / np.sqrt(1 - (0.5 * a) ** 2), rtol=1e-12)
+
+
+def test_non_convergence_is_flagged_not_returned_as_valid():
+    res = newton_solve(lambda x, th: x ** 2 + 1.0, 0.7, ())  # no real root
+    assert not bool(res.converged)
+    assert float(res.residual) >= 1.0
+    res = newton_solve(lambda x, th: jnp.exp(x) - 0.0, 0.0, (), max_steps=5)  # root at -inf
+    assert not bool(res.converged)
+    # mixed batch: converged mask is per element
+    res = jax.vmap(lambda t: newton_solve(lambda x, s: x ** 2 - s, 1.0, t))(jnp.array([4.0, -4.0]))
+    assert res.converged.tolist() == [True, False]
+
+
+def test_line_search_rescues_overshoot():
+    # arctan: undamped Newton diverges from |x0| > 1.39; the backtracking converges
+    res = newton_solve(lambda x, th: jnp.arctan(x), 3.0, ())
+    assert bool(res.converged) and abs(float(res.x)) < 1e-12
+
+
+def test_mismatched_system_rejected():
+    with pytest.raises(ValueError):
+        newton_solve(lambda x, th: jnp.stack([x[0], x[1], x[0]]), jnp.zeros(2), ())
