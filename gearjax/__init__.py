@@ -15,6 +15,13 @@ the core, never the other way round)::
                            u_e, u_s, SRR, K_II, R_eff, limit normal
     gearjax/gears/         gear families; involute.py: rack-generated spur and
                            helical pairs and their path-of-contact kinematics
+    gearjax/contact.py     Hertz point contact (exact, elliptic integrals by AGM;
+                           Hamrock-Brewe option; line-contact limit)
+    gearjax/tribology/     lubricant (Roelands/Barus, Dowson-Higginson, Ree-Eyring),
+                           film (Hamrock-Dowson, line contact), asperity
+                           (Greenwood-Tripp, load sharing), friction (seed 001 mu),
+                           losses (power loss, mesh efficiency, Stribeck curves)
+    gearjax/plot_tribology.py  Stribeck figures
     gearjax/errors.py      exception types and boundary validation helpers
     gearjax/cli.py         the ``gearjax`` command
 

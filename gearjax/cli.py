@@ -15,6 +15,7 @@ import sys
 # sub-command modules, in the order they appear in ``gearjax --help``
 COMMANDS = [
     "gearjax.commands.involute",
+    "gearjax.commands.friction",
 ]
 
 

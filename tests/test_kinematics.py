@@ -59,17 +59,30 @@ def contact_u(family2, psi, v=0.0):
                         0.0, jnp.stack([psi, v])).x
 
 
-@pytest.mark.parametrize("case", list(CASES))
-def test_eigenfunctions_against_independent_routes(case):
+def quantities(case):
+    """Everything the test compares, computed in one jitted call per case."""
     mesh, sigma1, family2, sigma2_body, sigma2, k2 = setup(case)
     uv0 = jnp.zeros(2)
-    assert abs(float(contact_u(family2, 0.0))) < 1e-12
     g1 = local_geometry(sigma1, uv0)
     g2 = local_geometry(sigma2, uv0)
+    kin = eigen_kinematics(mesh, g1.r, g1.n, g1.W)
+    # velocities of the contact point over each surface, from the motion (omega1 = 1);
+    # over Sigma_2 the member-2 frame derivative is rotated back (identity at psi = 0)
+    du = jax.jacfwd(lambda psi: contact_u(family2, psi))(0.0)
+    vr1 = jax.jacfwd(sigma1)(uv0)[:, 0] * du
+    vr2 = jax.jacfwd(lambda psi: sigma2_body(jnp.stack([contact_u(family2, psi), 0.0])))(0.0)
+    return dict(mesh=mesh, g1=g1, g2=g2, kin=kin, vr1=vr1, vr2=vr2,
+                u_at_0=contact_u(family2, 0.0))
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_eigenfunctions_against_independent_routes(case):
+    d = jax.jit(quantities, static_argnums=0)(case)
+    mesh, g1, g2, kin, vr1, vr2 = d["mesh"], d["g1"], d["g2"], d["kin"], d["vr1"], d["vr2"]
+    assert abs(float(d["u_at_0"])) < 1e-12
     np.testing.assert_allclose(g2.r, g1.r, atol=1e-12)          # same point
     s = np.sign(float(g1.n @ g2.n))
     np.testing.assert_allclose(s * g2.n, g1.n, atol=1e-12)       # common normal
-    kin = eigen_kinematics(mesh, g1.r, g1.n, g1.W)
     assert abs(float(g1.n @ kin.v12)) < 1e-12                    # meshing equation
 
     # K_II = kappa1 - kappa2 in the direction of p (common normal, independent surfaces)
@@ -84,11 +97,6 @@ def test_eigenfunctions_against_independent_routes(case):
     assert abs(float(curvature_in_direction(g1.n, g1.W - W2, cl)[0])) < 1e-10 * abs(float(kin.k_II))
     assert abs(float(ph @ (g1.W - W2) @ cl)) < 1e-10 * abs(float(kin.k_II))
 
-    # velocities of the contact point over each surface, from the motion (omega1 = 1)
-    du = jax.jacfwd(lambda psi: contact_u(family2, psi))(0.0)
-    vr1 = jax.jacfwd(sigma1)(uv0)[:, 0] * du
-    # over Sigma_2: member-2 frame derivative, rotated back (identity at psi = 0)
-    vr2 = jax.jacfwd(lambda psi: sigma2_body(jnp.stack([contact_u(family2, psi), 0.0])))(0.0)
     np.testing.assert_allclose(vr2 - vr1, kin.v12, rtol=1e-9, atol=1e-9)   # v_r2 = v_r1 + v12
     np.testing.assert_allclose(vr1 @ kin.p, kin.phi_I, rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(vr2 @ kin.p, kin.phi_II, rtol=1e-9, atol=1e-12)

@@ -1,0 +1,139 @@
+"""Throughput of the friction model: μ for 1e5 contact points per call, forward and
+gradient, against a NumPy/SciPy per-point loop (same model, same equations) on a
+subset, scaled.  Prints a table; not a test.
+
+    python benchmarks/bench_friction.py [--points 100000] [--baseline-points 200]
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+
+import numpy as np
+
+
+def numpy_mu(F, ue, us, Rx, Ry, Ep, eta0, z, tau0, sigma, dens, beta, fc, vslip):
+    """Per-point reference implementation with scipy (elliptic integrals, brentq, quad)."""
+    from scipy.integrate import quad
+    from scipy.optimize import brentq
+    from scipy.special import ellipe, ellipkm1
+    from scipy.stats import norm
+
+    r = Ry / Rx
+
+    def g(kp):
+        K, E = ellipkm1(kp * kp), ellipe(1 - kp * kp)
+        return (E / kp**2 - K) / (K - E) - r
+
+    kp = brentq(g, 1e-7, 1 - 1e-6, xtol=1e-15)
+    E = ellipe(1 - kp * kp)
+    R = Rx * Ry / (Rx + Ry)
+    b = (6 * E * kp * F * R / (math.pi * Ep)) ** (1 / 3)
+    a = b / kp
+    k = 1 / kp
+    pmax = 1.5 * F / (math.pi * a * b)
+    alpha = z * (math.log(eta0) + 9.67) * 5.1e-3
+    KGT = 16 * math.sqrt(2) * math.pi / 15 * (dens * beta * sigma) ** 2 * math.sqrt(sigma / beta)
+
+    def film(g1):
+        Fe, Ee = F / g1, Ep / g1
+        U = eta0 * 1e-6 * ue / (Ee * Rx)
+        hp = Rx * 2.69 * U**0.67 * (alpha * Ee) ** 0.53 * (Fe / (Ee * Rx * Rx)) ** -0.067 * (1 - 0.61 * math.exp(-0.73 * k))
+        hl = Rx * 2.922 * (0.75 * Fe / a / (Ee * Rx)) ** -0.166 * U**0.692 * (alpha * Ee) ** 0.47
+        x = min(max(math.log(k / 8) / math.log(8), 0), 1)
+        s = x * x * (3 - 2 * x)
+        return hp ** (1 - s) * hl**s
+
+    def logF52(lam):  # ln F_5/2 = ln φ(λ) + ln ∫ t^2.5 exp(-λt - t²/2) dt
+        T = 60.0 / (lam + 5.0)  # the integrand is below e^-40 of its peak beyond T
+        i = quad(lambda t: t**2.5 * math.exp(-lam * t - 0.5 * t * t), 0, T, limit=100)[0]
+        return norm.logpdf(lam) + math.log(i)
+
+    def res(sv):
+        logphi = -np.logaddexp(0.0, -sv)
+        hc = film(1.0 + math.exp(sv))  # γ1 = 1/(1-φ) = 1 + e^s
+        return logphi - math.log(math.pi * a * b * KGT * Ep / F) - logF52(hc / sigma)
+
+    sv = brentq(res, -700, 35, xtol=1e-12)
+    phi = 1 / (1 + math.exp(-sv))
+    hc = film(1.0 + math.exp(sv))
+
+    def tau_s(s):
+        p = (1 - phi) * pmax * s
+        eta = eta0 * math.exp((math.log(eta0) + 9.67) * ((1 + p / (1 / 5.1e-3)) ** z - 1))
+        return tau0 * math.asinh(eta * 1e-6 * us / (hc * tau0)) * s
+
+    Ft = 2 * math.pi * a * b * quad(tau_s, 0, 1)[0]
+    return fc * phi * math.tanh(us / vslip) + Ft / F
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--points", type=int, default=100_000)
+    ap.add_argument("--baseline-points", type=int, default=200)
+    ap.add_argument("--repeats", type=int, default=3)
+    args = ap.parse_args()
+
+    import jax
+    import jax.numpy as jnp
+
+    import gearjax  # noqa: F401
+    from gearjax.tribology import friction_traced, get_oil, make_surface
+
+    n = args.points
+    rng = np.random.default_rng(0)
+    F = rng.uniform(200, 3000, n)
+    ue = rng.uniform(500, 20000, n)
+    us = ue * rng.uniform(0.0, 0.5, n)
+    Rx = rng.uniform(5, 30, n)
+    Ry = Rx * rng.uniform(2, 200, n)
+    oil = get_oil("mineral_vg100")
+    surf = make_surface(0.5)
+    Ep = 226374.0
+    args_j = [jnp.asarray(v) for v in (F, ue, us, Rx, Ry)]
+
+    fwd = jax.jit(lambda F, ue, us, Rx, Ry: friction_traced(F, ue, us, Rx, Ry, oil, surf, Ep).mu)
+
+    def total_mu(F, ue, us, Rx, Ry, eta0, sigma):
+        o = oil.__class__(eta0, oil.z, oil.tau0, oil.rho0)
+        s = surf.__class__(sigma, surf.density, surf.beta, surf.f_c, surf.v_slip)
+        return jnp.sum(friction_traced(F, ue, us, Rx, Ry, o, s, Ep).mu)
+
+    grad = jax.jit(jax.grad(total_mu, argnums=(0, 1, 2, 3, 4, 5, 6)))
+
+    def timeit(fn, *a):
+        t0 = time.perf_counter()
+        jax.block_until_ready(fn(*a))
+        compile_s = time.perf_counter() - t0
+        best = math.inf
+        for _ in range(args.repeats):
+            t0 = time.perf_counter()
+            jax.block_until_ready(fn(*a))
+            best = min(best, time.perf_counter() - t0)
+        return compile_s, best
+
+    c_f, t_f = timeit(fwd, *args_j)
+    c_g, t_g = timeit(grad, *args_j, oil.eta0, surf.sigma)
+
+    m = args.baseline_points
+    t0 = time.perf_counter()
+    mu_np = [numpy_mu(F[i], ue[i], us[i], Rx[i], Ry[i], Ep, 0.088, float(oil.z), 5.0, 5e-4, 1e4, 1e-2,
+                      0.1, 1.0) for i in range(m)]
+    t_np = time.perf_counter() - t0
+    mu_j = np.asarray(fwd(*args_j))[:m]
+    agree = np.max(np.abs(np.asarray(mu_np) - mu_j) / np.abs(mu_j))
+
+    print(f"gearjax friction benchmark ({jax.devices()[0].platform}, {n} points per call)")
+    print(f"{'route':44s} {'points/s':>12s} {'call (s)':>10s} {'compile (s)':>12s}")
+    print(f"{'JAX forward mu (jit, vmap)':44s} {n / t_f:12.4g} {t_f:10.3f} {c_f:12.2f}")
+    print(f"{'JAX gradient of sum(mu) wrt 7 inputs':44s} {n / t_g:12.4g} {t_g:10.3f} {c_g:12.2f}")
+    print(f"{'NumPy/SciPy per-point loop (forward only)':44s} {m / t_np:12.4g} "
+          f"{t_np * n / m:10.3f} {'-':>12s}   (timed on {m} points, scaled)")
+    print(f"speed-up of JAX forward over the loop: {(m / t_np) and (n / t_f) / (m / t_np):.0f}x; "
+          f"max relative difference of mu on the subset: {agree:.1e}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,333 @@
+"""Hertz theory of elastic point (elliptical) and line contact, differentiable in JAX.
+
+Units
+-----
+Lengths in mm, forces in N, moduli and pressures in MPa (N/mm²).
+
+Conventions
+-----------
+``x`` is the rolling (entrainment) direction and ``Rx`` the relative radius of
+curvature in it; ``y`` is the transverse direction with relative radius ``Ry``
+(``1/Rx = 1/R_x1 ± 1/R_x2`` etc. — the *relative* principal radii of the two
+surfaces, with aligned principal directions).  The contact ellipse has semi-axis
+``a`` along ``y`` and ``b`` along ``x`` (Hamrock's convention), ellipticity
+``k = a/b``; ``k > 1`` when ``Ry > Rx`` (the usual gear-flank case, elongated
+across the rolling direction).
+
+The modulus is the *reduced modulus of elasticity* of Hamrock and Dowson,
+
+    E' = 2 / [(1 - ν1²)/E1 + (1 - ν2²)/E2]  = 2 E*,
+
+E* being the contact modulus of Johnson (Contact Mechanics, 1985).  E' is also
+what the EHL film formulas use (``gearjax.tribology.film``).  The seed
+(001, eq. for a, b) writes ``a = k_a [3w / (2E'(A+B))]^(1/3)`` without defining E';
+gearjax uses E' = 2E* everywhere and says so.
+
+Exact solution (Johnson 1985, §4.2; Hamrock, Schmid & Jacobson, *Fundamentals of
+Fluid Film Lubrication*, 2004, ch. 3).  With ``k' = b/a = 1/k``, ``m = 1 - k'²``,
+complete elliptic integrals ``K(m)``, ``E(m)`` and the auxiliary functions
+
+    D(m) = (K - E)/m,     B(m) = (E - k'² K)/m = K - D,
+
+the ellipticity follows from the curvature ratio
+
+    Ry/Rx = B(m) / (k'² D(m)),                                   (1)
+
+and then, with ``1/R = 1/Rx + 1/Ry``,
+
+    b³ = 6 E(m) k' F R / (π E'),   a = k b,                      (2)
+    p_max = 3 F / (2 π a b),                                     (3)
+    δ (approach) = 2 p_max b K(m) / E'.                          (4)
+
+(1)–(4) contain ``K - E`` only through ``D`` and ``B``, which are computed without
+cancellation by the arithmetic–geometric mean (AGM) — so the circle (m = 0) and
+the very elongated contact (m → 1, Ry/Rx up to 1e15) are both evaluated to
+machine precision and differentiably.  Equation (1) is solved for
+``t = ln k`` with :func:`gearjax.newton.newton_solve` (derivatives by the implicit
+function theorem).  ``t < 0`` (Rx > Ry) is the analytic continuation to ``m < 0``;
+the AGM works there too, so both orientations need no branch.
+
+Line contact is the limit Ry/Rx → ∞ at fixed load per unit length ``w'``:
+``b = sqrt(8 w' Rx / (π E'))``, ``p_max = 2 w' / (π b)``
+(:func:`hertz_line`).  The exact elliptical solution tends to it: the centre-line
+load intensity ``w'_c = π p_max b / 2 = 3F/(4a)`` satisfies ``b → 4 p_max Rx / E'``
+(tested).
+
+Hamrock–Brewe approximations (Hamrock & Brewe, J. Lubr. Technol. 105 (1983)
+171–177): ``k ≈ 1.0339 (Ry/Rx)^0.6360``, ``E ≈ 1.0003 + 0.5968 Rx/Ry``,
+``K ≈ 1.5277 + 0.6023 ln(Ry/Rx)``; fitted for 1 ≤ Ry/Rx ≤ 100 (a warning is
+issued outside that range).  Only ``Ry ≥ Rx`` is covered by the fit; for ``Ry < Rx``
+gearjax applies it to the swapped radii and swaps the semi-axes back.
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import NamedTuple
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from gearjax.errors import check_positive, check_range, require_converged
+from gearjax.newton import newton_solve
+
+__all__ = [
+    "HertzResult",
+    "combined_modulus",
+    "ellipk_agm",
+    "ellipe_agm",
+    "elliptic_KD",
+    "hertz_point",
+    "hertz_point_traced",
+    "hertz_line",
+    "hertz_line_traced",
+]
+
+_AGM_STEPS = 12  # enough for |ln k| <= 40 (checked against scipy in the tests)
+
+
+class HertzResult(NamedTuple):
+    """Hertz point-contact solution (all arrays broadcast to the input shape).
+
+    a : semi-axis along y (transverse), mm.
+    b : semi-axis along x (rolling), mm.
+    k : ellipticity a/b.
+    p_max : maximum (central) pressure, MPa.
+    p_mean : mean pressure F/(π a b), MPa.
+    approach : mutual approach of distant points δ, mm.
+    K, E : complete elliptic integrals K(m), E(m) at m = 1 - (b/a)².
+    converged : ellipticity solve converged (always True for Hamrock–Brewe).
+    """
+
+    a: jax.Array
+    b: jax.Array
+    k: jax.Array
+    p_max: jax.Array
+    p_mean: jax.Array
+    approach: jax.Array
+    K: jax.Array
+    E: jax.Array
+    converged: jax.Array
+
+
+# ----------------------------------------------------------------------------
+# materials
+# ----------------------------------------------------------------------------
+
+def combined_modulus(E1, nu1, E2=None, nu2=None):
+    """Reduced modulus E' = 2/[(1-ν1²)/E1 + (1-ν2²)/E2] (MPa; Hamrock's E', = 2E*).
+
+    ``E1``, ``E2`` in MPa; body 2 defaults to body 1.  Validates its inputs.
+    Example: steel 206 GPa, ν = 0.3 on steel → E' = 226 374 MPa.
+    """
+    E2 = E1 if E2 is None else E2
+    nu2 = nu1 if nu2 is None else nu2
+    for name, v in (("E1", E1), ("E2", E2)):
+        check_positive(name, np.min(np.asarray(v, float)), "MPa")
+    for name, v in (("nu1", nu1), ("nu2", nu2)):
+        arr = np.asarray(v, float)
+        check_range(name, np.min(arr), -1.0, 0.5, lo_open=True, hi_open=True)
+        check_range(name, np.max(arr), -1.0, 0.5, lo_open=True, hi_open=True)
+    return 2.0 / ((1.0 - jnp.asarray(nu1) ** 2) / jnp.asarray(E1, float)
+                  + (1.0 - jnp.asarray(nu2) ** 2) / jnp.asarray(E2, float))
+
+
+# ----------------------------------------------------------------------------
+# complete elliptic integrals by the AGM
+# ----------------------------------------------------------------------------
+
+def elliptic_KD(t):
+    """K(m) and D(m) = (K - E)/m at ``m = 1 - exp(-2t)`` (i.e. k' = exp(-t)).
+
+    Arithmetic–geometric mean ``a_{n+1} = (a_n+b_n)/2``, ``b_{n+1} = sqrt(a_n b_n)``,
+    ``a_0 = 1``, ``b_0 = k'``; ``K = π/(2 a_∞)`` and
+    ``K - E = K Σ_{n≥0} 2^{n-1} c_n²`` with ``c_0² = m``,
+    ``c_{n+1} = c_n²/(4 a_{n+1})`` (Abramowitz & Stegun 17.6).  The series is
+    carried as ``s_n = c_n²/m`` (``s_0 = 1``, ``s_{n+1} = s_n² m/(16 a_{n+1}²)``),
+    so ``D = K Σ 2^{n-1} s_n`` has no cancellation at m → 0.  Valid for any real
+    ``t`` (m < 0 for t < 0), jit/grad/vmap-friendly (fixed 12 steps).
+    """
+    t = jnp.asarray(t, float)
+    kp = jnp.exp(-t)
+    m = -jnp.expm1(-2.0 * t)
+    a = jnp.ones_like(kp)
+    b = kp
+    s = jnp.ones_like(kp)
+    w = 0.5
+    total = w * s
+    for _ in range(_AGM_STEPS):
+        a_new = 0.5 * (a + b)
+        b = jnp.sqrt(a * b)
+        s = s * s * m / (16.0 * a_new * a_new)
+        a = a_new
+        w = 2.0 * w
+        total = total + w * s
+    K = 0.5 * jnp.pi / a
+    return K, K * total
+
+
+def ellipk_agm(m):
+    """Complete elliptic integral of the first kind K(m), m < 1 (parameter convention)."""
+    m = jnp.asarray(m, float)
+    t = -0.5 * jnp.log1p(-m)
+    return elliptic_KD(t)[0]
+
+
+def ellipe_agm(m):
+    """Complete elliptic integral of the second kind E(m) = K - m D, m < 1."""
+    m = jnp.asarray(m, float)
+    t = -0.5 * jnp.log1p(-m)
+    K, D = elliptic_KD(t)
+    return K - m * D
+
+
+# ----------------------------------------------------------------------------
+# point contact
+# ----------------------------------------------------------------------------
+
+def _ratio_residual(t, log_ratio):
+    """ln(Ry/Rx) from eq. (1) minus the target: ln B - ln D + 2t - ln(Ry/Rx)."""
+    K, D = elliptic_KD(t)
+    return jnp.log(K - D) - jnp.log(D) + 2.0 * t - log_ratio
+
+
+def _solve_t(log_ratio):
+    t0 = 0.636 * log_ratio  # Hamrock–Brewe exponent as a start
+    res = newton_solve(_ratio_residual, t0, log_ratio, tol=1e-12, xtol=1e-14, max_steps=60)
+    return res.x, res.converged
+
+
+def _hertz_exact(F, Rx, Ry, E_prime):
+    lr = jnp.log(Ry) - jnp.log(Rx)
+    t, conv = _solve_t(lr)
+    K, D = elliptic_KD(t)
+    m = -jnp.expm1(-2.0 * t)
+    E = K - m * D
+    # 1/R = 1/Rx + 1/Ry, written to stay finite for Ry -> huge
+    R = Rx / (1.0 + Rx / Ry)
+    log_b = (jnp.log(6.0 / jnp.pi) + jnp.log(E) - t + jnp.log(F) + jnp.log(R)
+             - jnp.log(E_prime)) / 3.0
+    b = jnp.exp(log_b)
+    a = jnp.exp(log_b + t)
+    p_max = 1.5 * F / (jnp.pi * a * b)
+    approach = 2.0 * p_max * b * K / E_prime
+    return HertzResult(a, b, jnp.exp(t), p_max, p_max / 1.5, approach, K, E, conv)
+
+
+def _hertz_hamrock_brewe(F, Rx, Ry, E_prime):
+    swap = Ry < Rx
+    R_small = jnp.minimum(Rx, Ry)
+    R_big = jnp.maximum(Rx, Ry)
+    alpha_r = R_big / R_small
+    k = 1.0339 * alpha_r ** 0.6360
+    E = 1.0003 + 0.5968 / alpha_r
+    K = 1.5277 + 0.6023 * jnp.log(alpha_r)
+    R = Rx * Ry / (Rx + Ry)
+    # Hamrock & Brewe: D_y = 2 (6 k² E F R/(π E'))^(1/3), D_x = 2 (6 E F R/(π k E'))^(1/3)
+    a_big = (6.0 * k * k * E * F * R / (jnp.pi * E_prime)) ** (1.0 / 3.0)  # along R_big
+    b_small = (6.0 * E * F * R / (jnp.pi * k * E_prime)) ** (1.0 / 3.0)
+    a = jnp.where(swap, b_small, a_big)
+    b = jnp.where(swap, a_big, b_small)
+    p_max = 1.5 * F / (jnp.pi * a * b)
+    approach = K * (4.5 / (E * R) * (F / (jnp.pi * k * E_prime)) ** 2) ** (1.0 / 3.0)
+    return HertzResult(a, b, a / b, p_max, p_max / 1.5, approach, K, E,
+                       jnp.ones_like(p_max, dtype=bool))
+
+
+def hertz_point_traced(F, Rx, Ry, E_prime, method: str = "exact") -> HertzResult:
+    """Traceable core of :func:`hertz_point` (no validation; jit/grad/vmap-friendly).
+
+    Broadcasts its array arguments.  ``method`` is ``"exact"`` or
+    ``"hamrock_brewe"`` (static).
+    """
+    F, Rx, Ry, E_prime = jnp.broadcast_arrays(*(jnp.asarray(v, float) for v in (F, Rx, Ry, E_prime)))
+    if method == "exact":
+        if F.ndim == 0:
+            return _hertz_exact(F, Rx, Ry, E_prime)
+        shape = F.shape
+        out = jax.vmap(_hertz_exact)(F.ravel(), Rx.ravel(), Ry.ravel(), E_prime.ravel())
+        return HertzResult(*(jnp.reshape(v, shape) for v in out))
+    if method == "hamrock_brewe":
+        return _hertz_hamrock_brewe(F, Rx, Ry, E_prime)
+    raise ValueError(f"method = {method!r} must be 'exact' or 'hamrock_brewe'")
+
+
+_hertz_point_jit = jax.jit(hertz_point_traced, static_argnames=("method",))
+
+
+def _check_array_positive(name, value, unit):
+    arr = np.asarray(value, dtype=float)
+    if arr.size == 0:
+        raise ValueError(f"{name} is empty")
+    bad = ~np.isfinite(arr) | (arr <= 0)
+    if np.any(bad):
+        check_positive(name, arr[bad].ravel()[0], unit)
+    return arr
+
+
+def hertz_point(F, Rx, Ry, E_prime, method: str = "exact", strict: bool = True) -> HertzResult:
+    """Hertz elliptical point contact (validated public entry point).
+
+    Parameters
+    ----------
+    F : normal load, N (> 0).
+    Rx, Ry : relative principal radii of curvature in the rolling and transverse
+        directions, mm (> 0, finite; for an infinitely long line contact use
+        :func:`hertz_line`).
+    E_prime : reduced modulus E' = 2E*, MPa (> 0).
+    method : ``"exact"`` (AGM elliptic integrals + Newton for the ellipticity) or
+        ``"hamrock_brewe"`` (curve fits, warned outside 1 ≤ max/min radius ≤ 100).
+    strict : raise :class:`gearjax.errors.ConvergenceError` if a solve failed
+        (default); with False the ``converged`` mask is returned instead.
+
+    Returns
+    -------
+    :class:`HertzResult` (a, b in mm; p_max, p_mean in MPa; approach in mm).
+    Equations (1)–(4) of the module docstring.
+    """
+    _check_array_positive("F", F, "N")
+    rx = _check_array_positive("Rx", Rx, "mm")
+    ry = _check_array_positive("Ry", Ry, "mm")
+    _check_array_positive("E_prime", E_prime, "MPa")
+    if method not in ("exact", "hamrock_brewe"):
+        raise ValueError(f"method = {method!r} must be 'exact' or 'hamrock_brewe'")
+    ratio = np.maximum(rx, ry) / np.minimum(rx, ry)
+    if method == "exact" and np.any(np.abs(np.log(ratio)) > 34.0):
+        raise ValueError(f"Ry/Rx = {float(np.max(ry / rx)):g} is outside the allowed range "
+                         "[1e-15, 1e15]; use hertz_line for a line contact")
+    if method == "hamrock_brewe" and np.any(ratio > 100.0):
+        warnings.warn("Hamrock-Brewe approximations used outside their fitted range "
+                      f"1 <= Ry/Rx <= 100 (got {float(np.max(ratio)):g}); use method='exact'",
+                      stacklevel=2)
+    out = _hertz_point_jit(F, Rx, Ry, E_prime, method=method)
+    if strict:
+        require_converged(out.converged, "Hertz ellipticity solve")
+    return out
+
+
+# ----------------------------------------------------------------------------
+# line contact
+# ----------------------------------------------------------------------------
+
+def hertz_line_traced(w, Rx, E_prime):
+    """Line-contact semi-width b (mm) and maximum pressure (MPa); no validation.
+
+    ``b = sqrt(8 w Rx / (π E'))``, ``p_max = 2 w / (π b)`` with ``w`` the load per
+    unit length (N/mm).  Johnson (1985) eq. 4.45 with E' = 2E*.
+    """
+    w, Rx, E_prime = (jnp.asarray(v, float) for v in (w, Rx, E_prime))
+    b = jnp.sqrt(8.0 * w * Rx / (jnp.pi * E_prime))
+    return b, 2.0 * w / (jnp.pi * b)
+
+
+def hertz_line(w, Rx, E_prime):
+    """Validated :func:`hertz_line_traced`: w (N/mm), Rx (mm), E' (MPa) all > 0."""
+    _check_array_positive("w", w, "N/mm")
+    _check_array_positive("Rx", Rx, "mm")
+    _check_array_positive("E_prime", E_prime, "MPa")
+    return hertz_line_traced(w, Rx, E_prime)
+
+
+# radius-ratio ceiling of the exact solver, also used by callers
+MAX_LOG_RATIO = 34.0

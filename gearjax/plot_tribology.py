@@ -1,0 +1,102 @@
+"""Matplotlib figures for friction studies (Stribeck curves, μ along a mesh cycle).
+
+Figures are built with the object API (``matplotlib.figure.Figure`` + Agg canvas),
+never ``pyplot``, so they work headless and never open windows.  Files are written
+atomically (:func:`save_figure_atomic`).
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+
+import numpy as np
+
+__all__ = ["stribeck_figure", "mesh_friction_figure", "save_figure_atomic"]
+
+
+def _figure(size=(6.4, 4.2)):
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=size, layout="constrained")
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def stribeck_figure(curves, labels=None, x="stribeck", title=None):
+    """Stribeck curves μ(x) on a log x axis.
+
+    ``curves``: sequence of :class:`gearjax.tribology.losses.StribeckCurve`;
+    ``x``: ``"stribeck"`` (η0 u_e/F_n, 1/m), ``"lambda"`` (smooth-surface λ_s) or
+    ``"speed"`` (u_e, m/s).  Regime bands (from the first curve's asperity load ratio)
+    are shaded.  Returns the Figure.
+    """
+    fig = _figure()
+    ax = fig.add_subplot()
+    labels = labels or [None] * len(curves)
+    for c, lab in zip(curves, labels):
+        xs = {"stribeck": np.asarray(c.stribeck_number), "lambda": np.asarray(c.lam),
+              "speed": np.asarray(c.u_e) * 1e-3}[x]
+        ax.semilogx(xs, np.asarray(c.mu), marker=".", label=lab)
+    if curves:
+        c = curves[0]
+        xs = {"stribeck": np.asarray(c.stribeck_number), "lambda": np.asarray(c.lam),
+              "speed": np.asarray(c.u_e) * 1e-3}[x]
+        reg = np.asarray(c.friction.regime)
+        colors = {0: "#f4cccc", 1: "#fff2cc", 2: "#d9ead3"}
+        order = np.argsort(xs)
+        xo, ro = xs[order], reg[order]
+        mid = np.sqrt(xo[1:] * xo[:-1])  # band edges half-way (log scale) between samples
+        edges = np.concatenate([[xo[0]], mid, [xo[-1]]])
+        for i, code in enumerate(ro):
+            ax.axvspan(edges[i], edges[i + 1], color=colors[int(code)], alpha=0.5, lw=0)
+    ax.set_xlabel({"stribeck": r"$\eta_0 u_e / F_n$ (1/m)", "lambda": r"$\lambda_s = h_{c,smooth}/\sigma$",
+                   "speed": r"$u_e$ (m/s)"}[x])
+    ax.set_ylabel(r"friction coefficient $\mu$")
+    ax.set_ylim(bottom=0)
+    ax.grid(True, which="both", alpha=0.3)
+    if any(labels):
+        ax.legend()
+    ax.set_title(title or "Stribeck curve (boundary / mixed / full film shaded)")
+    return fig
+
+
+def mesh_friction_figure(position, mu, power_loss_W=None, title=None):
+    """μ (per contact point) and optionally the power loss along a mesh cycle.
+
+    ``position``: (n_positions,) mesh position (e.g. pinion angle, rad);
+    ``mu``: (n_positions, n_points), zeros for inactive points are not drawn.
+    """
+    fig = _figure()
+    ax = fig.add_subplot()
+    mu = np.asarray(mu, float)
+    for j in range(mu.shape[1]):
+        m = np.where(mu[:, j] > 0, mu[:, j], np.nan)
+        ax.plot(position, m, marker=".", label=f"point {j}")
+    ax.set_xlabel("mesh position")
+    ax.set_ylabel(r"$\mu$")
+    if power_loss_W is not None:
+        ax2 = ax.twinx()
+        ax2.plot(position, np.asarray(power_loss_W), "k--", label="power loss")
+        ax2.set_ylabel("power loss (W)")
+    ax.legend(loc="upper left")
+    ax.set_title(title or "friction along the mesh cycle")
+    return fig
+
+
+def save_figure_atomic(fig, path, dpi=120):
+    """Save ``fig`` to ``path`` atomically: temp file in the same directory, then os.replace."""
+    path = os.fspath(path)
+    d = os.path.dirname(os.path.abspath(path))
+    ext = os.path.splitext(path)[1] or ".png"
+    fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=ext, dir=d)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fig.savefig(fh, dpi=dpi, format=ext.lstrip(".") or "png")
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+    return path

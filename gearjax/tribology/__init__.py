@@ -1,0 +1,23 @@
+"""Lubrication and friction of Hertzian gear contacts (seed 001).
+
+Modules (imports flow downwards):
+
+    lubricant.py  Oil, example oils, Roelands/Barus viscosity, density, Ree–Eyring
+    film.py       Hamrock–Dowson (ellipse) and Pan–Hamrock (line) film thickness
+    asperity.py   Greenwood–Tripp F_2, F_5/2 by quadrature; film/asperity load sharing
+    friction.py   μ = (f_c F_a + ∫τ dA)/F_n at contact points
+    losses.py     sliding power loss, mesh efficiency, Stribeck curves
+    empirical.py  empirical gear friction formulas (for comparison only)
+
+Hertz contact lives in :mod:`gearjax.contact`.  Units: mm, N, s, MPa; viscosity
+Pa·s; speeds mm/s.
+"""
+
+from gearjax.tribology.friction import (REGIMES, STEEL_E_PRIME, FrictionResult, Surface,
+                                        friction_coefficient, friction_traced, make_surface)
+from gearjax.tribology.losses import mesh_losses, mesh_losses_traced, stribeck_curve
+from gearjax.tribology.lubricant import OILS, Oil, get_oil, make_oil
+
+__all__ = ["REGIMES", "STEEL_E_PRIME", "FrictionResult", "Surface", "friction_coefficient",
+           "friction_traced", "make_surface", "mesh_losses", "mesh_losses_traced",
+           "stribeck_curve", "OILS", "Oil", "get_oil", "make_oil"]
