@@ -15,6 +15,17 @@ the core, never the other way round)::
                            u_e, u_s, SRR, K_II, R_eff, limit normal
     gearjax/gears/         gear families; involute.py: rack-generated spur and
                            helical pairs and their path-of-contact kinematics
+    gearjax/gears/hypoid_blank.py, pitch_cones.py, iso23509.py
+                           hypoid/spiral-bevel blank design: seed-003 tangency
+                           route and ISO 23509 Methods 0/1, sensitivity Jacobian
+    gearjax/cutters.py     straight-blade face-mill cutter (with edge radius)
+    gearjax/machines.py    cradle-type generator settings (pytree), roll with 2C/6D,
+                           Gleason No. 116 dial converter
+    gearjax/gears/hypoid.py  flank grids by seed 004's algorithm (meshing,
+                           face-width and face-cone conditions, continuation)
+    gearjax/io.py          design files (TOML), atomic CSV/XYZ/STL exports
+    gearjax/plot_flank.py  axial-plane flank figure
+    gearjax/examples/      packaged design files (8/43 HFT of seed 004, ...)
     gearjax/contact.py     Hertz point contact (exact, elliptic integrals by AGM;
                            Hamrock-Brewe option; line-contact limit)
     gearjax/tribology/     lubricant (Roelands/Barus, Dowson-Higginson, Ree-Eyring),

@@ -15,6 +15,9 @@ import sys
 # sub-command modules, in the order they appear in ``gearjax --help``
 COMMANDS = [
     "gearjax.commands.involute",
+    "gearjax.commands.example",
+    "gearjax.commands.blank",
+    "gearjax.commands.surface",
     "gearjax.commands.friction",
 ]
 
@@ -34,11 +37,37 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _enable_compilation_cache() -> None:
+    """Persist compiled JAX programs between CLI runs (``$GEARJAX_CACHE_DIR`` or
+    ``~/.cache/gearjax/jax``; set ``GEARJAX_CACHE_DIR=off`` to disable)."""
+    import os
+
+    import jax
+
+    path = os.environ.get("GEARJAX_CACHE_DIR", os.path.join(os.path.expanduser("~"), ".cache",
+                                                            "gearjax", "jax"))
+    if path.lower() in ("off", "none", ""):
+        return
+    try:
+        os.makedirs(path, exist_ok=True)
+        jax.config.update("jax_compilation_cache_dir", path)
+        jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.5)
+    except (OSError, AttributeError, ValueError):  # read-only home or an older JAX
+        pass
+
+
 def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+    if argv is None:  # a real command-line run, not an in-process call
+        _enable_compilation_cache()
     try:
         return int(args.func(args) or 0)
+    except BrokenPipeError:  # output piped into `head` and the like
+        import os
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return 0
     except ValueError as exc:
         sys.stderr.write(f"gearjax: error: {exc}\n")
         return 2

@@ -8,7 +8,6 @@ atomically (:func:`save_figure_atomic`).
 from __future__ import annotations
 
 import os
-import tempfile
 
 import numpy as np
 
@@ -86,17 +85,15 @@ def mesh_friction_figure(position, mu, power_loss_W=None, title=None):
 
 
 def save_figure_atomic(fig, path, dpi=120):
-    """Save ``fig`` to ``path`` atomically: temp file in the same directory, then os.replace."""
+    """Save ``fig`` to ``path`` atomically (temp file in the same directory, then
+    ``os.replace``; see :func:`gearjax.io.atomic_write`)."""
+    import io as _io
+
+    from .io import atomic_write
+
     path = os.fspath(path)
-    d = os.path.dirname(os.path.abspath(path))
     ext = os.path.splitext(path)[1] or ".png"
-    fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=ext, dir=d)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fig.savefig(fh, dpi=dpi, format=ext.lstrip(".") or "png")
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    buf = _io.BytesIO()
+    fig.savefig(buf, dpi=dpi, format=ext.lstrip("."))
+    atomic_write(path, buf.getvalue())
     return path

@@ -1,0 +1,34 @@
+"""``gearjax blank DESIGN``: blank data of a hypoid / spiral-bevel design.
+
+DESIGN is a path or ``example:NAME``; its ``[blank]`` table goes verbatim to
+:meth:`gearjax.gears.hypoid_blank.BlankInput.from_dict` and
+:func:`~gearjax.gears.hypoid_blank.blank_geometry` computes the blank."""
+
+from __future__ import annotations
+
+import json
+import sys
+
+
+def register(sub):
+    p = sub.add_parser("blank", help="blank data (cones, depths) of a hypoid/bevel design",
+                       description="Blank geometry from the [blank] table of a design file.")
+    p.add_argument("design", help="design file path or example:NAME")
+    p.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    from gearjax.gears.hypoid_blank import blank_geometry
+    from gearjax.io import load_design
+    design = load_design(args.design)
+    data = blank_geometry(design.blank_input())
+    if args.json:
+        sys.stdout.write(json.dumps(data.to_dict(), indent=2) + "\n")
+        return 0
+    rows = data.to_table()
+    w = max(len(r[0]) for r in rows)
+    sys.stdout.write(f"blank of {design.name or args.design}\n")
+    for name, value, unit in rows:
+        sys.stdout.write(f"  {name:<{w}s}  {value:14.6f}  {unit}\n")
+    return 0

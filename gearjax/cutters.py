@@ -1,0 +1,145 @@
+"""Straight-blade face-mill cutter surfaces (inside and outside blades, edge fillet).
+
+A face-mill cutter head carries blades whose straight cutting edges sweep cones
+about the cutter axis ``z_t``.  In the cutter frame S_t (origin on the cutter axis in
+the plane of the blade tips, ``z_t`` pointing from the cutter head towards the
+workpiece) the generating cone of seed 004 is
+
+    r_t(s, theta) = [ (R_p - sgn * s * sin(alpha)) cos(theta),
+                      (R_p - sgn * s * sin(alpha)) sin(theta),
+                      -s * cos(alpha) ]                                   (seed 004)
+
+with ``s`` the distance along the blade from its tip (mm, arc length), ``theta``
+the angular position about the cutter axis (rad), ``R_p`` the point radius (mm,
+radius of the blade tip corner), ``alpha`` the blade (pressure) angle, and
+``sgn = +1`` for the blade that cuts a *convex* flank (inside blade: its radius
+shrinks towards the tooth tip) and ``sgn = -1`` for the blade that cuts a
+*concave* flank (outside blade).  This is seed 004's sign convention.
+
+Unit normal (gearjax's orientation, not stated in the seed): the normal points from
+the workpiece material into the tooth space, i.e. into the blade,
+
+    n_t(theta) = [ sgn cos(alpha) cos(theta), sgn cos(alpha) sin(theta), -sin(alpha) ],
+
+which is ``sgn * (dr/ds x dr/dtheta)/|.|`` (checked in tests).
+
+Edge radius (root fillet): the blade tip corner is rounded with radius ``rho_f``.
+The straight part starts at ``s_min = rho_f (1 - sin(alpha)) / cos(alpha)`` (seed 004,
+"fillet start"); the fillet is a torus segment whose normal turns from the blade
+normal (angle ``alpha``) to ``-z_t`` (angle ``pi/2``):
+
+    centre (radial, axial) = (R_p + sgn*s_min, -rho_f),
+    point  = centre - rho_f * (sgn cos(phi), -sin(phi)),  phi in [alpha, pi/2].
+
+Units: mm, rad.  References: seed 004 (004_bb3a6051ad34f267.txt); Litvin & Fuentes,
+*Gear Geometry and Applied Theory*, 2nd ed., ch. 21 (head-cutters for spiral bevel
+gears).
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass
+
+import jax
+import jax.numpy as jnp
+
+from gearjax.errors import check_positive, check_range
+
+__all__ = ["FaceMillCutter", "make_cutter", "cutter_point", "cutter_normal",
+           "cutter_tangents", "fillet_start", "fillet_point", "fillet_normal",
+           "blade_radius"]
+
+
+@functools.partial(jax.tree_util.register_dataclass,
+                   data_fields=["point_radius", "blade_angle", "edge_radius"],
+                   meta_fields=["sign"])
+@dataclass(frozen=True)
+class FaceMillCutter:
+    """One blade of a straight-blade face-mill cutter (a pytree).
+
+    Attributes
+    ----------
+    point_radius : R_p, radius of the blade tip corner (mm).
+    blade_angle : alpha, blade (pressure) angle, in (0, pi/4) (rad).
+    edge_radius : rho_f, radius of the blade tip fillet (mm), >= 0.
+    sign : +1 inside blade (cuts a convex flank), -1 outside blade (concave flank).
+    """
+
+    point_radius: jax.Array
+    blade_angle: jax.Array
+    edge_radius: jax.Array
+    sign: int = 1
+
+    @property
+    def side(self) -> str:
+        return "convex" if self.sign > 0 else "concave"
+
+
+def make_cutter(point_radius, blade_angle_deg, edge_radius, flank: str) -> FaceMillCutter:
+    """Validated constructor (file units: mm and degrees).
+
+    ``flank`` is "convex" (inside blade, sgn = +1) or "concave" (outside blade,
+    sgn = -1).  Raises ValueError naming the parameter and the allowed range.
+    """
+    if flank not in ("convex", "concave"):
+        raise ValueError(f"flank = {flank!r} must be 'convex' or 'concave'")
+    R = check_positive("point_radius", point_radius, "mm")
+    a = check_range("blade_angle", blade_angle_deg, 0.0, 45.0, lo_open=True, hi_open=True,
+                    unit="deg")
+    rho = check_range("edge_radius", edge_radius, 0.0, None, unit="mm")
+    a_rad = math.radians(a)
+    s_min = rho * (1.0 - math.sin(a_rad)) / math.cos(a_rad)
+    if s_min * math.sin(a_rad) + rho >= R:
+        raise ValueError(f"edge_radius = {rho:g} mm is too large for point_radius = {R:g} mm")
+    return FaceMillCutter(jnp.asarray(R), jnp.asarray(a_rad), jnp.asarray(rho),
+                          1 if flank == "convex" else -1)
+
+
+def blade_radius(c: FaceMillCutter, s):
+    """Radius of the blade cone at distance ``s`` (mm) from the tip: R_p - sgn s sin(alpha)."""
+    return c.point_radius - c.sign * s * jnp.sin(c.blade_angle)
+
+
+def cutter_point(c: FaceMillCutter, s, theta):
+    """Point r_t(s, theta) of the straight-blade cone in the cutter frame (mm), seed 004."""
+    rho = blade_radius(c, s)
+    return jnp.stack([rho * jnp.cos(theta), rho * jnp.sin(theta), -s * jnp.cos(c.blade_angle)])
+
+
+def cutter_normal(c: FaceMillCutter, s, theta):
+    """Unit normal of the blade cone (points out of the workpiece material into the slot)."""
+    ca, sa = jnp.cos(c.blade_angle), jnp.sin(c.blade_angle)
+    sg = c.sign
+    del s
+    return jnp.stack([sg * ca * jnp.cos(theta), sg * ca * jnp.sin(theta), -sa * jnp.ones_like(theta)])
+
+
+def cutter_tangents(c: FaceMillCutter, s, theta):
+    """(dr/ds, dr/dtheta) of the blade cone by forward-mode autodiff (mm, mm/rad)."""
+    f = lambda a, b: cutter_point(c, a, b)
+    return jax.jacfwd(f, 0)(s, theta), jax.jacfwd(f, 1)(s, theta)
+
+
+def fillet_start(c: FaceMillCutter):
+    """s_min = rho_f (1 - sin alpha) / cos alpha: where the straight blade meets the fillet (mm)."""
+    a = c.blade_angle
+    return c.edge_radius * (1.0 - jnp.sin(a)) / jnp.cos(a)
+
+
+def fillet_point(c: FaceMillCutter, phi, theta):
+    """Point on the tip-fillet torus, ``phi`` in [alpha, pi/2] the normal's angle (mm)."""
+    sg = c.sign
+    rc = c.point_radius + sg * fillet_start(c)
+    zc = -c.edge_radius
+    r = rc - c.edge_radius * sg * jnp.cos(phi)
+    z = zc + c.edge_radius * jnp.sin(phi)
+    return jnp.stack([r * jnp.cos(theta), r * jnp.sin(theta), z])
+
+
+def fillet_normal(c: FaceMillCutter, phi, theta):
+    """Unit normal of the fillet torus (same orientation as :func:`cutter_normal`)."""
+    sg = c.sign
+    return jnp.stack([sg * jnp.cos(phi) * jnp.cos(theta), sg * jnp.cos(phi) * jnp.sin(theta),
+                      -jnp.sin(phi) * jnp.ones_like(theta)])

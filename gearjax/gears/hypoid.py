@@ -1,0 +1,361 @@
+"""Face-milled hypoid and spiral-bevel tooth flanks by seed 004's algorithm.
+
+A flank is the envelope of a straight-blade face-mill cutter cone
+(:mod:`gearjax.cutters`) carried by a cradle-type generator
+(:mod:`gearjax.machines`), or for a formate (non-generated) member the cutter cone
+itself placed by the settings.  With ``r_w(s, theta, psi)`` the cutter surface in
+the work frame and ``n_w`` its unit normal:
+
+* meshing equation (generated members)      f1 = n_w . dr_w/dpsi = 0   (mm/rad)
+  The relative velocity is the autodiff derivative ``dr_w/dpsi`` of the carried
+  cutter point (DESIGN.md), not a hand-derived velocity formula; it equals seed
+  004's ``(omega_c - omega_w) x r + omega_w x R`` per unit cradle roll.
+* face-width condition                      f2 = l_p(r_w) - l_p(xi0) = 0   (mm)
+  with the distance along the pitch generatrix ``l_p = cos(gp) x_A + sin(gp) R_A``
+  (seed 004) and ``xi = 1 - 2 (A_o - l_p)/F`` so that ``xi = -1`` at the toe, 0 at
+  mid face and +1 at the heel.  (Seed 004 prints ``xi = 1 - A_o/F + l_p/F``, which
+  runs from 0 to 1 and contradicts its own "-1 at the toe, +1 at the heel"; gearjax
+  uses the form that matches the stated range.)
+* face-cone (tip) condition                 f3 = sin(gF)(x_A + x_pf) - cos(gF) R_A = 0  (mm)
+  (seed 004's ``tan(gF)(x_A + x_pf) - R_A`` times ``cos(gF)``: the signed normal
+  distance to the face cone, better scaled near gF = 90 deg).
+
+For a formate member ``psi`` is fixed at 0 and the first equation reads
+``f1 = psi``, so both kinds share one code path.
+
+Algorithm (seed 004): (1) start values at mid face from the cutter/blank geometry
+at ``psi = 0`` -- gearjax takes the blank's mean pitch point on the side facing the
+cutter and reads ``theta*`` and ``s*`` off it in the cutter frame (the geometric
+content of seed 004's closed-form ``theta* = pi/2 - beta + q0``,
+``s* = A_m sin(Delta)/cos(alpha)``, ``psi* = 0``, whose signs depend on the paper's
+frame conventions); (2) Newton on (f1, f2, f3) at ``xi = 0`` gives the tip point
+(seed 004 uses simulated annealing here; Newton from the geometric estimate
+converges and nothing random is used); (3) continuation of the tip point along the
+face width (``lax.scan`` from mid face to heel and to toe, previous solution as
+the start); (4) for every face-width position a scan down the blade from
+``s_max`` to the fillet start ``s_min = rho_f (1 - sin a)/cos a`` solving (f1, f2) at
+fixed ``s``.  All solves use :func:`gearjax.newton.newton_solve`, so flank points
+are differentiable (forward and reverse) with respect to every machine setting,
+the cutter and the blank by the implicit function theorem.
+
+Work frame: origin at the pitch-cone apex, ``z_w`` the work axis pointing from the
+apex towards the heel; ``x_A = z_w``, ``R_A = sqrt(x_w^2 + y_w^2)``.
+Normals point out of the tooth material into the tooth space.
+
+Units: mm, rad.  References: seed 004 (004_bb3a6051ad34f267.txt); Litvin & Fuentes,
+*Gear Geometry and Applied Theory*, 2nd ed., ch. 6 (envelopes) and ch. 21-22.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from gearjax import frames
+from gearjax.cutters import FaceMillCutter, cutter_normal, cutter_point, fillet_start
+from gearjax.errors import check_int, check_positive, check_range, require_converged
+from gearjax.machines import MachineSettings, cutter_to_work, work_to_machine
+from gearjax.newton import newton_solve
+
+__all__ = ["MemberBlank", "FlankSpec", "FlankGrid", "make_member_blank", "mean_cone_distance",
+           "face_apex_offset", "root_apex_offset", "axial_coords", "pitch_distance", "xi_of",
+           "face_cone_gap", "root_cone_gap", "work_point", "meshing_function", "mid_estimate",
+           "solve_tip", "solve_point", "flank_points", "flank_surface", "spiral_angle_at",
+           "BLANK_FIELDS"]
+
+TOL = 1e-10   # mm, residual tolerance of every solve
+
+BLANK_FIELDS = ["outer_cone_distance", "face_width", "pitch_angle", "face_angle", "root_angle",
+                "outer_addendum", "outer_dedendum", "mean_spiral_angle"]
+
+
+@functools.partial(jax.tree_util.register_dataclass, data_fields=BLANK_FIELDS,
+                   meta_fields=["teeth", "hand"])
+@dataclass(frozen=True)
+class MemberBlank:
+    """Cone data of one member's blank (mm, rad), as in seed 004's Table 1.
+
+    outer_cone_distance A_o, face_width F (mm), pitch/face/root cone angles,
+    outer addendum and dedendum (mm, at the heel, Gleason convention), mean spiral
+    angle; static: number of teeth and hand of spiral ("left"/"right").
+    """
+
+    outer_cone_distance: jax.Array
+    face_width: jax.Array
+    pitch_angle: jax.Array
+    face_angle: jax.Array
+    root_angle: jax.Array
+    outer_addendum: jax.Array
+    outer_dedendum: jax.Array
+    mean_spiral_angle: jax.Array
+    teeth: int = 1
+    hand: str = "right"
+
+
+def make_member_blank(*, outer_cone_distance, face_width, pitch_angle, face_angle, root_angle,
+                      outer_addendum, outer_dedendum, mean_spiral_angle, teeth, hand) -> MemberBlank:
+    """Validated constructor; angles in degrees (file units), lengths in mm."""
+    Ao = check_positive("outer_cone_distance", outer_cone_distance, "mm")
+    F = check_range("face_width", face_width, 0.0, Ao, lo_open=True, hi_open=True, unit="mm")
+    gp = check_range("pitch_angle", pitch_angle, 0.0, 90.0, lo_open=True, hi_open=True, unit="deg")
+    gf = check_range("face_angle", face_angle, gp, 90.0, hi_open=True, unit="deg")
+    gr = check_range("root_angle", root_angle, 0.0, gp, lo_open=True, unit="deg")
+    a = check_range("outer_addendum", outer_addendum, 0.0, None, unit="mm")
+    d = check_positive("outer_dedendum", outer_dedendum, "mm")
+    b = check_range("mean_spiral_angle", mean_spiral_angle, 0.0, 90.0, hi_open=True, unit="deg")
+    z = check_int("teeth", teeth, 1)
+    if hand not in ("left", "right"):
+        raise ValueError(f"hand = {hand!r} must be 'left' or 'right'")
+    r = np.radians
+    f = lambda v: jnp.asarray(float(v))
+    return MemberBlank(f(Ao), f(F), f(r(gp)), f(r(gf)), f(r(gr)), f(a), f(d), f(r(b)), z, hand)
+
+
+def mean_cone_distance(b: MemberBlank):
+    """A_m = A_o - F/2 (mm)."""
+    return b.outer_cone_distance - 0.5 * b.face_width
+
+
+def face_apex_offset(b: MemberBlank):
+    """x_pf: distance from the face-cone apex to the pitch apex along the axis (mm).
+
+    The face cone passes through the heel addendum point
+    ``(x, R) = (A_o cos gp - a sin gp, A_o sin gp + a cos gp)``, so
+    ``x_pf = R / tan(gF) - x``.
+    """
+    Ao, gp, a = b.outer_cone_distance, b.pitch_angle, b.outer_addendum
+    x = Ao * jnp.cos(gp) - a * jnp.sin(gp)
+    R = Ao * jnp.sin(gp) + a * jnp.cos(gp)
+    return R / jnp.tan(b.face_angle) - x
+
+
+def root_apex_offset(b: MemberBlank):
+    """x_pr: root-cone apex to pitch apex (mm); root cone through the heel dedendum point."""
+    Ao, gp, d = b.outer_cone_distance, b.pitch_angle, b.outer_dedendum
+    x = Ao * jnp.cos(gp) + d * jnp.sin(gp)
+    R = Ao * jnp.sin(gp) - d * jnp.cos(gp)
+    return R / jnp.tan(b.root_angle) - x
+
+
+def axial_coords(r):
+    """(x_A, R_A): axial coordinate from the pitch apex and radius of work-frame point(s)."""
+    r = jnp.asarray(r)
+    return r[..., 2], jnp.sqrt(r[..., 0] ** 2 + r[..., 1] ** 2)
+
+
+def pitch_distance(b: MemberBlank, r):
+    """l_p = cos(gp) x_A + sin(gp) R_A (mm), seed 004."""
+    x, R = axial_coords(r)
+    return jnp.cos(b.pitch_angle) * x + jnp.sin(b.pitch_angle) * R
+
+
+def xi_of(b: MemberBlank, r):
+    """Face-width coordinate xi = 1 - 2 (A_o - l_p)/F: -1 toe, 0 mid face, +1 heel."""
+    return 1.0 - 2.0 * (b.outer_cone_distance - pitch_distance(b, r)) / b.face_width
+
+
+def face_cone_gap(b: MemberBlank, r):
+    """Signed normal distance below the face cone (mm): > 0 inside the blank."""
+    x, R = axial_coords(r)
+    g = b.face_angle
+    return jnp.sin(g) * (x + face_apex_offset(b)) - jnp.cos(g) * R
+
+
+def root_cone_gap(b: MemberBlank, r):
+    """Signed normal distance above the root cone (mm): > 0 above the root."""
+    x, R = axial_coords(r)
+    g = b.root_angle
+    return jnp.cos(g) * R - jnp.sin(g) * (x + root_apex_offset(b))
+
+
+@functools.partial(jax.tree_util.register_dataclass,
+                   data_fields=["cutter", "machine", "blank"], meta_fields=[])
+@dataclass(frozen=True)
+class FlankSpec:
+    """Everything one flank needs: the blade, the machine settings and the blank."""
+
+    cutter: FaceMillCutter
+    machine: MachineSettings
+    blank: MemberBlank
+
+
+def work_point(fl: FlankSpec, s, theta, psi=0.0):
+    """Cutter point and unit normal carried into the work frame at cradle roll psi."""
+    M = cutter_to_work(fl.machine, psi)
+    r = frames.apply_point(M, cutter_point(fl.cutter, s, theta))
+    n = frames.apply_vector(M, cutter_normal(fl.cutter, s, theta))
+    return r, n
+
+
+def meshing_function(fl: FlankSpec, s, theta, psi):
+    """f1 = n_w . dr_w/dpsi (mm/rad): zero on the generated flank (0 for formate)."""
+    if not fl.machine.generated:
+        return jnp.zeros_like(jnp.asarray(psi, float))
+    v = jax.jacfwd(lambda p: work_point(fl, s, theta, p)[0])(psi)
+    _, n = work_point(fl, s, theta, psi)
+    return jnp.dot(n, v)
+
+
+def _target(b: MemberBlank, xi0):
+    return b.outer_cone_distance - 0.5 * b.face_width * (1.0 - xi0)
+
+
+def _first_eq(fl, s, th, psi):
+    return meshing_function(fl, s, th, psi) if fl.machine.generated else psi
+
+
+def _F_tip(x, p):
+    fl, xi0 = p
+    s, th, psi = x[0], x[1], x[2]
+    r, _ = work_point(fl, s, th, psi)
+    return jnp.stack([_first_eq(fl, s, th, psi), pitch_distance(fl.blank, r) - _target(fl.blank, xi0),
+                      face_cone_gap(fl.blank, r)])
+
+
+def _F_point(x, p):
+    fl, s, xi0 = p
+    th, psi = x[0], x[1]
+    r, _ = work_point(fl, s, th, psi)
+    return jnp.stack([_first_eq(fl, s, th, psi), pitch_distance(fl.blank, r) - _target(fl.blank, xi0)])
+
+
+def mid_estimate(fl: FlankSpec):
+    """Start values (s*, theta*, psi* = 0) at mid face (see module docstring).
+
+    The blank's mean pitch point is taken in the axial plane facing the cutter
+    (the work-frame direction of ``-z_m``) and expressed in the cutter frame at
+    ``psi = 0``: ``theta* = atan2(y_t, x_t)``, ``s* = max(-z_t / cos(alpha), s_min)``.
+    """
+    b, ms = fl.blank, fl.machine
+    d = frames.apply_vector(frames.inverse(work_to_machine(ms, 0.0)), jnp.array([0.0, 0.0, -1.0]))
+    az = jnp.arctan2(d[1], d[0])
+    Am = mean_cone_distance(b)
+    x, R = Am * jnp.cos(b.pitch_angle), Am * jnp.sin(b.pitch_angle)
+    P = jnp.stack([R * jnp.cos(az), R * jnp.sin(az), x])
+    Pt = frames.apply_point(frames.inverse(cutter_to_work(ms, 0.0)), P)
+    th = jnp.arctan2(Pt[1], Pt[0])
+    s = jnp.maximum(-Pt[2] / jnp.cos(fl.cutter.blade_angle), fillet_start(fl.cutter))
+    return jnp.stack([s, th, 0.0 * th])
+
+
+def solve_tip(fl: FlankSpec, xi0, x0):
+    """Tip point (on the face cone) at face-width position xi0: x = (s, theta, psi)."""
+    return newton_solve(_F_tip, x0, (fl, jnp.asarray(xi0, float)), tol=TOL)
+
+
+def solve_point(fl: FlankSpec, s, xi0, x0):
+    """Flank point at blade distance s and face-width position xi0: x = (theta, psi)."""
+    return newton_solve(_F_point, x0, (fl, jnp.asarray(s, float), jnp.asarray(xi0, float)), tol=TOL)
+
+
+class FlankGrid(NamedTuple):
+    """A flank grid, shape (n_xi, n_s) per field; index j runs root (fillet start) -> tip.
+
+    points (n_xi, n_s, 3) mm and normals (n_xi, n_s, 3) in the work frame;
+    params (n_xi, n_s, 3) = (s, theta, psi) surface parameters (mm, rad, rad);
+    xi (n_xi,) face-width positions; residual (n_xi, n_s) max |F| of the solve (mm);
+    converged (n_xi, n_s) bool (point solve and its row's tip solve both converged).
+    """
+
+    points: jax.Array
+    normals: jax.Array
+    params: jax.Array
+    xi: jax.Array
+    residual: jax.Array
+    converged: jax.Array
+
+
+def _tip_scan(fl, xs, x_start):
+    def step(carry, xi0):
+        res = solve_tip(fl, xi0, carry)
+        nxt = jnp.where(res.converged, res.x, carry)
+        return nxt, res
+    _, out = jax.lax.scan(step, x_start, xs)
+    return out
+
+
+def flank_points(fl: FlankSpec, n_xi: int = 21, n_s: int = 11) -> FlankGrid:
+    """Flank grid by seed 004's algorithm (pure and jit-friendly; no validation).
+
+    ``n_xi`` face-width positions ``xi`` in [-1, 1] (toe to heel), ``n_s`` blade
+    positions from the fillet start ``s_min`` to the tip ``s_max(xi)``, uniformly
+    spaced in ``s``.  Use :func:`flank_surface` for a validated, convergence-checked
+    result.  Differentiable w.r.t. ``fl`` (jacfwd/jacrev) through the implicit solves.
+    """
+    xis = np.linspace(-1.0, 1.0, int(n_xi))
+    ts = np.linspace(1.0, 0.0, int(n_s))          # tip -> root
+    mid = solve_tip(fl, 0.0, mid_estimate(fl))
+    up = xis[xis >= 0.0]
+    down = xis[xis < 0.0][::-1]
+    tips_up = _tip_scan(fl, jnp.asarray(up), mid.x)
+    if down.size:
+        tips_dn = _tip_scan(fl, jnp.asarray(down), mid.x)
+        tips = jax.tree_util.tree_map(lambda a, b: jnp.concatenate([a[::-1], b]), tips_dn, tips_up)
+    else:
+        tips = tips_up
+    tip_ok = tips.converged & mid.converged
+    s_min = fillet_start(fl.cutter)
+
+    def row(tip_x, xi0):
+        s_max = tip_x[0]
+
+        def step(carry, t):
+            s = s_min + (s_max - s_min) * t
+            res = solve_point(fl, s, xi0, carry)
+            nxt = jnp.where(res.converged, res.x, carry)
+            r, n = work_point(fl, s, res.x[0], res.x[1])
+            return nxt, (r, n, jnp.stack([s, res.x[0], res.x[1]]), res.residual, res.converged)
+
+        _, out = jax.lax.scan(step, tip_x[1:], jnp.asarray(ts))
+        return out
+
+    r, n, prm, res, conv = jax.vmap(row)(tips.x, jnp.asarray(xis))
+    flip = lambda a: a[:, ::-1]
+    res = jnp.maximum(flip(res), tips.residual[:, None])
+    conv = flip(conv) & tip_ok[:, None]
+    return FlankGrid(flip(r), flip(n), flip(prm), jnp.asarray(xis), res, conv)
+
+
+@functools.partial(jax.jit, static_argnums=(1, 2))
+def _flank_points_jit(fl, n_xi, n_s):
+    return flank_points(fl, n_xi, n_s)
+
+
+def flank_surface(fl: FlankSpec, n_xi: int = 21, n_s: int = 11, *, strict: bool = True) -> FlankGrid:
+    """Validated, jitted :func:`flank_points`; raises ConvergenceError unless every point
+    converged (``strict=False`` returns the grid with its ``converged`` mask)."""
+    n_xi = check_int("n_xi", n_xi, 2, 2001)
+    n_s = check_int("n_s", n_s, 2, 2001)
+    g = _flank_points_jit(fl, n_xi, n_s)
+    if strict:
+        require_converged(g.converged, "hypoid flank grid", g.residual)
+    return g
+
+
+def spiral_angle_at(fl: FlankSpec, s, xi0, x0):
+    """Spiral angle (rad) of the flank line s = const at (s, xi0), measured in the
+    plane tangent to the pitch cone between the flank line and the cone generatrix.
+
+    The flank line tangent dr/dxi comes from the implicit solve (autodiff); it is
+    projected onto the tangent plane of the pitch cone at the point's axial
+    position (normal ``(cos gp e_R - sin gp e_z)`` in the axial plane).
+    """
+    b = fl.blank
+
+    def pt(xi):
+        res = solve_point(fl, s, xi, x0)
+        return work_point(fl, s, res.x[0], res.x[1])[0]
+
+    r = pt(xi0)
+    t = jax.jacfwd(pt)(jnp.asarray(xi0, float))
+    e_R = jnp.stack([r[0], r[1], 0.0]) / jnp.hypot(r[0], r[1])
+    e_z = jnp.array([0.0, 0.0, 1.0])
+    g = jnp.cos(b.pitch_angle) * e_z + jnp.sin(b.pitch_angle) * e_R       # generatrix
+    nrm = jnp.cos(b.pitch_angle) * e_R - jnp.sin(b.pitch_angle) * e_z     # cone normal
+    t = t - jnp.dot(t, nrm) * nrm
+    return jnp.arctan2(jnp.linalg.norm(jnp.cross(g, t)), jnp.abs(jnp.dot(g, t)))

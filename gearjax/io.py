@@ -1,0 +1,475 @@
+"""Design files (TOML) and exports of flank grids (CSV, XYZ, STL), written atomically.
+
+Design files use mm and degrees; inside gearjax everything is mm and rad.  A
+hypoid/spiral-bevel design file has the tables
+
+* ``[design]``  name, kind ("hypoid" | "spiral_bevel"), description, source
+* ``[blank]``   the blank-design input, passed verbatim to
+  :meth:`gearjax.gears.hypoid_blank.BlankInput.from_dict` (optional)
+* ``[blank_summary.pinion]``, ``[blank_summary.gear]``  cone data of each member
+  (seed 004's Table 1 layout): hand, teeth, outer_cone_distance,
+  mean_cone_distance (optional, checked against A_o - F/2), face_width,
+  outer_addendum, outer_dedendum, pitch_angle, face_angle, root_angle,
+  mean_spiral_angle
+* ``[<member>.<flank>.cutter]`` point_radius, blade_angle, edge_radius
+  (member: pinion | gear, flank: convex | concave; convex = inside blade)
+* ``[<member>.<flank>.machine]`` type ("generated" | "formate"), blank_offset,
+  machine_root_angle, sliding_base, center_to_back, ratio_of_roll,
+  modified_roll_2c, modified_roll_6d, and either the geometric radial_distance,
+  cradle_angle, tilt, swivel or a sub-table ``no116`` with the Gleason No. 116
+  dials cradle, eccentric, swivel, tilt (seed 004)
+* ``[machine_summary]`` free-form copy of published settings, kept for comparison.
+
+Unknown keys raise ``ValueError`` naming the key.  :func:`save_design` writes the
+same data back (a small TOML writer for this schema; no extra dependency) and
+``load_design(save_design(d)) == d`` (tested).
+
+Every file is written atomically: to a temporary file in the target directory,
+then ``os.replace``; a failing export never touches an existing file.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import os
+import tempfile
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+
+try:
+    import tomllib
+except ModuleNotFoundError:  # pragma: no cover  (python < 3.11)
+    import tomli as tomllib  # type: ignore
+
+__all__ = ["HypoidDesign", "load_design", "save_design", "design_from_dict", "dumps_toml",
+           "list_examples", "example_path", "atomic_write", "write_csv", "write_xyz",
+           "write_stl_flank", "write_stl_tooth", "tooth_mesh", "flank_triangles",
+           "write_flank"]
+
+MEMBERS = ("pinion", "gear")
+FLANKS = ("convex", "concave")
+_TOP = {"design", "blank", "blank_summary", "pinion", "gear", "machine_summary"}
+_DESIGN = {"name", "kind", "description", "source"}
+_SUMMARY = {"hand", "teeth", "outer_cone_distance", "mean_cone_distance", "face_width",
+            "outer_addendum", "outer_dedendum", "pitch_angle", "face_angle", "root_angle",
+            "mean_spiral_angle"}
+_CUTTER = {"point_radius", "blade_angle", "edge_radius"}
+_MACHINE = {"type", "blank_offset", "machine_root_angle", "sliding_base", "center_to_back",
+            "ratio_of_roll", "modified_roll_2c", "modified_roll_6d", "radial_distance",
+            "cradle_angle", "tilt", "swivel", "no116"}
+_NO116 = {"cradle", "eccentric", "swivel", "tilt"}
+
+
+# --------------------------------------------------------------------------------------
+# atomic writes
+
+
+def atomic_write(path, data) -> Path:
+    """Write ``data`` (str or bytes) to ``path`` via a temp file in the same directory
+    and ``os.replace``.  On any error the temp file is removed and ``path`` untouched."""
+    path = Path(path)
+    mode = "wb" if isinstance(data, (bytes, bytearray)) else "w"
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent or ".")
+    umask = os.umask(0)
+    os.umask(umask)
+    try:
+        os.chmod(tmp, 0o666 & ~umask)  # mkstemp creates 0600; give the usual file mode
+        with os.fdopen(fd, mode, **({} if mode == "wb" else {"encoding": "utf-8", "newline": "\n"})) as f:
+            f.write(data)
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
+    return path
+
+
+# --------------------------------------------------------------------------------------
+# TOML writer (the subset the design schema uses)
+
+
+def _toml_key(k: str) -> str:
+    if k and all(c.isalnum() or c in "_-" for c in k):
+        return k
+    return '"' + k.replace("\\", "\\\\").replace('"', '\\"') + '"'
+
+
+def _toml_value(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        if math.isnan(v):
+            return "nan"
+        if math.isinf(v):
+            return "inf" if v > 0 else "-inf"
+        return repr(v)
+    if isinstance(v, str):
+        s = v.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n").replace("\t", "\\t")
+        return f'"{s}"'
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    raise ValueError(f"cannot write {type(v).__name__} value {v!r} to TOML")
+
+
+def dumps_toml(data: dict) -> str:
+    """Serialise nested dicts of str/int/float/bool/lists to TOML (tables as [a.b])."""
+    out: list[str] = []
+
+    def emit(tbl: dict, prefix: list[str]):
+        scalars = [(k, v) for k, v in tbl.items() if not isinstance(v, dict)]
+        tables = [(k, v) for k, v in tbl.items() if isinstance(v, dict)]
+        if prefix and (scalars or not tables):
+            out.append("[" + ".".join(_toml_key(p) for p in prefix) + "]")
+        for k, v in scalars:
+            out.append(f"{_toml_key(k)} = {_toml_value(v)}")
+        if prefix and (scalars or not tables):
+            out.append("")
+        for k, v in tables:
+            emit(v, prefix + [k])
+
+    emit(data, [])
+    return "\n".join(out).rstrip("\n") + "\n"
+
+
+# --------------------------------------------------------------------------------------
+# design files
+
+
+def _check_keys(where: str, d, allowed: set):
+    if not isinstance(d, dict):
+        raise ValueError(f"[{where}] must be a table")
+    for k in d:
+        if k not in allowed:
+            raise ValueError(f"unknown key '{where}.{k}' (allowed: {', '.join(sorted(allowed))})")
+
+
+def _req(where: str, d: dict, key: str):
+    if key not in d:
+        raise ValueError(f"missing key '{where}.{key}'")
+    return d[key]
+
+
+@dataclass(frozen=True)
+class HypoidDesign:
+    """A validated hypoid / spiral-bevel design (file content in file units)."""
+
+    data: dict = field(compare=True)
+
+    @property
+    def name(self) -> str:
+        return self.data.get("design", {}).get("name", "")
+
+    def to_dict(self) -> dict:
+        return copy.deepcopy(self.data)
+
+    def flanks(self):
+        """(member, flank) pairs present in the design."""
+        return [(m, f) for m in MEMBERS for f in FLANKS if f in self.data.get(m, {})]
+
+    def member_blank(self, member: str):
+        """:class:`~gearjax.gears.hypoid.MemberBlank` of ``member`` from [blank_summary]."""
+        from gearjax.gears.hypoid import make_member_blank
+        if member not in MEMBERS:
+            raise ValueError(f"member = {member!r} must be 'pinion' or 'gear'")
+        where = f"blank_summary.{member}"
+        d = self.data.get("blank_summary", {}).get(member)
+        if d is None:
+            raise ValueError(f"missing table [{where}]")
+        kw = {k: _req(where, d, k) for k in _SUMMARY if k != "mean_cone_distance"}
+        b = make_member_blank(**kw)
+        if "mean_cone_distance" in d:
+            am = float(d["outer_cone_distance"]) - 0.5 * float(d["face_width"])
+            if abs(am - float(d["mean_cone_distance"])) > 1e-6 * max(1.0, am):
+                raise ValueError(f"{where}.mean_cone_distance = {d['mean_cone_distance']} mm "
+                                 f"must equal outer_cone_distance - face_width/2 = {am:g} mm")
+        return b
+
+    def cutter(self, member: str, flank: str):
+        from gearjax.cutters import make_cutter
+        where = f"{member}.{flank}.cutter"
+        d = self._flank_table(member, flank)["cutter"]
+        return make_cutter(_req(where, d, "point_radius"), _req(where, d, "blade_angle"),
+                           _req(where, d, "edge_radius"), flank)
+
+    def machine(self, member: str, flank: str):
+        """:class:`~gearjax.machines.MachineSettings` (dials converted to geometric settings)."""
+        import jax.numpy as jnp
+        from gearjax.machines import MachineSettings, No116Dials, dials_to_geometric
+        where = f"{member}.{flank}.machine"
+        d = self._flank_table(member, flank)["machine"]
+        typ = _req(where, d, "type")
+        if typ not in ("generated", "formate"):
+            raise ValueError(f"{where}.type = {typ!r} must be 'generated' or 'formate'")
+        gen = typ == "generated"
+        r = math.radians
+        g = lambda k, default=0.0: float(d.get(k, default))
+        if "no116" in d:
+            if not gen:
+                raise ValueError(f"{where}.no116 dials apply to generated members only")
+            dd = d["no116"]
+            _check_keys(where + ".no116", dd, _NO116)
+            for k in ("radial_distance", "cradle_angle", "tilt", "swivel"):
+                if k in d:
+                    raise ValueError(f"{where}.{k} conflicts with {where}.no116 (give one of them)")
+            from gearjax.errors import check_range
+            ecc = check_range(where + ".no116.eccentric", _req(where + ".no116", dd, "eccentric"),
+                              0.0, 180.0, lo_open=True, unit="deg")
+            tilt = check_range(where + ".no116.tilt", _req(where + ".no116", dd, "tilt"),
+                               0.0, 180.0, unit="deg")
+            dials = No116Dials(jnp.asarray(r(float(_req(where + ".no116", dd, "cradle")))),
+                               jnp.asarray(r(ecc)),
+                               jnp.asarray(r(float(_req(where + ".no116", dd, "swivel")))),
+                               jnp.asarray(r(tilt)))
+            S, q, i, j = (float(v) for v in dials_to_geometric(dials))
+        else:
+            S = _req(where, d, "radial_distance")
+            q = r(float(_req(where, d, "cradle_angle")))
+            i, j = r(g("tilt")), r(g("swivel"))
+        try:
+            return MachineSettings.create(
+                radial_distance=S, cradle_angle=q, tilt=i, swivel=j, blank_offset=g("blank_offset"),
+                machine_root_angle=r(float(_req(where, d, "machine_root_angle"))),
+                sliding_base=g("sliding_base"), center_to_back=g("center_to_back"),
+                ratio_of_roll=g("ratio_of_roll") if gen else 0.0,
+                modified_roll_2c=g("modified_roll_2c"), modified_roll_6d=g("modified_roll_6d"),
+                generated=gen)
+        except ValueError as exc:
+            raise ValueError(f"{where}: {exc}") from None
+
+    def flank(self, member: str, flank: str):
+        """:class:`~gearjax.gears.hypoid.FlankSpec` for one flank."""
+        from gearjax.gears.hypoid import FlankSpec
+        return FlankSpec(self.cutter(member, flank), self.machine(member, flank),
+                         self.member_blank(member))
+
+    def blank_input(self):
+        """The ``[blank]`` table as :class:`BlankInput` (blank-design module)."""
+        from gearjax.gears.hypoid_blank import BlankInput
+        if "blank" not in self.data:
+            raise ValueError("the design has no [blank] table")
+        return BlankInput.from_dict(self.data["blank"])
+
+    def _flank_table(self, member, flank):
+        if member not in MEMBERS:
+            raise ValueError(f"member = {member!r} must be 'pinion' or 'gear'")
+        if flank not in FLANKS:
+            raise ValueError(f"flank = {flank!r} must be 'convex' or 'concave'")
+        t = self.data.get(member, {}).get(flank)
+        if t is None:
+            raise ValueError(f"the design has no [{member}.{flank}] flank")
+        return t
+
+
+def design_from_dict(data: dict) -> HypoidDesign:
+    """Validate a design dict (file units) and return a :class:`HypoidDesign`."""
+    data = copy.deepcopy(data)
+    _check_keys("", data, _TOP)
+    _check_keys("design", data.get("design", {}), _DESIGN)
+    kind = data.get("design", {}).get("kind", "hypoid")
+    if kind not in ("hypoid", "spiral_bevel"):
+        raise ValueError(f"design.kind = {kind!r} must be 'hypoid' or 'spiral_bevel'")
+    bs = data.get("blank_summary", {})
+    _check_keys("blank_summary", bs, set(MEMBERS))
+    for m, t in bs.items():
+        _check_keys(f"blank_summary.{m}", t, _SUMMARY)
+    for m in MEMBERS:
+        if m not in data:
+            continue
+        _check_keys(m, data[m], set(FLANKS))
+        for f, t in data[m].items():
+            _check_keys(f"{m}.{f}", t, {"cutter", "machine"})
+            _check_keys(f"{m}.{f}.cutter", _req(f"{m}.{f}", t, "cutter"), _CUTTER)
+            _check_keys(f"{m}.{f}.machine", _req(f"{m}.{f}", t, "machine"), _MACHINE)
+    design = HypoidDesign(data)
+    teeth = {}
+    for m in bs:
+        teeth[m] = design.member_blank(m).teeth
+    if "pinion" in teeth and "gear" in teeth and teeth["gear"] < teeth["pinion"]:
+        raise ValueError(f"ratio = z_gear/z_pinion = {teeth['gear']}/{teeth['pinion']} "
+                         f"must be >= 1 (the pinion is the member with fewer teeth)")
+    for m, f in design.flanks():
+        design.cutter(m, f)
+        design.machine(m, f)
+        if m not in bs:
+            raise ValueError(f"missing table [blank_summary.{m}] for the {m} flanks")
+    if "blank" in data:
+        design.blank_input()
+    return design
+
+
+def list_examples() -> list[str]:
+    """Names of the packaged example designs."""
+    root = resources.files("gearjax") / "examples"
+    return sorted(p.name[:-5] for p in root.iterdir() if p.name.endswith(".toml"))
+
+
+def example_path(name: str):
+    """Path (Traversable) of a packaged example; ValueError naming the known ones."""
+    names = list_examples()
+    if name not in names:
+        raise ValueError(f"unknown example {name!r} (known: {', '.join(names)})")
+    return resources.files("gearjax") / "examples" / f"{name}.toml"
+
+
+def _read_text(source) -> str:
+    if isinstance(source, str) and source.startswith("example:"):
+        return example_path(source[len("example:"):]).read_text(encoding="utf-8")
+    p = Path(source)
+    if not p.is_file():
+        raise ValueError(f"design file {str(source)!r} does not exist")
+    return p.read_text(encoding="utf-8")
+
+
+def load_design(source) -> HypoidDesign:
+    """Load and validate a design: a path or ``example:NAME``."""
+    text = _read_text(source)
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"design file {source}: invalid TOML: {exc}") from None
+    return design_from_dict(data)
+
+
+def save_design(design: HypoidDesign, path) -> Path:
+    """Write a design file (atomically); ``load_design`` reads back an equal design."""
+    return atomic_write(path, dumps_toml(design.data))
+
+
+# --------------------------------------------------------------------------------------
+# exports
+
+
+def _np(a):
+    return np.asarray(a, dtype=float)
+
+
+def write_csv(path, grid) -> Path:
+    """CSV with one row per grid point: indices, xi, (s, theta, psi), point, normal,
+    residual and converged flag (mm, rad)."""
+    P, N, prm = _np(grid.points), _np(grid.normals), _np(grid.params)
+    res, conv, xi = _np(grid.residual), np.asarray(grid.converged), _np(grid.xi)
+    lines = ["i,j,xi,s_mm,theta_rad,psi_rad,x_mm,y_mm,z_mm,nx,ny,nz,residual_mm,converged"]
+    for i in range(P.shape[0]):
+        for j in range(P.shape[1]):
+            vals = [xi[i], *prm[i, j], *P[i, j], *N[i, j], res[i, j]]
+            lines.append(f"{i},{j}," + ",".join(f"{v:.17g}" for v in vals) + f",{int(conv[i, j])}")
+    return atomic_write(path, "\n".join(lines) + "\n")
+
+
+def write_xyz(path, grid) -> Path:
+    """XYZ point cloud with normals: ``x y z nx ny nz`` per line (mm)."""
+    P, N = _np(grid.points).reshape(-1, 3), _np(grid.normals).reshape(-1, 3)
+    lines = [" ".join(f"{v:.12g}" for v in (*p, *n)) for p, n in zip(P, N)]
+    return atomic_write(path, "\n".join(lines) + "\n")
+
+
+def flank_triangles(points, normals=None):
+    """Triangles (T, 3, 3) of a (n_xi, n_s, 3) grid; oriented along ``normals`` if given."""
+    P = _np(points)
+    a, b, c, d = P[:-1, :-1], P[1:, :-1], P[1:, 1:], P[:-1, 1:]
+    tri = np.concatenate([np.stack([a, b, c], -2).reshape(-1, 3, 3),
+                          np.stack([a, c, d], -2).reshape(-1, 3, 3)])
+    if normals is not None:
+        N = _np(normals)
+        nq = (N[:-1, :-1] + N[1:, :-1] + N[1:, 1:] + N[:-1, 1:]).reshape(-1, 3)
+        nq = np.concatenate([nq, nq])
+        tri = _orient(tri, nq)
+    return tri
+
+
+def _orient(tri, direction):
+    fn = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    flip = np.einsum("ij,ij->i", fn, direction) < 0
+    tri = tri.copy()
+    tri[flip] = tri[flip][:, [0, 2, 1]]
+    return tri
+
+
+def _stl_text(tri, name) -> str:
+    out = [f"solid {name}"]
+    for t in tri:
+        n = np.cross(t[1] - t[0], t[2] - t[0])
+        ln = np.linalg.norm(n)
+        n = n / ln if ln > 0 else n
+        out.append(f"  facet normal {n[0]:.9g} {n[1]:.9g} {n[2]:.9g}")
+        out.append("    outer loop")
+        for v in t:
+            out.append(f"      vertex {v[0]:.12g} {v[1]:.12g} {v[2]:.12g}")
+        out.append("    endloop")
+        out.append("  endfacet")
+    out.append(f"endsolid {name}")
+    return "\n".join(out) + "\n"
+
+
+def write_stl_flank(path, grid, name: str = "flank") -> Path:
+    """ASCII STL of one flank (facets oriented out of the material)."""
+    return atomic_write(path, _stl_text(flank_triangles(grid.points, grid.normals), name))
+
+
+def _rot_z(P, a):
+    c, s = math.cos(a), math.sin(a)
+    R = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    return P @ R.T
+
+
+def tooth_mesh(convex, concave, teeth: int):
+    """Closed triangle mesh of one tooth: both flanks, top land, root, toe and heel.
+
+    The convex flank is turned by ``k 2 pi / teeth`` (k in -1, 0, 1) so that both
+    flanks bound one tooth: each flank's outward normal at mid face points away
+    from the other flank.  The root face joins the fillet-start rows (seed 004's
+    flank grid ends there).  Returns triangles (T, 3, 3) in mm.
+    """
+    Pv, Nv = _np(convex.points), _np(convex.normals)
+    Pc, Nc = _np(concave.points), _np(concave.normals)
+    i0, j0 = Pv.shape[0] // 2, Pv.shape[1] // 2
+    best = None
+    for k in (-1, 0, 1):
+        a = 2.0 * math.pi * k / int(teeth)
+        Q = _rot_z(Pv, a)
+        M = _rot_z(Nv, a)
+        dvec = Q[i0, j0] - Pc[i0, j0]
+        if np.dot(Nc[i0, j0], dvec) < 0 and np.dot(M[i0, j0], -dvec) < 0:
+            dist = np.linalg.norm(dvec)
+            if best is None or dist < best[0]:
+                best = (dist, Q, M)
+    if best is None:
+        raise ValueError("the convex and concave flanks do not bound a tooth "
+                         "(normals do not point away from each other)")
+    _, Qv, Mv = best
+    parts = [flank_triangles(Qv, Mv), flank_triangles(Pc, Nc)]
+    centre = 0.5 * (Qv.reshape(-1, 3).mean(0) + Pc.reshape(-1, 3).mean(0))
+    caps = []
+    for A, B in [(Qv[:, -1], Pc[:, -1]), (Qv[:, 0], Pc[:, 0]), (Qv[0, :], Pc[0, :]),
+                 (Qv[-1, :], Pc[-1, :])]:
+        G = np.stack([A, B], axis=1)            # (n, 2, 3) strip between the two edges
+        caps.append(flank_triangles(G))
+    caps = np.concatenate(caps)
+    ctr = caps.mean(axis=1)
+    caps = _orient(caps, ctr - centre)
+    return np.concatenate(parts + [caps])
+
+
+def write_stl_tooth(path, convex, concave, teeth: int, name: str = "tooth") -> Path:
+    """ASCII STL of a whole tooth (see :func:`tooth_mesh`)."""
+    return atomic_write(path, _stl_text(tooth_mesh(convex, concave, teeth), name))
+
+
+def write_flank(path, grid, name: str = "flank") -> Path:
+    """Write a flank grid by file extension: .csv, .xyz or .stl."""
+    ext = Path(path).suffix.lower()
+    if ext == ".csv":
+        return write_csv(path, grid)
+    if ext == ".xyz":
+        return write_xyz(path, grid)
+    if ext == ".stl":
+        return write_stl_flank(path, grid, name)
+    raise ValueError(f"output file {str(path)!r}: extension must be .csv, .xyz or .stl")

@@ -1,0 +1,72 @@
+"""Straight-blade face-mill cutter (gearjax.cutters): seed 004 surface, normals, fillet."""
+
+import math
+
+import jax
+import numpy as np
+import pytest
+
+from gearjax.cutters import (blade_radius, cutter_normal, cutter_point, fillet_normal,
+                             fillet_point, fillet_start, make_cutter)
+
+
+@pytest.mark.parametrize("flank,alpha", [("convex", 29.0), ("concave", 16.0)])
+def test_seed_formula_and_normal(flank, alpha):
+    c = make_cutter(117.475, alpha, 1.0, flank)
+    a = math.radians(alpha)
+    sg = 1 if flank == "convex" else -1
+    for s, th in [(0.0, 0.3), (5.0, -1.2), (12.0, 2.9)]:
+        r = np.asarray(cutter_point(c, s, th))
+        rho = 117.475 - sg * s * math.sin(a)              # seed 004, written out by hand
+        np.testing.assert_allclose(r, [rho * math.cos(th), rho * math.sin(th), -s * math.cos(a)],
+                                   rtol=0, atol=1e-12)
+        # normal = sgn * (dr/ds x dr/dtheta)/|.|, a unit vector
+        rs = jax.jacfwd(lambda x: cutter_point(c, x, th))(s)
+        rt = jax.jacfwd(lambda x: cutter_point(c, s, x))(th)
+        cr = np.cross(rs, rt)
+        n_ref = sg * cr / np.linalg.norm(cr)
+        np.testing.assert_allclose(np.asarray(cutter_normal(c, s, th)), n_ref, atol=1e-14)
+        # s is arc length along the blade
+        assert abs(np.linalg.norm(rs) - 1.0) < 1e-14
+
+
+def test_inside_blade_shrinks_outside_grows():
+    cv = make_cutter(100.0, 20.0, 1.0, "convex")
+    cc = make_cutter(100.0, 20.0, 1.0, "concave")
+    assert float(blade_radius(cv, 5.0)) < 100.0 < float(blade_radius(cc, 5.0))
+    # normal points into the tooth space: outward for the inside blade, inward for the outside
+    assert float(cutter_normal(cv, 1.0, 0.0)[0]) > 0 > float(cutter_normal(cc, 1.0, 0.0)[0])
+
+
+@pytest.mark.parametrize("flank", ["convex", "concave"])
+def test_fillet_joins_blade_and_tip_plane(flank):
+    c = make_cutter(114.3, 25.0, 1.2, flank)
+    a = math.radians(25.0)
+    s0 = float(fillet_start(c))
+    assert abs(s0 - 1.2 * (1 - math.sin(a)) / math.cos(a)) < 1e-14
+    th = 0.7
+    # tangent continuity with the blade at phi = alpha
+    np.testing.assert_allclose(fillet_point(c, a, th), cutter_point(c, s0, th), atol=1e-12)
+    np.testing.assert_allclose(fillet_normal(c, a, th), cutter_normal(c, s0, th), atol=1e-14)
+    # at phi = pi/2 the fillet touches the tip plane z = 0 with normal -z
+    p = np.asarray(fillet_point(c, math.pi / 2, th))
+    assert abs(p[2]) < 1e-12
+    np.testing.assert_allclose(fillet_normal(c, math.pi / 2, th), [0, 0, -1], atol=1e-15)
+    # fillet normal is the torus normal: perpendicular to d/dphi and d/dtheta
+    dphi = jax.jacfwd(lambda x: fillet_point(c, x, th))(1.0)
+    dth = jax.jacfwd(lambda x: fillet_point(c, 1.0, x))(th)
+    n = np.asarray(fillet_normal(c, 1.0, th))
+    assert abs(n @ dphi) < 1e-12 and abs(n @ dth) < 1e-12
+
+
+@pytest.mark.parametrize("args,name", [
+    ((-5.0, 20.0, 1.0, "convex"), "point_radius"),
+    ((100.0, 0.0, 1.0, "convex"), "blade_angle"),
+    ((100.0, 45.0, 1.0, "convex"), "blade_angle"),
+    ((100.0, 50.0, 1.0, "concave"), "blade_angle"),
+    ((100.0, 20.0, -1.0, "convex"), "edge_radius"),
+    ((100.0, 20.0, 1.0, "middle"), "flank"),
+])
+def test_validation_names_parameter(args, name):
+    with pytest.raises(ValueError, match=name):
+        make_cutter(*args)
