@@ -33,6 +33,15 @@ the core, never the other way round)::
                            (Greenwood-Tripp, load sharing), friction (seed 001 mu),
                            losses (power loss, mesh efficiency, Stribeck curves)
     gearjax/plot_tribology.py  Stribeck figures
+    gearjax/tca.py         tooth contact analysis of any two flanks: position and
+                           normal coincidence continued by lax.scan, TE, contact
+                           ellipses, multiple pairs, misalignments (dE, dP, dG, dSigma)
+    gearjax/tca_involute.py  TCA adapter for involute pairs (crowning, mismatch)
+    gearjax/plot_tca.py    TE curves and contact pattern figures
+    gearjax/gears/hypoid_kinematics.py  seed-000 meshing characteristics over the
+                           hypoid gear flank, limits, cutter-radius study
+    gearjax/optimize.py    objective -> gradient -> optax / jaxopt optimisation layer
+    gearjax/plot_kinematics.py  flank field maps (u_e, SRR, R_eff)
     gearjax/errors.py      exception types and boundary validation helpers
     gearjax/cli.py         the ``gearjax`` command
 

@@ -19,6 +19,8 @@ COMMANDS = [
     "gearjax.commands.blank",
     "gearjax.commands.surface",
     "gearjax.commands.friction",
+    "gearjax.commands.kinematics",
+    "gearjax.commands.tca",
 ]
 
 

@@ -1,0 +1,478 @@
+"""Tooth contact analysis (TCA) of two tooth surfaces — the generic core.
+
+Two tooth surfaces, each given in its own body frame whose rotation axis is the
+body z axis, are mounted in one fixed frame:
+
+    pinion (member 1):  r1f = Rz(phi1) r1(u1, v1) + dP e_z
+    gear   (member 2):  r2f = c + R Rz(phi2) r2(u2, v2)
+                        R = Rot(d, dSigma) R0,   c = c0 + dE d + dG (R e_z)
+
+``R0`` maps the gear body frame to the fixed frame at phi2 = 0, ``c0`` is the
+point of the gear axis on the common perpendicular (the crossing point) and ``d``
+the unit common perpendicular (for parallel axes: the centre line).  The
+misalignments (:class:`Misalignment`, mm and rad) are: ``dE`` shift of the gear
+along ``d`` (change of offset / centre distance), ``dP`` axial shift of the pinion
+along its axis, ``dG`` axial shift of the gear along its axis, ``dSigma`` rotation
+of the gear axis about ``d`` through the crossing point (change of shaft angle).
+
+**Contact equations** (Litvin & Fuentes, *Gear Geometry and Applied Theory*, 2nd
+ed., ch. 9): for a given pinion angle phi1, unknowns x = (u1, v1, u2, v2, phi2),
+
+    r1f(u1, v1, phi1) - r2f(u2, v2, phi2) = 0                   (3 equations)
+    n1f . ta = 0,   n1f . tb = 0                                (2 equations)
+
+with ``ta = k2 x n2f/|k2 x n2f|`` (``k2`` the gear axis) and ``tb = n2f x ta`` an
+orthonormal basis of the gear's tangent plane: the normals are collinear exactly
+when n1 is orthogonal to that plane (orientation-free).  The normals are the
+*tool* normals at the solved generating motion where a flank is a
+:class:`~gearjax.surfaces.GeneratedSurface` (same tangent plane as the envelope,
+one derivative fewer to compile).  This square 5x5 system is regular for *point
+contact*.  For *line contact* (conjugate pairs, and any pair whose flanks touch
+along a line, e.g. a spur pair with a profile-only modification) its Jacobian is
+singular along the contact line.  Line-contact mode fixes the pinion face-width
+coordinate ``v1`` (at its value in the initial guess of the reference point) and
+drops ``n1f . tb``: at a line contact the relative curvature tensor annihilates
+the contact-line direction, so of the two normal equations only the one across
+the contact line carries information; ``ta`` is perpendicular to the gear axis,
+hence never along the contact line of a spur or helical flank (contact lines
+parallel or inclined at the base helix angle to the axis).  Unknowns then are
+(u1, u2, v2, phi2): 4 equations, 4 unknowns.
+
+The solve is the implicit-differentiated Newton of :mod:`gearjax.newton`,
+continued along the mesh cycle with ``lax.scan`` from the reference point (the
+middle grid point) forwards and backwards, each step started from a linear
+predictor of the two previous solutions.
+
+**Transmission error** (unloaded), reported in arc-seconds at the output boundary:
+
+    TE(phi1) = s2 (phi2 - phi2_0) - |rho| (phi1 - phi1_0)
+
+with ``rho`` the nominal signed ratio (phi2 turns by rho*dphi1 about the gear body
+axis, e.g. ``-z1/z2`` for an external parallel pair) and ``s2 = sign(rho)``:
+TE > 0 means the gear is ahead of its nominal position in its direction of
+motion.  ``(phi1_0, phi2_0)`` is the reference contact (the middle grid point).
+
+**Contact ellipse** for an elastic approach ``delta`` (default 0.00632 mm, Litvin's
+customary value): with both flanks' Weingarten maps taken for the common normal,
+the relative (induced) curvature tensor of the tangent plane is
+``B = B1 - B2`` (``B_i = -A^T W_i A`` in an orthonormal tangent basis ``A``); the
+gap between the flanks at a tangent offset t is ``t.B.t/2`` to second order, so the
+contact ellipse ``t.B.t/2 = delta`` has semi-axes ``sqrt(2 delta/lambda_i)``
+(``lambda_i`` eigenvalues of B) along its eigenvectors (Litvin & Fuentes §9.4:
+``2a = 2 sqrt(delta/A)``, ``A = lambda_min/2``).  For line contact the long axis is
+infinite (reported as ``inf``).
+
+Family adapters build the flanks, the assembly, the initial guess and the flank
+boundaries: :mod:`gearjax.tca_involute` (rack-generated involute pairs).  Figures:
+:mod:`gearjax.plot_tca`; CLI: ``gearjax tca``; documentation: ``docs/tca.md``.
+
+Units: mm, rad inside; arc-seconds only in keys/fields named ``*_arcsec``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable, NamedTuple
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from .errors import ConvergenceError, require_converged
+from .newton import newton_solve
+from .surfaces import GeneratedSurface, local_geometry, unit_normal
+
+__all__ = ["Misalignment", "Assembly", "contact_equations", "point_normal", "gear_mount",
+           "ContactPath", "contact_path", "te_arcsec", "require_path",
+           "ARCSEC", "ellipse_from_weingarten", "rotation_about", "relative_curvature",
+           "MultiPair", "multi_pair", "DEFAULT_APPROACH", "NoContactError"]
+
+class NoContactError(ConvergenceError):
+    """The flanks do not touch inside their boundaries (a :class:`ConvergenceError`)."""
+
+
+ARCSEC = np.pi / (180.0 * 3600.0)   # rad per arc-second
+DEFAULT_APPROACH = 0.00632          # mm, elastic approach of the contact ellipse
+
+
+@jax.tree_util.register_dataclass
+@dataclass(frozen=True)
+class Misalignment:
+    """Assembly errors (differentiable): dE, dP, dG in mm, dSigma in rad.
+
+    See the module docstring for their definition.  ``Misalignment.zero()`` is the
+    nominal assembly.
+    """
+
+    dE: jnp.ndarray
+    dP: jnp.ndarray
+    dG: jnp.ndarray
+    dSigma: jnp.ndarray
+
+    @classmethod
+    def zero(cls):
+        z = jnp.asarray(0.0)
+        return cls(z, z, z, z)
+
+    @classmethod
+    def create(cls, dE=0.0, dP=0.0, dG=0.0, dSigma_deg=0.0):
+        """Validated constructor (mm, mm, mm, degrees) for user input."""
+        import math
+        vals = dict(dE=dE, dP=dP, dG=dG, dSigma=dSigma_deg)
+        for k, v in vals.items():
+            v = float(v)
+            if not math.isfinite(v) or abs(v) > (5.0 if k == "dSigma" else 50.0):
+                lim = "|dSigma| <= 5 deg" if k == "dSigma" else f"|{k}| <= 50 mm"
+                raise ValueError(f"{k} = {v!r} out of the allowed range ({lim})")
+        return cls(jnp.asarray(float(dE)), jnp.asarray(float(dP)), jnp.asarray(float(dG)),
+                   jnp.asarray(math.radians(float(dSigma_deg))))
+
+
+@jax.tree_util.register_dataclass
+@dataclass(frozen=True)
+class Assembly:
+    """Nominal mounting of the gear (see module docstring).
+
+    R0 : (3,3) gear body frame -> fixed frame at phi2 = 0.
+    c0 : (3,) crossing point on the gear axis (mm).
+    d : (3,) unit common perpendicular (direction of dE, axis of dSigma).
+    z1, z2 : tooth numbers (static); ratio_sign : sign of the nominal rho (static).
+    """
+
+    R0: jnp.ndarray
+    c0: jnp.ndarray
+    d: jnp.ndarray
+    z1: int = field(metadata=dict(static=True))
+    z2: int = field(metadata=dict(static=True))
+    ratio_sign: int = field(metadata=dict(static=True), default=-1)
+
+
+def rotation_about(axis, angle):
+    """Rodrigues rotation matrix about the unit ``axis`` by ``angle`` (rad)."""
+    k = axis / jnp.linalg.norm(axis)
+    K = jnp.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+    return jnp.eye(3) + jnp.sin(angle) * K + (1.0 - jnp.cos(angle)) * (K @ K)
+
+
+def _rz(phi):
+    c, s = jnp.cos(phi), jnp.sin(phi)
+    o, z = jnp.ones_like(phi), jnp.zeros_like(phi)
+    return jnp.array([[c, -s, z], [s, c, z], [z, z, o]])
+
+
+def gear_mount(asm: Assembly, mis: Misalignment):
+    """Misaligned gear mounting ``(R, c)``: r2f = c + R Rz(phi2) r2."""
+    R = rotation_about(asm.d, mis.dSigma) @ asm.R0
+    c = asm.c0 + mis.dE * asm.d + mis.dG * R[:, 2]
+    return R, c
+
+
+class ContactPath(NamedTuple):
+    """TCA of one tooth pair over a grid of pinion angles (arrays over the grid).
+
+    phi1, phi2 : pinion angle (input) and solved gear angle (rad).
+    te : transmission error (rad, sign convention of the module docstring).
+    uv1, uv2 : (N, 2) surface parameters of the contact on pinion and gear.
+    point : (N, 3) contact point, fixed frame (mm); normal : (N, 3) pinion normal.
+    p1_body, p2_body : (N, 3) contact point in the pinion / gear body frame (mm).
+    axial1, radial1, axial2, radial2 : axial-projection coordinates (mm) of the
+        contact on each flank (body z and distance from the body axis).
+    semi_major, semi_minor : contact-ellipse semi-axes (mm; inf for line contact).
+    major_dir : (N, 3) unit direction of the major axis (fixed frame).
+    residual : max |F| of the contact solve (mm / dimensionless).
+    converged : Newton converged (and the residual is finite).
+    """
+
+    phi1: jnp.ndarray
+    phi2: jnp.ndarray
+    te: jnp.ndarray
+    uv1: jnp.ndarray
+    uv2: jnp.ndarray
+    point: jnp.ndarray
+    normal: jnp.ndarray
+    p1_body: jnp.ndarray
+    p2_body: jnp.ndarray
+    axial1: jnp.ndarray
+    radial1: jnp.ndarray
+    axial2: jnp.ndarray
+    radial2: jnp.ndarray
+    semi_major: jnp.ndarray
+    semi_minor: jnp.ndarray
+    major_dir: jnp.ndarray
+    residual: jnp.ndarray
+    converged: jnp.ndarray
+
+
+def te_arcsec(te_rad):
+    """Transmission error in arc-seconds (output boundary)."""
+    return jnp.asarray(te_rad) / ARCSEC
+
+
+def relative_curvature(n, W1, W2, t_ref):
+    """Relative curvature tensor ``B = B1 - B2`` (2x2, 1/mm) and its tangent basis.
+
+    ``W1, W2`` are the Weingarten maps of the two flanks for the *same* unit normal
+    ``n`` (dn = W dr).  ``B_i = -A^T W_i A`` with ``A = [a1, n x a1]``, ``a1`` the unit
+    tangent closest to ``t_ref``.  Returns ``(B, A)``.
+    """
+    a1 = t_ref - jnp.dot(t_ref, n) * n
+    a1 = a1 / jnp.linalg.norm(a1)
+    A = jnp.stack([a1, jnp.cross(n, a1)], axis=1)
+    B = -A.T @ (W1 - W2) @ A
+    return 0.5 * (B + B.T), A
+
+
+def ellipse_from_weingarten(n, W1, W2, t_ref, approach=DEFAULT_APPROACH):
+    """Contact ellipse ``(semi_major, semi_minor, major_dir)`` for elastic approach (mm).
+
+    Semi-axes ``sqrt(2 delta/lambda_i)`` from the eigenvalues of the relative
+    curvature tensor (module docstring); ``inf`` where an eigenvalue is <= 0 (line
+    contact or a non-convex contact, where the quadratic theory gives no ellipse).
+    """
+    B, A = relative_curvature(n, W1, W2, t_ref)
+    h = 0.5 * (B[0, 0] + B[1, 1])
+    dd = 0.5 * (B[0, 0] - B[1, 1])
+    g = jnp.sqrt(dd ** 2 + B[0, 1] ** 2 + 1e-300)
+    lam_min, lam_max = h - g, h + g
+    ang = 0.5 * jnp.arctan2(B[0, 1], dd) + 0.5 * jnp.pi   # eigenvector of lam_min
+    major_dir = A @ jnp.stack([jnp.cos(ang), jnp.sin(ang)])
+
+    def axis(lam):
+        ok = lam > 1e-12
+        return jnp.where(ok, jnp.sqrt(2.0 * approach / jnp.where(ok, lam, 1.0)), jnp.inf)
+
+    return axis(lam_min), axis(lam_max), major_dir
+
+
+def point_normal(surf, uv):
+    """Point and unit normal of a flank at ``uv``.
+
+    For a :class:`~gearjax.surfaces.GeneratedSurface` the normal is the tool normal
+    at the solved motion parameter (the envelope and the tool share the tangent
+    plane), which needs only first derivatives of the tool family and one envelope
+    solve; otherwise ``n = r_u x r_v/|r_u x r_v|``.  The orientation is not fixed
+    (the contact equations do not depend on it).
+    """
+    uv = jnp.asarray(uv, float)
+    if isinstance(surf, GeneratedSurface):
+        psi = surf.solve(uv).x
+        return surf.family(uv, psi), unit_normal(lambda q: surf.family(q, psi), uv)
+    return surf(uv), unit_normal(surf, uv)
+
+
+def _solve_grid(F, xs_ref, phis, tol, max_steps):
+    """Continuation over ``phis`` from ``xs_ref`` with a linear predictor (lax.scan)."""
+
+    def step(carry, phi):
+        x_prev, x_prev2 = carry
+        pred = jax.lax.stop_gradient(2.0 * x_prev - x_prev2)
+        sol = newton_solve(F, pred, phi, tol=tol, max_steps=max_steps)
+        ok = sol.converged
+        x_next = jnp.where(ok, sol.x, x_prev)
+        # the first solve (reference) starts from the guess itself: no predictor yet
+        first = jnp.all(x_prev == x_prev2)
+        return (x_next, jnp.where(ok & jnp.logical_not(first), x_prev, x_next)), sol
+
+    _, sols = jax.lax.scan(step, (xs_ref, xs_ref), phis)
+    return sols
+
+
+def contact_equations(r1: Callable, r2: Callable, asm: Assembly, mis: Misalignment,
+                      line_contact: bool, v1_fixed=0.0):
+    """The contact system ``F(x, phi1)`` of the module docstring, with ``unpack`` and
+    ``pack`` between the solver unknowns and ``(uv1, uv2, phi2)`` / the 5-vector.
+
+    Point contact: x = (u1, v1, u2, v2, phi2), 5 equations.  Line contact: x =
+    (u1, u2, v2, phi2) with ``v1 = v1_fixed``, 4 equations.  Position equations in
+    mm, normal equations dimensionless.
+    """
+    R, c = gear_mount(asm, mis)
+    ez = jnp.array([0.0, 0.0, 1.0])
+    k2 = R[:, 2]
+
+    def unpack(x):
+        if line_contact:
+            return jnp.stack([x[0], jnp.asarray(v1_fixed, float)]), x[1:3], x[3]
+        return x[0:2], x[2:4], x[4]
+
+    def pack(x5):
+        if line_contact:
+            return jnp.stack([x5[0], x5[2], x5[3], x5[4]])
+        return x5
+
+    def F(x, ph1):
+        uv1, uv2, ph2 = unpack(x)
+        R1 = _rz(ph1)
+        R2 = R @ _rz(ph2)
+        q1, m1 = point_normal(r1, uv1)
+        q2, m2 = point_normal(r2, uv2)
+        p1 = R1 @ q1 + mis.dP * ez
+        p2 = c + R2 @ q2
+        n1 = R1 @ m1
+        n2 = R2 @ m2
+        ta = jnp.cross(k2, n2)
+        ta = ta / jnp.linalg.norm(ta)
+        if line_contact:
+            return jnp.concatenate([p1 - p2, jnp.stack([jnp.dot(n1, ta)])])
+        tb = jnp.cross(n2, ta)
+        return jnp.concatenate([p1 - p2, jnp.stack([jnp.dot(n1, ta), jnp.dot(n1, tb)])])
+
+    return F, unpack, pack
+
+
+def contact_path(r1: Callable, r2: Callable, asm: Assembly, mis: Misalignment, phi1,
+                 x_ref, *, line_contact: bool, approach=DEFAULT_APPROACH,
+                 tol: float = 1e-11, max_steps: int = 30) -> ContactPath:
+    """Solve the contact equations at every pinion angle of the grid ``phi1`` (traceable).
+
+    ``r1``, ``r2`` : flank functions ``uv -> (3,)`` in the body frames (may close over
+    traced design parameters).  ``phi1`` : (N,) increasing grid, N odd; the reference
+    contact is at the middle index ``N // 2``.  ``x_ref`` : initial
+    guess ``(u1, v1, u2, v2, phi2)`` at ``phi1[N//2]``; it is solved first, then the
+    path is continued forwards and backwards.  In line-contact mode ``v1`` stays at
+    ``x_ref[1]`` (no derivative flows into it).
+
+    Returns a :class:`ContactPath` (TE relative to the reference contact, in rad).
+    """
+    phi1 = jnp.asarray(phi1, float)
+    n_pts = phi1.shape[0]
+    if n_pts % 2 == 0 or n_pts < 3:
+        raise ValueError(f"phi1 has {n_pts} positions: an odd number >= 3 is required "
+                         "(the reference contact is the middle one)")
+    mid = n_pts // 2
+    R, c = gear_mount(asm, mis)
+    ez = jnp.array([0.0, 0.0, 1.0])
+    v1_fixed = jax.lax.stop_gradient(jnp.asarray(x_ref)[1])
+    F, unpack, pack = contact_equations(r1, r2, asm, mis, line_contact, v1_fixed)
+
+    def frames(x, ph1):
+        uv1, uv2, ph2 = unpack(x)
+        return uv1, uv2, ph2, _rz(ph1), R @ _rz(ph2)
+
+    x0 = jax.lax.stop_gradient(pack(jnp.asarray(x_ref, float)))
+    # one scan, vmapped over the two directions (forwards from the reference and
+    # backwards from it); both start by solving the reference point itself
+    seqs = jnp.stack([phi1[mid:], phi1[:mid + 1][::-1]])
+    sols = jax.vmap(lambda s: _solve_grid(F, x0, s, tol, max_steps))(seqs)
+    X = jnp.concatenate([sols.x[1, 1:mid + 1][::-1], sols.x[0]], axis=0)
+    res = jnp.concatenate([sols.residual[1, 1:mid + 1][::-1], sols.residual[0]])
+    conv = jnp.concatenate([sols.converged[1, 1:mid + 1][::-1], sols.converged[0]])
+    conv = conv & sols.converged[0, 0] & sols.converged[1, 0]
+    ref_x = sols.x[0, 0]
+
+    def post(x, ph1):
+        uv1, uv2, ph2, R1, R2 = frames(x, ph1)
+        g1 = local_geometry(r1, uv1)
+        g2 = local_geometry(r2, uv2)
+        n = R1 @ g1.n
+        W1 = R1 @ g1.W @ R1.T
+        n2 = R2 @ g2.n
+        s = jnp.sign(jnp.dot(n, n2))
+        W2 = s * (R2 @ g2.W @ R2.T)
+        a, b, major = ellipse_from_weingarten(n, W1, W2, R1 @ g1.ru, approach)
+        p1b = g1.r
+        p2b = g2.r
+        point = R1 @ p1b + mis.dP * ez
+        return (ph2, uv1, uv2, point, n, p1b, p2b, a, b, major)
+
+    ph2, uv1, uv2, point, n, p1b, p2b, a, b, major = jax.vmap(post)(X, phi1)
+    ph2_0 = ref_x[-1]
+    rho = asm.z1 / asm.z2
+    te = asm.ratio_sign * (ph2 - ph2_0) - rho * (phi1 - phi1[mid])
+    if line_contact:
+        a = jnp.full_like(a, jnp.inf)
+    rad1 = jnp.linalg.norm(p1b[:, :2], axis=1)
+    rad2 = jnp.linalg.norm(p2b[:, :2], axis=1)
+    return ContactPath(phi1, ph2, te, uv1, uv2, point, n, p1b, p2b, p1b[:, 2], rad1,
+                       p2b[:, 2], rad2, a, b, major, res, conv)
+
+
+class MultiPair(NamedTuple):
+    """Consecutive tooth pairs and the unloaded TE envelope (over the grid of one pair).
+
+    te_pairs : (K, N) TE of pairs k = -(K//2) .. K//2 on the common grid (rad);
+        pair k is pair 0 shifted by k pinion pitches, NaN where that pair is not on
+        the flank (edge/no contact) or outside the computed range.
+    inside : (K, N) pair k has a valid contact inside both flank boundaries.
+    envelope : (N,) unloaded TE: max over pairs in contact (drive) or min (coast).
+    active : (N,) index (into ``te_pairs``) of the pair carrying the contact.
+    ptp : peak-to-peak of the envelope over one pitch around the reference (rad).
+    transfer_phi1 : (2,) pinion angles of the transfer points into / out of pair 0
+        (linear interpolation between grid points; NaN if none).
+    contact_ratio : length of the pinion-angle interval in which pair 0 is on the
+        flank, divided by the angular pitch 2 pi/z1 (boundary crossings
+        interpolated linearly in the boundary margin).
+    """
+
+    te_pairs: jnp.ndarray
+    inside: jnp.ndarray
+    envelope: jnp.ndarray
+    active: jnp.ndarray
+    ptp: jnp.ndarray
+    transfer_phi1: jnp.ndarray
+    contact_ratio: jnp.ndarray
+
+
+def _crossing(phi, f):
+    """Linear-interpolated first sign change of ``f`` from <0 to >=0 along ``phi`` (NaN if none)."""
+    neg = f[:-1] < 0.0
+    pos = f[1:] >= 0.0
+    hit = neg & pos
+    idx = jnp.argmax(hit)
+    t = f[idx] / (f[idx] - f[idx + 1])
+    val = phi[idx] + t * (phi[idx + 1] - phi[idx])
+    return jnp.where(jnp.any(hit), val, jnp.nan)
+
+
+def multi_pair(path: ContactPath, margin, steps_per_pitch: int, z1: int, drive: bool = True,
+               n_pairs: int = 3) -> MultiPair:
+    """Shift pair 0 by whole pitches and form the unloaded TE envelope (traceable).
+
+    The grid ``path.phi1`` must be uniform with step ``2 pi/(z1 steps_per_pitch)``
+    so that a shift by one pitch is a shift by ``steps_per_pitch`` grid indices (no
+    interpolation of the TE curves).  ``margin`` : (N,) boundary margin of pair 0
+    (>= 0 inside both flanks, mm).  ``drive`` chooses the max (drive) or min (coast)
+    envelope (the flank pushing the gear decides its position).
+    """
+    n = path.phi1.shape[0]
+    mid = n // 2
+    m = steps_per_pitch
+    inside0 = (margin >= 0.0) & path.converged
+    te0 = jnp.where(inside0, path.te, jnp.nan)
+    ks = np.arange(n_pairs) - n_pairs // 2
+    idx = np.arange(n)
+
+    def shifted(arr, k, fill):
+        src = idx - k * m
+        ok = (src >= 0) & (src < n)
+        return jnp.where(ok, arr[np.clip(src, 0, n - 1)], fill)
+
+    te_pairs = jnp.stack([shifted(te0, k, jnp.nan) for k in ks])
+    inside = jnp.stack([shifted(inside0, k, False) for k in ks])
+    sgn = 1.0 if drive else -1.0
+    key = jnp.where(inside, sgn * te_pairs, -jnp.inf)
+    active = jnp.argmax(key, axis=0)
+    env = sgn * jnp.max(key, axis=0)
+    window = np.abs(idx - mid) <= m // 2
+    ew = jnp.where(window & jnp.isfinite(env), env, jnp.nan)
+    ptp = jnp.nanmax(ew) - jnp.nanmin(ew)
+    k0 = n_pairs // 2
+    # transfer from pair -1 (earlier tooth) to pair 0 and from pair 0 to pair +1:
+    # sign change of the TE difference where both are on the flank, else of who is on
+    def lead(a, b):
+        both = inside[a] & inside[b]
+        return jnp.where(both, sgn * (jnp.nan_to_num(te_pairs[a]) - jnp.nan_to_num(te_pairs[b])),
+                         jnp.where(inside[a], 1.0, -1.0))
+
+    d_in = lead(k0, k0 - 1)
+    d_out = lead(k0 + 1, k0)
+    transfer = jnp.stack([_crossing(path.phi1, d_in), _crossing(path.phi1, d_out)])
+    lo = _crossing(path.phi1, jnp.where(path.converged, margin, -1.0))
+    hi = _crossing(path.phi1[::-1], jnp.where(path.converged, margin, -1.0)[::-1])
+    cr = (hi - lo) / (2.0 * jnp.pi / z1)
+    return MultiPair(te_pairs, inside, env, active, ptp, transfer, cr)
+
+
+def require_path(path: ContactPath, what: str = "tooth contact analysis") -> None:
+    """Raise :class:`~gearjax.errors.ConvergenceError` if any contact solve failed."""
+    require_converged(path.converged, what, path.residual)

@@ -1,0 +1,56 @@
+"""``gearjax tca`` in-process (same static configuration as tests/test_tca.py, so the
+compiled TCA is shared within one pytest run)."""
+
+import json
+
+import numpy as np
+
+from gearjax.cli import main
+from gearjax.gears.involute import InvolutePair, pair_geometry
+
+DESIGN = "involute:z1=25,z2=41,m=2,alpha=20,b=20,crown=1e-4"
+
+
+def test_json_te_is_the_parabola_of_the_profile_crown(capsys, tmp_path):
+    png = tmp_path / "tca.png"
+    assert main(["tca", DESIGN, "--json", "--plot", str(png)]) == 0
+    out = json.loads(capsys.readouterr().out)
+    for key in ("phi1_rad", "te_arcsec", "te_pairs_arcsec", "envelope_arcsec", "ptp_arcsec",
+                "transfer_phi1_rad", "contact_ratio", "path", "ellipses", "flags"):
+        assert key in out
+    phi = np.array(out["phi1_rad"])
+    te = np.array([np.nan if v is None else v for v in out["te_arcsec"]])
+    on = np.array(out["flags"]["on_flank"])
+    assert len(phi) == 61 and on.sum() > 30 and np.all(np.isfinite(te[on]))
+    pair = InvolutePair.create(25, 41, 2.0, 20.0)
+    geo = pair_geometry(pair)
+    s = float(geo["rb1"]) * (phi - phi[30])
+    theory = -1e-4 * (s * np.tan(np.radians(20.0))) ** 2 / float(geo["rb2"])
+    theory /= np.pi / (180 * 3600)
+    # first-order closed form; the O(a^2) remainder is < 0.5 % at a = 1e-4/mm
+    assert np.max(np.abs(te[on] - theory[on])) < 5e-3 * np.max(np.abs(theory[on]))
+    assert all(v is None for v in out["ellipses"]["semi_major_mm"])   # line contact
+    assert png.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_table_output(capsys):
+    assert main(["tca", DESIGN]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].startswith("# TCA involute:")
+    assert "p-t-p" in lines[1]
+    assert len(lines) == 3 + 61
+
+
+def test_flanks_that_do_not_touch_exit_nonzero_with_one_line(capsys):
+    assert main(["tca", DESIGN, "--misalign", "dE=40"]) == 3
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "do not touch" in err[0]
+
+
+def test_bad_input_one_line(capsys):
+    assert main(["tca", "example:spiral_bevel_10x30"]) == 2
+    assert "not implemented" in capsys.readouterr().err
+    assert main(["tca", DESIGN, "--positions", "60"]) == 2
+    assert "positions" in capsys.readouterr().err
+    assert main(["tca", DESIGN, "--misalign", "dX=1"]) == 2
+    assert "dX" in capsys.readouterr().err
