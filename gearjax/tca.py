@@ -85,7 +85,8 @@ from .surfaces import GeneratedSurface, local_geometry, unit_normal
 __all__ = ["Misalignment", "Assembly", "contact_equations", "point_normal", "gear_mount",
            "ContactPath", "contact_path", "te_arcsec", "require_path",
            "ARCSEC", "ellipse_from_weingarten", "rotation_about", "relative_curvature",
-           "MultiPair", "multi_pair", "DEFAULT_APPROACH", "NoContactError"]
+           "MultiPair", "multi_pair", "DEFAULT_APPROACH", "NoContactError",
+           "check_on_flank_converged"]
 
 class NoContactError(ConvergenceError):
     """The flanks do not touch inside their boundaries (a :class:`ConvergenceError`)."""
@@ -226,10 +227,15 @@ def ellipse_from_weingarten(n, W1, W2, t_ref, approach=DEFAULT_APPROACH):
     """Contact ellipse ``(semi_major, semi_minor, major_dir)`` for elastic approach (mm).
 
     Semi-axes ``sqrt(2 delta/lambda_i)`` from the eigenvalues of the relative
-    curvature tensor (module docstring); ``inf`` where an eigenvalue is <= 0 (line
-    contact or a non-convex contact, where the quadratic theory gives no ellipse).
+    curvature tensor (module docstring), oriented so that its trace is >= 0 (the
+    gap does not depend on the sense of ``n``); ``inf`` where an eigenvalue is <= 0
+    (line contact, or flanks that cross, where the quadratic theory gives no ellipse).
     """
     B, A = relative_curvature(n, W1, W2, t_ref)
+    # the gap between the flanks does not depend on which way ``n`` points: orient B
+    # so that its trace is >= 0 (a definite B then has two positive eigenvalues; an
+    # indefinite one -- the flanks cross, no ellipse -- keeps a negative one)
+    B = jnp.where(B[0, 0] + B[1, 1] < 0.0, -B, B)
     h = 0.5 * (B[0, 0] + B[1, 1])
     dd = 0.5 * (B[0, 0] - B[1, 1])
     g = jnp.sqrt(dd ** 2 + B[0, 1] ** 2 + 1e-300)
@@ -476,3 +482,22 @@ def multi_pair(path: ContactPath, margin, steps_per_pitch: int, z1: int, drive: 
 def require_path(path: ContactPath, what: str = "tooth contact analysis") -> None:
     """Raise :class:`~gearjax.errors.ConvergenceError` if any contact solve failed."""
     require_converged(path.converged, what, path.residual)
+
+
+def check_on_flank_converged(path: ContactPath, margin) -> None:
+    """Raise ConvergenceError if a solve failed between on-flank points, and
+    :class:`~gearjax.tca.NoContactError` if no grid point is on both flanks (concrete)."""
+    conv = np.asarray(path.converged)
+    inside = np.asarray(margin) >= 0.0
+    mid = conv.shape[0] // 2
+    if not conv[mid]:
+        require_converged(path.converged[mid:mid + 1], "tooth contact at the reference point",
+                          path.residual[mid:mid + 1])
+    idx = np.nonzero(inside & conv)[0]
+    if idx.size == 0:
+        raise NoContactError("no contact inside the flank boundaries at any grid position "
+                             "(the flanks do not touch); pass strict=False to get the masks")
+    if idx.size:
+        sl = slice(idx[0], idx[-1] + 1)
+        require_converged(path.converged[sl], "tooth contact analysis on the flank",
+                          path.residual[sl])

@@ -46,11 +46,11 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .errors import check_int, check_range, require_converged
+from .errors import check_int, check_range
 from .gears.involute import InvolutePair, generated_flank, pair_geometry
 from .surfaces import GeneratedSurface
-from .tca import (DEFAULT_APPROACH, Assembly, ContactPath, Misalignment, MultiPair, NoContactError,
-                  contact_path, multi_pair)
+from .tca import (DEFAULT_APPROACH, Assembly, ContactPath, Misalignment, MultiPair,
+                  contact_path, multi_pair, check_on_flank_converged)
 
 __all__ = ["InvoluteTCA", "crowned_pinion_flank", "involute_assembly", "involute_tca_traced",
            "involute_tca", "involute_margin", "tca_summary", "SUMMARY_KEYS",
@@ -240,25 +240,6 @@ def involute_tca(des: InvoluteTCA, mis: Misalignment | None = None, *, side: int
         path, margin, _ = out
         check_on_flank_converged(path, margin)
     return out
-
-
-def check_on_flank_converged(path: ContactPath, margin) -> None:
-    """Raise ConvergenceError if a solve failed between on-flank points, and
-    :class:`~gearjax.tca.NoContactError` if no grid point is on both flanks (concrete)."""
-    conv = np.asarray(path.converged)
-    inside = np.asarray(margin) >= 0.0
-    mid = conv.shape[0] // 2
-    if not conv[mid]:
-        require_converged(path.converged[mid:mid + 1], "tooth contact at the reference point",
-                          path.residual[mid:mid + 1])
-    idx = np.nonzero(inside & conv)[0]
-    if idx.size == 0:
-        raise NoContactError("no contact inside the flank boundaries at any grid position "
-                             "(the flanks do not touch); pass strict=False to get the masks")
-    if idx.size:
-        sl = slice(idx[0], idx[-1] + 1)
-        require_converged(path.converged[sl], "tooth contact analysis on the flank",
-                          path.residual[sl])
 
 
 SUMMARY_KEYS = ("ptp_rad", "phi2_ref_rad", "axial1_mm", "radial1_mm", "axial2_mm",
