@@ -37,6 +37,9 @@ the core, never the other way round)::
                            normal coincidence continued by lax.scan, TE, contact
                            ellipses, multiple pairs, misalignments (dE, dP, dG, dSigma)
     gearjax/tca_involute.py  TCA adapter for involute pairs (crowning, mismatch)
+    gearjax/tca_hypoid.py  TCA adapter for face-milled spiral-bevel/hypoid pairs:
+                           mounting, hand check, reference contact, flank boundaries,
+                           crown-gear complementary settings, V-H table
     gearjax/plot_tca.py    TE curves and contact pattern figures
     gearjax/gears/hypoid_kinematics.py  seed-000 meshing characteristics over the
                            hypoid gear flank, limits, cutter-radius study

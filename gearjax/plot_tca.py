@@ -45,8 +45,10 @@ def ellipse_outline_axial(path, i, points=48):
 def plot_tca(results, limits=None, title="TCA"):
     """Figure for ``results``: a list of ``(label, path, margin, multi)``.
 
-    ``limits`` (optional dict: ``face_half``, ``root_radius``, ``tip_radius`` in mm)
-    draws the flank boundary of the pinion.  Returns the matplotlib Figure.
+    ``limits`` (optional) draws the flank boundary of the pinion: a dict with
+    ``face_half``, ``root_radius``, ``tip_radius`` (mm, cylindrical gears), or one
+    dict per result with ``outline`` (a closed (5, 2) polygon toe-root, heel-root,
+    heel-tip, toe-tip, mm; bevel gears).  Returns the matplotlib Figure.
     """
     import matplotlib
     matplotlib.use("Agg", force=False)
@@ -55,6 +57,7 @@ def plot_tca(results, limits=None, title="TCA"):
     k = len(results)
     fig, axes = plt.subplots(2, k, figsize=(6 * k, 8), squeeze=False)
     for j, (label, path, margin, multi) in enumerate(results):
+        lim = limits[j] if isinstance(limits, (list, tuple)) else limits
         ax = axes[0, j]
         phi = np.degrees(np.asarray(path.phi1))
         te = np.asarray(multi.te_pairs) / ARCSEC
@@ -76,8 +79,21 @@ def plot_tca(results, limits=None, title="TCA"):
         for i in np.nonzero(inside)[0][::3]:
             o = ellipse_outline_axial(path, i)
             ax.plot(o[:, 0], o[:, 1], color="C0", lw=0.7)
-        if limits is not None:
-            h, r0, r1 = limits["face_half"], limits["root_radius"], limits["tip_radius"]
+        if lim is not None and "outline" in lim:
+            o = np.asarray(lim["outline"])          # toe-root, heel-root, heel-tip, toe-tip
+            ax.plot(o[:, 0], o[:, 1], "k-", lw=1)
+            mid = lambda a, c: 0.5 * (o[a] + o[c])
+            for (a, c), txt, ha, va in (((0, 3), "toe ", "right", "center"),
+                                        ((1, 2), " heel", "left", "center"),
+                                        ((2, 3), "tip", "center", "bottom"),
+                                        ((0, 1), "root", "center", "top")):
+                x, y = mid(a, c)
+                ax.text(x, y, txt, ha=ha, va=va)
+            span = np.ptp(o, axis=0)
+            ax.set_xlim(o[:, 0].min() - 0.25 * span[0], o[:, 0].max() + 0.25 * span[0])
+            ax.set_ylim(o[:, 1].min() - 0.2 * span[1], o[:, 1].max() + 0.2 * span[1])
+        elif lim is not None:
+            h, r0, r1 = lim["face_half"], lim["root_radius"], lim["tip_radius"]
             ax.plot([-h, h, h, -h, -h], [r0, r0, r1, r1, r0], "k-", lw=1)
             ax.text(-h, 0.5 * (r0 + r1), "toe ", ha="right", va="center")
             ax.text(h, 0.5 * (r0 + r1), " heel", ha="left", va="center")

@@ -78,7 +78,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .errors import ConvergenceError, require_converged
+from .errors import ConvergenceError, check_int, check_range, require_converged
 from .newton import newton_solve
 from .surfaces import GeneratedSurface, local_geometry, unit_normal
 
@@ -86,7 +86,7 @@ __all__ = ["Misalignment", "Assembly", "contact_equations", "point_normal", "gea
            "ContactPath", "contact_path", "te_arcsec", "require_path",
            "ARCSEC", "ellipse_from_weingarten", "rotation_about", "relative_curvature",
            "MultiPair", "multi_pair", "DEFAULT_APPROACH", "NoContactError",
-           "check_on_flank_converged"]
+           "check_on_flank_converged", "check_tca_options"]
 
 class NoContactError(ConvergenceError):
     """The flanks do not touch inside their boundaries (a :class:`ConvergenceError`)."""
@@ -501,3 +501,14 @@ def check_on_flank_converged(path: ContactPath, margin) -> None:
         sl = slice(idx[0], idx[-1] + 1)
         require_converged(path.converged[sl], "tooth contact analysis on the flank",
                           path.residual[sl])
+
+
+def check_tca_options(steps_per_pitch, half_pitches, n_pairs, approach) -> None:
+    """Validate the grid and ellipse options of the adapters' public TCA functions
+    (ValueError naming the parameter and its allowed range)."""
+    check_int("steps_per_pitch", steps_per_pitch, lo=2, hi=1000)
+    check_int("n_pairs", n_pairs, lo=3, hi=9)
+    if n_pairs % 2 == 0:
+        raise ValueError(f"n_pairs = {n_pairs} must be odd (pairs -k..k)")
+    check_range("half_pitches", half_pitches, 0.5, 4.0)
+    check_range("approach", approach, 0.0, 1.0, lo_open=True, unit="mm")

@@ -75,19 +75,21 @@ import jax.numpy as jnp
 import numpy as np
 
 from gearjax.cutters import FaceMillCutter
-from gearjax.errors import check_int, check_range
-from gearjax.gears.hypoid import (FlankSpec, face_cone_gap, mid_estimate, pitch_distance,
-                                  root_cone_gap, solve_tip, work_point)
+from gearjax.gears.hypoid import (FlankSpec, face_apex_offset, face_cone_gap, mid_estimate,
+                                  pitch_distance, root_apex_offset, root_cone_gap, solve_tip,
+                                  work_point)
 from gearjax.machines import MachineSettings
 from gearjax.surfaces import GeneratedSurface
 from gearjax.newton import newton_solve
 from gearjax.tca import (DEFAULT_APPROACH, Assembly, ContactPath, Misalignment, MultiPair,
-                         NoContactError, check_on_flank_converged, contact_equations, contact_path, multi_pair)
+                         NoContactError, check_on_flank_converged, check_tca_options,
+                         contact_equations, contact_path, multi_pair)
 
 __all__ = ["mean_dedendum", "HypoidPair", "HypoidMounting", "pair_flanks", "complementary_pinion",
            "hypoid_assembly", "flank_function", "reference_guess", "hypoid_margin",
            "flank_coordinates", "hypoid_tca_traced", "hypoid_tca", "SIDES", "HypoidTCA",
-           "Prepared", "prepare", "with_point_radius", "reference_contact", "tca_summary", "SUMMARY_KEYS"]
+           "Prepared", "prepare", "with_point_radius", "pinion_outline",
+           "misalignment_sensitivity", "reference_contact", "tca_summary", "SUMMARY_KEYS"]
 
 # drive side: pinion concave drives gear convex (Gleason convention); coast: the others
 SIDES = {"drive": ("concave", "convex"), "coast": ("convex", "concave")}
@@ -242,8 +244,9 @@ def reference_guess(pair: HypoidPair, n_search: int = 181):
     """Initial guess ``x_ref = (theta1, s1, theta2, s2, phi2)`` and ``phi1_ref`` for the
     reference contact, and the hand of the mounting (concrete; module docstring).
 
-    Returns ``(x_ref, phi1_ref, hand, mismatch)`` where ``mismatch`` is the value of
-    the search objective (mm^2) at the chosen configuration.
+    Returns ``(x_ref, phi1_ref, hand, (gap, angle))``: the distance of the mean points
+    (mm) and the angle between the normals (deg, 0 = exactly opposite) at the chosen
+    configuration.
     """
     pts = []
     for fl, t in ((pair.pinion, pair.pinion_crossing), (pair.gear, pair.gear_crossing)):
@@ -267,10 +270,12 @@ def reference_guess(pair: HypoidPair, n_search: int = 181):
         obj = np.sum((p1 - p2) ** 2, axis=0) + L2 * (1.0 + np.sum(m1 * m2, axis=0))
         i, j = np.unravel_index(np.argmin(obj), obj.shape)
         if best is None or obj[i, j] < best[0]:
-            best = (obj[i, j], h, a[i], a[j])
-    mismatch, h, ph1, ph2 = best
+            gap = float(np.sqrt(np.sum((p1[:, i, j] - p2[:, i, j]) ** 2)))
+            ang = float(np.degrees(np.arccos(np.clip(-np.sum(m1[:, i, j] * m2[:, i, j]), -1, 1))))
+            best = (obj[i, j], h, a[i], a[j], gap, ang)
+    _, h, ph1, ph2, gap, ang = best
     x_ref = np.array([uv1[0], uv1[1], uv2[0], uv2[1], ph2])
-    return x_ref, float(ph1), int(h), float(mismatch)
+    return x_ref, float(ph1), int(h), (gap, ang)
 
 
 def _rotz_np(a, v):
@@ -328,7 +333,8 @@ def reference_contact(pair: HypoidPair, mis: Misalignment, x_guess, phi1_guess):
     Step 1 keeps the pinion point ``uv1`` of the guess fixed and solves position
     coincidence and one normal equation for ``(phi1, theta2, s2, phi2)`` (4x4): where
     the pinion's mean point meets the gear flank.  Step 2 solves the full 5x5 point
-    contact at that ``phi1``.  Returns ``(x_ref, phi1_ref, ok)``; where step 2 fails
+    contact at that ``phi1``.  Returns ``(x_ref, phi1_ref, ok)`` (``phi1_ref``
+    differentiable with respect to the settings); where step 2 fails
     (a pair in line contact, whose 5x5 system is singular) ``x_ref`` is step 1's.
     """
     r1 = flank_function(pair.pinion, pair.pinion_crossing)
@@ -345,7 +351,10 @@ def reference_contact(pair: HypoidPair, mis: Misalignment, x_guess, phi1_guess):
     x1 = jnp.concatenate([uv1, s1.x[1:]])
     s2 = newton_solve(F, x1, s1.x[0], tol=1e-11, max_steps=40)
     x_ref = jnp.where(s2.converged, s2.x, x1)
-    return jax.lax.stop_gradient(x_ref), jax.lax.stop_gradient(s1.x[0]), s1.converged
+    # phi1_ref keeps its (implicit-function) derivatives: the grid moves with the
+    # settings, so the reference contact stays the pinion's mean point under
+    # differentiation as it does under finite differences
+    return jax.lax.stop_gradient(x_ref), s1.x[0], s1.converged
 
 
 class HypoidTCA(NamedTuple):
@@ -372,7 +381,11 @@ class Prepared(NamedTuple):
     x_ref: np.ndarray
     phi1_ref: float
     drive: bool
-    mismatch: float
+    mismatch: tuple
+
+
+MAX_GAP = 6.0      # mm, mean points of the flanks after the coarse search
+MAX_ANGLE = 20.0   # deg, their normals from exactly opposite
 
 
 def prepare(pair: HypoidPair, n_search: int = 181) -> Prepared:
@@ -384,12 +397,13 @@ def prepare(pair: HypoidPair, n_search: int = 181) -> Prepared:
     body rotations bring the mean points of the flanks within 2 mm with opposite
     normals (the flanks cannot mesh).
     """
-    x_ref, phi1_ref, hand, mism = reference_guess(pair, n_search)
-    if not mism < 4.0 + 100.0 * (1.0 - math.cos(math.radians(15.0))):
+    x_ref, phi1_ref, hand, (gap, ang) = reference_guess(pair, n_search)
+    if not (gap < MAX_GAP and ang < MAX_ANGLE):
         raise NoContactError(
             f"the pinion and gear flanks cannot be brought into contact near their mean "
-            f"points (best gap^2 + L^2(1 + n1.n2) = {mism:.3g} mm^2 over both hands of the "
-            "mounting): check the flank sides, hands of spiral and mounting data")
+            f"points (best over both hands of the mounting: gap {gap:.3g} mm, normals "
+            f"{ang:.3g} deg from opposite; limits {MAX_GAP:g} mm, {MAX_ANGLE:g} deg): check "
+            "the flank sides, hands of spiral and mounting data")
     pair = replace(pair, hand=hand)
     uv1 = jnp.asarray(x_ref[:2])
     r1 = flank_function(pair.pinion, pair.pinion_crossing)
@@ -399,7 +413,7 @@ def prepare(pair: HypoidPair, n_search: int = 181) -> Prepared:
     p = np.array([c * p[0] - s_ * p[1], s_ * p[0] + c * p[1], p[2]])
     n = np.array([c * n[0] - s_ * n[1], s_ * n[0] + c * n[1], n[2]])
     drive = float(np.dot(np.cross([0.0, 0.0, 1.0], p), n)) > 0.0
-    return Prepared(pair, x_ref, phi1_ref, drive, mism)
+    return Prepared(pair, x_ref, phi1_ref, drive, (gap, ang))
 
 
 def hypoid_tca_traced(pair: HypoidPair, mis: Misalignment, x_ref, phi1_ref, *,
@@ -414,9 +428,11 @@ def hypoid_tca_traced(pair: HypoidPair, mis: Misalignment, x_ref, phi1_ref, *,
     blade position ``s`` stays at ``x_ref[1]``.
     """
     if not line_contact:
-        x_ref, phi1_ref, ok = reference_contact(pair, mis, x_ref, phi1_ref)
-    else:
-        ok = jnp.asarray(True)
+        # where step 1 fails the reference stays at the guessed pinion angle; the
+        # path's own solves carry the convergence flags
+        x_new, phi1_new, ok = reference_contact(pair, mis, x_ref, phi1_ref)
+        x_ref = jnp.where(ok, x_new, jax.lax.stop_gradient(jnp.asarray(x_ref, float)))
+        phi1_ref = jnp.where(ok, phi1_new, jax.lax.stop_gradient(jnp.asarray(phi1_ref, float)))
     h = 2.0 * np.pi / (pair.z1 * steps_per_pitch)
     k = int(round(half_pitches * steps_per_pitch))
     grid = phi1_ref + h * jnp.arange(-k, k + 1, dtype=float)
@@ -424,7 +440,6 @@ def hypoid_tca_traced(pair: HypoidPair, mis: Misalignment, x_ref, phi1_ref, *,
     r2 = flank_function(pair.gear, pair.gear_crossing)
     path = contact_path(r1, r2, hypoid_assembly(pair), mis, grid, x_ref,
                         line_contact=line_contact, approach=approach)
-    path = path._replace(converged=path.converged & ok)
     margin, coords = hypoid_margin(pair, path)
     multi = multi_pair(path, margin, steps_per_pitch, pair.z1, drive=drive, n_pairs=n_pairs)
     return HypoidTCA(path, margin, multi, coords)
@@ -439,15 +454,6 @@ def _tca_jit(pair, mis, x_ref, phi1_ref, approach, *, steps_per_pitch, half_pitc
     return hypoid_tca_traced(pair, mis, x_ref, phi1_ref, steps_per_pitch=steps_per_pitch,
                              half_pitches=half_pitches, line_contact=line_contact,
                              n_pairs=n_pairs, drive=drive, approach=approach)
-
-
-def _check_options(steps_per_pitch, half_pitches, n_pairs, approach):
-    check_int("steps_per_pitch", steps_per_pitch, lo=2, hi=1000)
-    check_int("n_pairs", n_pairs, lo=3, hi=9)
-    if n_pairs % 2 == 0:
-        raise ValueError(f"n_pairs = {n_pairs} must be odd (pairs -k..k)")
-    check_range("half_pitches", half_pitches, 0.5, 4.0)
-    check_range("approach", approach, 0.0, 1.0, lo_open=True, unit="mm")
 
 
 def hypoid_tca(pair: HypoidPair | Prepared, mis: Misalignment | None = None, *,
@@ -465,7 +471,7 @@ def hypoid_tca(pair: HypoidPair | Prepared, mis: Misalignment | None = None, *,
     (or at the reference) and :class:`~gearjax.tca.NoContactError` when no grid
     point is on both flanks; ``strict=False`` returns the masks.
     """
-    _check_options(steps_per_pitch, half_pitches, n_pairs, approach)
+    check_tca_options(steps_per_pitch, half_pitches, n_pairs, approach)
     prep = pair if isinstance(pair, Prepared) else prepare(pair)
     if mis is None:
         mis = Misalignment.zero()
@@ -501,3 +507,63 @@ def tca_summary(pair: HypoidPair, res: HypoidTCA):
     ang = jnp.arctan2(dh, dxi * 0.5 * pair.pinion.blank.face_width)
     return jnp.stack([res.multi.ptp, p.phi2[mid], c["xi1"][mid], c["h1"][mid], c["xi2"][mid],
                       c["h2"][mid], p.semi_major[mid], ang])
+
+
+@functools.partial(jax.jit, static_argnames=_STATIC)
+def _sensitivity_jit(pair, mis, x_ref, phi1_ref, approach, *, steps_per_pitch, half_pitches,
+                     line_contact, n_pairs, drive):
+    def f(m):
+        res = hypoid_tca_traced(pair, m, x_ref, phi1_ref, steps_per_pitch=steps_per_pitch,
+                                half_pitches=half_pitches, line_contact=line_contact,
+                                n_pairs=n_pairs, drive=drive, approach=approach)
+        return tca_summary(pair, res)
+    return f(mis), jax.jacfwd(f)(mis)
+
+
+def misalignment_sensitivity(prep: Prepared, mis: Misalignment | None = None, *,
+                             steps_per_pitch: int = 16, half_pitches: float = 2.0,
+                             n_pairs: int = 5, approach: float = DEFAULT_APPROACH):
+    """The V-H check by ``jax.jacfwd``: derivatives of the :func:`tca_summary` values
+    (TE peak-to-peak, gear angle at the reference = TE shift, bearing position on
+    both flanks, ellipse length, path angle) with respect to dE, dP, dG (per mm) and
+    dSigma (per rad), exact through every contact solve (point contact).
+
+    Returns ``(values, table)``: dicts keyed by :data:`SUMMARY_KEYS`; ``table[key]``
+    is ``{"dE": .., "dP": .., "dG": .., "dSigma": ..}``.
+    """
+    check_tca_options(steps_per_pitch, half_pitches, n_pairs, approach)
+    if mis is None:
+        mis = Misalignment.zero()
+    vals, jac = _sensitivity_jit(prep.pair, mis, jnp.asarray(prep.x_ref),
+                                 jnp.asarray(prep.phi1_ref), float(approach),
+                                 steps_per_pitch=int(steps_per_pitch),
+                                 half_pitches=float(half_pitches), line_contact=False,
+                                 n_pairs=int(n_pairs), drive=bool(prep.drive))
+    values = {k: float(v) for k, v in zip(SUMMARY_KEYS, np.asarray(vals))}
+    table = {k: {name: float(np.asarray(getattr(jac, name))[i])
+                 for name in ("dE", "dP", "dG", "dSigma")} for i, k in enumerate(SUMMARY_KEYS)}
+    return values, table
+
+
+def pinion_outline(pair: HypoidPair) -> dict:
+    """Axial projection of the pinion's working flank boundary for plots (concrete).
+
+    Corners toe-root, heel-root, heel-tip, toe-tip in (body z from the crossing
+    point, radius) mm: the toe and heel lines ``l_p = A_o - F`` and ``l_p = A_o``
+    (distance along the pitch generatrix, as in :mod:`gearjax.gears.hypoid`)
+    intersected with the root cone and the face cone.
+    """
+    b = pair.pinion.blank
+    gp = float(b.pitch_angle)
+    Ao, F = float(b.outer_cone_distance), float(b.face_width)
+    cones = [(float(b.root_angle), float(root_apex_offset(b))),
+             (float(b.face_angle), float(face_apex_offset(b)))]
+
+    def corner(L, cone):
+        g, c = cone
+        x = (L - math.sin(gp) * math.tan(g) * c) / (math.cos(gp) + math.sin(gp) * math.tan(g))
+        return [x - float(pair.pinion_crossing), math.tan(g) * (x + c)]
+
+    pts = [corner(Ao - F, cones[0]), corner(Ao, cones[0]), corner(Ao, cones[1]),
+           corner(Ao - F, cones[1])]
+    return {"outline": np.array(pts + [pts[0]])}

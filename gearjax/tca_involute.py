@@ -46,11 +46,11 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .errors import check_int, check_range
+from .errors import check_range
 from .gears.involute import InvolutePair, generated_flank, pair_geometry
 from .surfaces import GeneratedSurface
 from .tca import (DEFAULT_APPROACH, Assembly, ContactPath, Misalignment, MultiPair,
-                  contact_path, multi_pair, check_on_flank_converged)
+                  contact_path, multi_pair, check_on_flank_converged, check_tca_options)
 
 __all__ = ["InvoluteTCA", "crowned_pinion_flank", "involute_assembly", "involute_tca_traced",
            "involute_tca", "involute_margin", "tca_summary", "SUMMARY_KEYS",
@@ -224,12 +224,7 @@ def involute_tca(des: InvoluteTCA, mis: Misalignment | None = None, *, side: int
     """
     if side not in (-1, 1):
         raise ValueError(f"side = {side!r} must be -1 (drive) or +1 (coast)")
-    check_int("steps_per_pitch", steps_per_pitch, lo=2, hi=1000)
-    check_int("n_pairs", n_pairs, lo=3, hi=9)
-    if n_pairs % 2 == 0:
-        raise ValueError(f"n_pairs = {n_pairs} must be odd (pairs -k..k)")
-    check_range("half_pitches", half_pitches, 0.5, 4.0)
-    check_range("approach", approach, 0.0, 1.0, lo_open=True, unit="mm")
+    check_tca_options(steps_per_pitch, half_pitches, n_pairs, approach)
     if mis is None:
         mis = Misalignment.zero()
     if line_contact is None:

@@ -47,9 +47,17 @@ def test_flanks_that_do_not_touch_exit_nonzero_with_one_line(capsys):
     assert len(err) == 1 and "do not touch" in err[0]
 
 
+def test_hypoid_design_whose_flanks_do_not_mesh_is_reported_in_one_line(capsys):
+    """The seed-004 8/43 set with its derived settings: at the pinion's mean point the
+    gear flank's normal is 9.5 deg off (drive), no reference contact exists."""
+    assert main(["tca", "example:hft_8x43", "--positions", "21"]) == 3
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "drive side" in err[0]
+
+
 def test_bad_input_one_line(capsys):
-    assert main(["tca", "example:spiral_bevel_10x30"]) == 2
-    assert "not implemented" in capsys.readouterr().err
+    assert main(["tca", "example:no_such_design"]) == 2
+    assert "no_such_design" in capsys.readouterr().err
     assert main(["tca", DESIGN, "--positions", "60"]) == 2
     assert "positions" in capsys.readouterr().err
     assert main(["tca", DESIGN, "--misalign", "dX=1"]) == 2

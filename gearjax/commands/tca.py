@@ -1,11 +1,11 @@
 """``gearjax tca``: unloaded tooth contact analysis (see :mod:`gearjax.tca`).
 
-DESIGN is an involute pair given inline,
+DESIGN is either an involute pair given inline,
 ``involute:z1=25,z2=41,m=2,alpha=20,b=20[,helix=0,x1=0,x2=0,dalpha=0,crown=0,lead_crown=0]``
 (tooth numbers, normal module mm, normal pressure angle deg, face width mm, helix
 deg, profile shifts, pinion pressure-angle change deg, pinion profile and lead
-crown 1/mm).  Hypoid/spiral-bevel designs (``example:NAME`` or a file) are not yet
-supported by TCA and are refused with one line.
+crown 1/mm), or a hypoid/spiral-bevel design file (a path or ``example:NAME``;
+:mod:`gearjax.tca_hypoid`; drive side = pinion concave on gear convex).
 """
 
 from __future__ import annotations
@@ -27,7 +27,11 @@ JSON_KEYS_DOC = """JSON keys:
   transfer_phi1_rad  pinion angles of the transfers into and out of pair 0
   contact_ratio    on-flank interval of pair 0 / angular pitch
   path             {axial1_mm, radial1_mm, axial2_mm, radial2_mm}: contact point on
-                   pinion and gear flank in axial projection (body z, radius)
+                   pinion and gear flank in axial projection (body z, radius; for
+                   bevel gears z is measured from the crossing point); bevel gears
+                   also {xi1, h1_mm, xi2, h2_mm}: face-width position (-1 toe, +1
+                   heel) and height above the root cone
+  (with --side both the output is {"drive": {...}, "coast": {...}})
   ellipses         {semi_major_mm, semi_minor_mm}: contact ellipse (elastic approach
                    0.00632 mm; null = infinite, line contact)
   flags            {converged, on_flank, edge}: per grid point (edge: converged but
@@ -38,10 +42,12 @@ def register(sub):
     p = sub.add_parser(
         "tca", help="tooth contact analysis: TE, path of contact, contact ellipses",
         description="Unloaded tooth contact analysis of an involute pair (optionally with a "
-                    "crowned or mismatched pinion and misalignments).",
+                    "crowned or mismatched pinion) or of a hypoid/spiral-bevel design, "
+                    "with misalignments.",
         epilog=JSON_KEYS_DOC, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("design", help="involute:z1=..,z2=..,m=..,alpha=..,b=..[,...] (see above)")
-    p.add_argument("--side", choices=["drive", "coast"], default="drive")
+    p.add_argument("design", help="involute:z1=..,z2=..,m=..,alpha=..,b=..[,...], or a "
+                                  "hypoid/spiral-bevel design file or example:NAME")
+    p.add_argument("--side", choices=["drive", "coast", "both"], default="drive")
     p.add_argument("--misalign", default="",
                    help="dE=mm,dP=mm,dG=mm,dSigma=deg (any subset; default all 0)")
     p.add_argument("--positions", type=float, default=61,
@@ -74,10 +80,6 @@ def _design(text):
     from ..gears.involute import InvolutePair
     from ..tca_involute import InvoluteTCA
 
-    if not text.startswith("involute:"):
-        raise ValueError(f"design {text!r}: tooth contact analysis supports involute pairs "
-                         "('involute:z1=..,z2=..,m=..,alpha=..,b=..'); hypoid/spiral-bevel TCA "
-                         "is not implemented yet")
     kv = _parse_kv(text[len("involute:"):], _ALLOWED, "design")
     missing = [k for k in ("z1", "z2", "m", "alpha", "b") if k not in kv]
     if missing:
@@ -93,41 +95,33 @@ def _nan_list(a):
     return [None if not np.isfinite(x) else float(x) for x in a.ravel()]
 
 
-def run(args) -> int:
-    from ..errors import ConvergenceError, check_int
-    from ..tca import ARCSEC, Misalignment, NoContactError
-    from ..tca_involute import involute_tca
+def _involute_side(args, mis, m, side_name):
+    from ..tca_involute import involute_limits, involute_tca
+    _, des = _design(args.design)
+    side = -1 if side_name == "drive" else 1
+    path, margin, multi = involute_tca(des, mis, side=side, steps_per_pitch=m, half_pitches=1.25)
+    return path, margin, multi, involute_limits(des, side), {}
 
-    kv, des = _design(args.design)
-    mis_kv = _parse_kv(args.misalign, {"dE", "dP", "dG", "dSigma"}, "misalign")
-    mis = Misalignment.create(mis_kv.get("dE", 0.0), mis_kv.get("dP", 0.0),
-                              mis_kv.get("dG", 0.0), mis_kv.get("dSigma", 0.0))
-    n = check_int("positions", args.positions, lo=11, hi=1001)
-    if (n - 1) % 10:
-        raise ValueError(f"positions = {n} must be of the form 10k+1 (11, 21, ..., 61, ...)")
-    m = 4 * ((n - 1) // 10)
-    side = -1 if args.side == "drive" else 1
-    try:
-        path, margin, multi = involute_tca(des, mis, side=side, steps_per_pitch=m,
-                                           half_pitches=1.25)
-    except NoContactError:
-        sys.stderr.write("gearjax: error: the flanks do not touch inside their boundaries "
-                         "(no on-flank contact at any grid position)\n")
-        return 3
-    except ConvergenceError as exc:
-        sys.stderr.write(f"gearjax: error: the contact solve failed: {exc}\n")
-        return 3
+
+def _hypoid_side(design, mis, m, side_name):
+    from .. import tca_hypoid as th
+    prep = th.prepare(th.pair_flanks(design, side_name))
+    res = th.hypoid_tca(prep, mis, steps_per_pitch=m, half_pitches=1.25, n_pairs=3)
+    prep_pair = prep.pair
+    extra = {"xi1": res.coords["xi1"], "h1_mm": res.coords["h1"], "xi2": res.coords["xi2"],
+             "h2_mm": res.coords["h2"]}
+    return res.path, res.margin, res.multi, th.pinion_outline(prep_pair), extra
+
+
+def _side_json(path, margin, multi, extra):
+    from ..tca import ARCSEC
     conv = np.asarray(path.converged)
     on = (np.asarray(margin) >= 0.0) & conv
     te = np.where(on, np.asarray(path.te), np.nan) / ARCSEC
-    if args.plot:
-        from ..plot_tca import save_tca_plot
-        from ..tca_involute import involute_limits
-        save_tca_plot(args.plot, [(args.side, path, margin, multi)], involute_limits(des, side),
-                      title="involute TCA")
-    sm = np.asarray(path.semi_major)
-    out = {
-        "input": {"design": args.design, "side": args.side, "misalign": mis_kv, "positions": n},
+    pth = {k: _nan_list(getattr(path, k[:-3])) for k in
+           ("axial1_mm", "radial1_mm", "axial2_mm", "radial2_mm")}
+    pth.update({k: _nan_list(v) for k, v in extra.items()})
+    return {
         "phi1_rad": _nan_list(path.phi1),
         "te_arcsec": _nan_list(te),
         "te_pairs_arcsec": [_nan_list(r) for r in np.asarray(multi.te_pairs) / ARCSEC],
@@ -135,23 +129,68 @@ def run(args) -> int:
         "ptp_arcsec": float(multi.ptp) / ARCSEC,
         "transfer_phi1_rad": _nan_list(multi.transfer_phi1),
         "contact_ratio": float(multi.contact_ratio),
-        "path": {k: _nan_list(getattr(path, k[:-3])) for k in
-                 ("axial1_mm", "radial1_mm", "axial2_mm", "radial2_mm")},
-        "ellipses": {"semi_major_mm": _nan_list(sm),
+        "path": pth,
+        "ellipses": {"semi_major_mm": _nan_list(path.semi_major),
                      "semi_minor_mm": _nan_list(path.semi_minor)},
         "flags": {"converged": conv.tolist(), "on_flank": on.tolist(),
                   "edge": (conv & ~on).tolist()},
     }
+
+
+def run(args) -> int:
+    from ..errors import ConvergenceError, check_int
+    from ..tca import Misalignment, NoContactError
+
+    mis_kv = _parse_kv(args.misalign, {"dE", "dP", "dG", "dSigma"}, "misalign")
+    mis = Misalignment.create(mis_kv.get("dE", 0.0), mis_kv.get("dP", 0.0),
+                              mis_kv.get("dG", 0.0), mis_kv.get("dSigma", 0.0))
+    n = check_int("positions", args.positions, lo=11, hi=1001)
+    if (n - 1) % 10:
+        raise ValueError(f"positions = {n} must be of the form 10k+1 (11, 21, ..., 61, ...)")
+    m = 4 * ((n - 1) // 10)
+    sides = ["drive", "coast"] if args.side == "both" else [args.side]
+    if args.design.startswith("involute:"):
+        _design(args.design)                       # validate before any tracing
+        solve = lambda side: _involute_side(args, mis, m, side)
+    else:
+        from ..io import load_design
+        design = load_design(args.design)
+        solve = lambda side: _hypoid_side(design, mis, m, side)
+    results = {}
+    for side in sides:
+        try:
+            results[side] = solve(side)
+        except NoContactError as exc:
+            sys.stderr.write(f"gearjax: error: {side} side: the flanks do not touch: {exc}\n")
+            return 3
+        except ConvergenceError as exc:
+            sys.stderr.write(f"gearjax: error: {side} side: the contact solve failed: {exc}\n")
+            return 3
+    if args.plot:
+        from ..plot_tca import save_tca_plot
+        save_tca_plot(args.plot, [(sd, r[0], r[1], r[2]) for sd, r in results.items()],
+                      [r[3] for r in results.values()], title=f"TCA {args.design}")
+    outs = {sd: _side_json(r[0], r[1], r[2], r[4]) for sd, r in results.items()}
+    inp = {"design": args.design, "side": args.side, "misalign": mis_kv, "positions": n}
     if args.json:
-        print(json.dumps(out, indent=1))
+        if len(sides) == 1:
+            print(json.dumps({"input": inp, **outs[sides[0]]}, indent=1))
+        else:
+            print(json.dumps({"input": inp, **outs}, indent=1))
         return 0
-    print(f"# TCA {args.design} ({args.side}); misalign {mis_kv or 'none'}")
-    print(f"# TE p-t-p {out['ptp_arcsec']:.4f} arcsec, contact ratio {out['contact_ratio']:.4f}")
-    print(f"{'phi1[deg]':>10s} {'TE[arcsec]':>11s} {'axial1':>9s} {'radius1':>9s} "
-          f"{'2a[mm]':>8s} {'2b[mm]':>8s} flag")
-    for i in range(n):
-        flag = "ok" if on[i] else ("edge" if conv[i] else "no-conv")
-        print(f"{math.degrees(float(path.phi1[i])):10.4f} {te[i]:11.5f} "
-              f"{float(path.axial1[i]):9.4f} {float(path.radial1[i]):9.4f} "
-              f"{2 * sm[i]:8.4f} {2 * float(path.semi_minor[i]):8.4f} {flag}")
+    for sd, (path, margin, multi, _, extra) in results.items():
+        out = outs[sd]
+        conv = np.asarray(out["flags"]["converged"])
+        on = np.asarray(out["flags"]["on_flank"])
+        te = np.array([np.nan if v is None else v for v in out["te_arcsec"]])
+        sm = np.asarray(path.semi_major)
+        print(f"# TCA {args.design} ({sd}); misalign {mis_kv or 'none'}")
+        print(f"# TE p-t-p {out['ptp_arcsec']:.4f} arcsec, contact ratio {out['contact_ratio']:.4f}")
+        print(f"{'phi1[deg]':>10s} {'TE[arcsec]':>11s} {'axial1':>9s} {'radius1':>9s} "
+              f"{'2a[mm]':>8s} {'2b[mm]':>8s} flag")
+        for i in range(n):
+            flag = "ok" if on[i] else ("edge" if conv[i] else "no-conv")
+            print(f"{math.degrees(float(path.phi1[i])):10.4f} {te[i]:11.5f} "
+                  f"{float(path.axial1[i]):9.4f} {float(path.radial1[i]):9.4f} "
+                  f"{2 * sm[i]:8.4f} {2 * float(path.semi_minor[i]):8.4f} {flag}")
     return 0
