@@ -40,6 +40,8 @@ the core, never the other way round)::
     gearjax/tca_hypoid.py  TCA adapter for face-milled spiral-bevel/hypoid pairs:
                            mounting, hand check, reference contact, flank boundaries,
                            crown-gear complementary settings, V-H table
+    gearjax/synthesis.py   local synthesis of a spiral-bevel/hypoid pinion through TCA
+                           (least squares with exact Jacobians)
     gearjax/plot_tca.py    TE curves and contact pattern figures
     gearjax/gears/hypoid_kinematics.py  seed-000 meshing characteristics over the
                            hypoid gear flank, limits, cutter-radius study

@@ -47,12 +47,21 @@ def test_flanks_that_do_not_touch_exit_nonzero_with_one_line(capsys):
     assert len(err) == 1 and "do not touch" in err[0]
 
 
-def test_hypoid_design_whose_flanks_do_not_mesh_is_reported_in_one_line(capsys):
-    """The seed-004 8/43 set with its derived settings: at the pinion's mean point the
-    gear flank's normal is 9.5 deg off (drive), no reference contact exists."""
-    assert main(["tca", "example:hft_8x43", "--positions", "21"]) == 3
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "drive side" in err[0]
+def test_hypoid_design_json_and_plot(capsys, tmp_path):
+    """The shipped synthesised spiral-bevel pair: localised bearing on the flank,
+    parabolic TE of a few arc-seconds, the bevel-gear path keys, a figure."""
+    png = tmp_path / "sb.png"
+    assert main(["tca", "example:spiral_bevel_10x30_synthesised", "--positions", "21", "--json",
+                 "--plot", str(png)]) == 0
+    out = json.loads(capsys.readouterr().out)
+    for key in ("xi1", "h1_mm", "xi2", "h2_mm", "axial1_mm"):
+        assert len(out["path"][key]) == 21
+    on = np.array(out["flags"]["on_flank"])
+    assert on[10] and on.sum() >= 5
+    assert abs(out["path"]["xi1"][10]) < 0.2                      # bearing near mid face
+    assert 2.0 < out["ptp_arcsec"] < 20.0                          # synthesised for 8 arcsec
+    assert all(v is not None for v, o in zip(out["ellipses"]["semi_major_mm"], on) if o)
+    assert png.read_bytes()[:4] == b"\x89PNG"
 
 
 def test_bad_input_one_line(capsys):
