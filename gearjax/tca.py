@@ -63,7 +63,8 @@ contact ellipse ``t.B.t/2 = delta`` has semi-axes ``sqrt(2 delta/lambda_i)``
 infinite (reported as ``inf``).
 
 Family adapters build the flanks, the assembly, the initial guess and the flank
-boundaries: :mod:`gearjax.tca_involute` (rack-generated involute pairs).  Figures:
+boundaries: :mod:`gearjax.tca_involute` (rack-generated involute pairs) and
+:mod:`gearjax.tca_hypoid` (face-milled spiral-bevel and hypoid pairs).  Figures:
 :mod:`gearjax.plot_tca`; CLI: ``gearjax tca``; documentation: ``docs/tca.md``.
 
 Units: mm, rad inside; arc-seconds only in keys/fields named ``*_arcsec``.

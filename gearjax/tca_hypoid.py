@@ -19,7 +19,7 @@ everything the generic core :mod:`gearjax.tca` needs:
   lengthwise line of the flank): the contact lines of a conjugate bevel pair run
   across the face from root to tip and cross every such line.
 
-* **Mounting** (:class:`HypoidMounting`).  Fixed frame = pinion body frame at
+* **Mounting** (carried by :class:`HypoidPair`).  Fixed frame = pinion body frame at
   ``phi1 = 0``: pinion axis ``z`` through the origin (its crossing point).  The
   gear axis ``k2 = (0, h sin Sigma, cos Sigma)`` passes through ``c0 = (E, 0, 0)``;
   ``Sigma`` is the angle between the two apex-to-heel axis vectors (the shaft
@@ -79,13 +79,13 @@ from gearjax.gears.hypoid import (FlankSpec, face_apex_offset, face_cone_gap, mi
                                   pitch_distance, root_apex_offset, root_cone_gap, solve_tip,
                                   work_point)
 from gearjax.machines import MachineSettings
-from gearjax.surfaces import GeneratedSurface
+from gearjax.surfaces import GeneratedSurface, solve_envelope
 from gearjax.newton import newton_solve
 from gearjax.tca import (DEFAULT_APPROACH, Assembly, ContactPath, Misalignment, MultiPair,
                          NoContactError, check_on_flank_converged, check_tca_options,
                          contact_equations, contact_path, multi_pair)
 
-__all__ = ["mean_dedendum", "HypoidPair", "HypoidMounting", "pair_flanks", "complementary_pinion",
+__all__ = ["mean_dedendum", "HypoidPair", "pair_flanks", "complementary_pinion",
            "hypoid_assembly", "flank_function", "reference_guess", "hypoid_margin",
            "flank_coordinates", "hypoid_tca_traced", "hypoid_tca", "SIDES", "HypoidTCA",
            "Prepared", "prepare", "with_point_radius", "pinion_outline",
@@ -121,9 +121,6 @@ class HypoidPair:
     z1: int = 1
     z2: int = 1
     hand: int = 1
-
-
-HypoidMounting = HypoidPair   # alias used in docs: the pair carries its mounting
 
 
 def _f(v):
@@ -248,14 +245,13 @@ def reference_guess(pair: HypoidPair, n_search: int = 181):
     (mm) and the angle between the normals (deg, 0 = exactly opposite) at the chosen
     configuration.
     """
-    pts = []
-    for fl, t in ((pair.pinion, pair.pinion_crossing), (pair.gear, pair.gear_crossing)):
-        uv = _mean_uv(fl)
-        r = flank_function(fl, t)
-        q = np.asarray(r(uv)) if not isinstance(r, GeneratedSurface) else np.asarray(r(uv))
-        n = np.asarray(_normal(fl, uv))
-        pts.append((np.asarray(uv), q, n))
-    (uv1, q1, n1), (uv2, q2, n2) = pts
+    return _search(pair, n_search)[:4]
+
+
+def _search(pair: HypoidPair, n_search: int):
+    """:func:`reference_guess`, plus the pinion's mean point and outward normal (body frame)."""
+    (uv1, q1, n1), (uv2, q2, n2) = (_mean_point(pair.pinion, pair.pinion_crossing),
+                                    _mean_point(pair.gear, pair.gear_crossing))
     a = np.linspace(-np.pi, np.pi, n_search, endpoint=False)
     A1, A2 = np.meshgrid(a, a, indexing="ij")
     best = None
@@ -275,7 +271,7 @@ def reference_guess(pair: HypoidPair, n_search: int = 181):
             best = (obj[i, j], h, a[i], a[j], gap, ang)
     _, h, ph1, ph2, gap, ang = best
     x_ref = np.array([uv1[0], uv1[1], uv2[0], uv2[1], ph2])
-    return x_ref, float(ph1), int(h), (gap, ang)
+    return x_ref, float(ph1), int(h), (gap, ang), q1, n1
 
 
 def _rotz_np(a, v):
@@ -283,20 +279,18 @@ def _rotz_np(a, v):
     return np.stack([c * v[0] - s * v[1], s * v[0] + c * v[1], np.broadcast_to(v[2], np.shape(a))])
 
 
-def _mean_uv(fl: FlankSpec):
-    """``(theta, s)`` of the flank point at mid face, half-way from the fillet start to the tip."""
+def _mean_point(fl: FlankSpec, crossing):
+    """Mean point of a flank (concrete): ``uv = (theta, s)`` at mid face, half-way along
+    the blade to the tip, its body-frame point (origin at the crossing point) and the
+    outward normal (out of the tooth material; one envelope solve for both)."""
     tip = solve_tip(fl, 0.0, mid_estimate(fl))
-    s_tip, th = float(tip.x[0]), float(tip.x[1])
-    return jnp.array([th, 0.5 * s_tip])
-
-
-def _normal(fl: FlankSpec, uv):
+    uv = jnp.array([float(tip.x[1]), 0.5 * float(tip.x[0])])
+    psi = 0.0
     if fl.machine.generated:
-        from gearjax.surfaces import solve_envelope
-        fam = lambda q, psi: work_point(fl, q[1], q[0], psi)[0]
-        psi = solve_envelope(fam, uv, 0.0).x
-        return work_point(fl, uv[1], uv[0], psi)[1]
-    return work_point(fl, uv[1], uv[0], 0.0)[1]
+        psi = solve_envelope(lambda q, p: work_point(fl, q[1], q[0], p)[0], uv, 0.0).x
+    r, n = work_point(fl, uv[1], uv[0], psi)
+    q = np.asarray(r) - np.array([0.0, 0.0, float(crossing)])
+    return np.asarray(uv), q, np.asarray(n)
 
 
 def flank_coordinates(fl: FlankSpec, crossing, p_body):
@@ -394,10 +388,10 @@ def prepare(pair: HypoidPair, n_search: int = 181) -> Prepared:
     ``drive`` is True when the pinion flank pushes the gear for increasing ``phi1``:
     ``(e_z x p1) . n1 > 0`` at the reference point, ``n1`` the pinion normal out of
     its material.  Raises :class:`~gearjax.tca.NoContactError` when no hand and no
-    body rotations bring the mean points of the flanks within 2 mm with opposite
-    normals (the flanks cannot mesh).
+    body rotations bring the mean points of the flanks within ``MAX_GAP`` with
+    normals within ``MAX_ANGLE`` of opposite (the flanks cannot mesh).
     """
-    x_ref, phi1_ref, hand, (gap, ang) = reference_guess(pair, n_search)
+    x_ref, phi1_ref, hand, (gap, ang), p, n = _search(pair, n_search)
     if not (gap < MAX_GAP and ang < MAX_ANGLE):
         raise NoContactError(
             f"the pinion and gear flanks cannot be brought into contact near their mean "
@@ -405,10 +399,6 @@ def prepare(pair: HypoidPair, n_search: int = 181) -> Prepared:
             f"{ang:.3g} deg from opposite; limits {MAX_GAP:g} mm, {MAX_ANGLE:g} deg): check "
             "the flank sides, hands of spiral and mounting data")
     pair = replace(pair, hand=hand)
-    uv1 = jnp.asarray(x_ref[:2])
-    r1 = flank_function(pair.pinion, pair.pinion_crossing)
-    p = np.asarray(r1(uv1))
-    n = np.asarray(_normal(pair.pinion, uv1))
     c, s_ = math.cos(phi1_ref), math.sin(phi1_ref)
     p = np.array([c * p[0] - s_ * p[1], s_ * p[0] + c * p[1], p[2]])
     n = np.array([c * n[0] - s_ * n[1], s_ * n[0] + c * n[1], n[2]])
