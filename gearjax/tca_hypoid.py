@@ -78,7 +78,7 @@ from gearjax.cutters import FaceMillCutter
 from gearjax.gears.hypoid import (FlankSpec, face_apex_offset, face_cone_gap, mid_estimate,
                                   pitch_distance, root_apex_offset, root_cone_gap, solve_tip,
                                   work_point)
-from gearjax.machines import MachineSettings
+from gearjax.machines import MachineSettings, cutter_to_cradle
 from gearjax.surfaces import GeneratedSurface, solve_envelope
 from gearjax.newton import newton_solve
 from gearjax.tca import (DEFAULT_APPROACH, Assembly, ContactPath, Misalignment, MultiPair,
@@ -193,20 +193,25 @@ def with_point_radius(fl: FlankSpec, d_radius, theta_m) -> FlankSpec:
     """The flank cut with blade point radius ``R_p + d_radius`` and the cutter centre
     moved so that the blade still passes through the point of phase ``theta_m``.
 
-    For an untilted cutter the centre moves by ``-d_radius`` along the radial line of
-    ``theta_m`` (in the cradle plane, direction ``q - j + theta_m``); the two blade
-    cones then touch along the blade line at ``theta_m`` and the generated flanks
-    coincide along the curve that line generates (a lengthwise mismatch, the usual
-    way to localise the bearing).  The swivel is changed with the cradle angle so
-    that ``q - j`` (the cutter's orientation, hence ``theta``) is unchanged.
+    The centre moves by ``-d_radius`` along the cutter's radial line of ``theta_m``
+    (in the plane of the blade tips; the two blade cones then touch along the blade
+    line at ``theta_m`` and the generated flanks coincide along the curve that line
+    generates: a lengthwise mismatch, the usual way to localise the bearing).  In
+    the cradle the radial line is ``u = R(M_ct) (cos theta_m, sin theta_m, 0)``: its
+    cradle-plane part changes the radial distance and cradle angle (the swivel is
+    changed with the cradle angle so that ``q - j``, the cutter's orientation, hence
+    ``theta``, is unchanged); for a tilted cutter its component along the cradle axis
+    is a move of the cutter along ``z_c``, i.e. of the work by the opposite amount
+    (sliding base).  Untilted: ``u = (cos(q - j + theta_m), sin(q - j + theta_m), 0)``.
     """
     ms = fl.machine
     q, j = ms.cradle_angle, ms.swivel
-    C = jnp.stack([ms.radial_distance * jnp.cos(q), ms.radial_distance * jnp.sin(q)])
-    a = q - j + theta_m
-    C2 = C - d_radius * jnp.stack([jnp.cos(a), jnp.sin(a)])
+    M = cutter_to_cradle(ms)
+    u = M[:3, :3] @ jnp.stack([jnp.cos(theta_m), jnp.sin(theta_m), 0.0 * theta_m])
+    C2 = M[:3, 3] - d_radius * u
     q2 = jnp.arctan2(C2[1], C2[0])
-    ms2 = replace(ms, radial_distance=jnp.linalg.norm(C2), cradle_angle=q2, swivel=q2 - q + j)
+    ms2 = replace(ms, radial_distance=jnp.linalg.norm(C2[:2]), cradle_angle=q2,
+                  swivel=q2 - q + j, sliding_base=ms.sliding_base - C2[2])
     return replace(fl, machine=ms2, cutter=replace(fl.cutter,
                                                    point_radius=fl.cutter.point_radius + d_radius))
 

@@ -9,6 +9,15 @@ import pytest
 from gearjax.cli import main
 from gearjax.tribology import friction_coefficient, get_oil, make_surface
 
+README = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "README.md")
+
+
+def _readme_documents(keys):
+    text = open(README, encoding="utf-8").read()
+    missing = [k for k in keys if f"`{k}`" not in text]
+    assert not missing, f"JSON keys not documented in README.md: {missing}"
+
+
 BASE = ["--load-N", "1000", "--rx-mm", "10", "--ry-mm", "100", "--oil", "mineral_vg100",
         "--sigma-um", "0.6"]
 
@@ -25,6 +34,7 @@ def test_friction_json_keys_and_unit_conversion(capsys):
     assert out["h_c_um"] == pytest.approx(float(r.h_c) * 1e3, rel=1e-12)
     assert out["lambda"] == pytest.approx(float(r.h_c) / 6e-4, rel=1e-12)
     assert out["sliding_power_W"] == pytest.approx(float(r.mu) * 1000.0 * 0.6, rel=1e-12)
+    _readme_documents(out)  # every key the command prints is documented in the README
 
 
 def test_friction_table_and_custom_oil(capsys):
@@ -66,6 +76,7 @@ def test_stribeck_json_and_atomic_plot(capsys, tmp_path):
     x = np.asarray(out["stribeck_number_per_m"])
     assert x[0] == pytest.approx(0.088 * 0.05 / 1000.0, rel=1e-12)
     assert out["regime"][-1] == "full film"
+    _readme_documents(out)
 
 
 def test_stribeck_bad_input(capsys, tmp_path):

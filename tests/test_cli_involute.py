@@ -34,6 +34,11 @@ def test_table_and_json(capsys):
     np.testing.assert_allclose(data["srr"], cf["srr"], rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(data["r_eff_mm"], cf["r_eff"], rtol=1e-9)
     assert min(data["u_e"]) > 0
+    # every key the command prints is documented in the README
+    import os
+    readme = open(os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                               "README.md"), encoding="utf-8").read()
+    assert [k for k in data if f"`{k}`" not in readme] == []
 
 
 @pytest.mark.parametrize("change, word", [

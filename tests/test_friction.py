@@ -53,7 +53,7 @@ def test_full_film_mu_rises_with_viscosity():
 
 
 def test_mixed_regime_mu_falls_with_speed():
-    # gear-like: 1.2 GPa, SRR 0.2, composite roughness 0.8 µm, f_c = 0.1
+    # gear-like: p_max 1.54 GPa (F 1000 N, Rx 10 mm, Ry 100 mm), SRR 0.2, σ 0.8 µm, f_c = 0.1
     ue = np.logspace(np.log10(300.0), np.log10(20000.0), 15)
     r = mu_at(ue, 0.2 * ue, sigma_um=0.8)
     mixed = np.asarray(r.regime) == 1
@@ -169,6 +169,11 @@ def test_mesh_bad_input():
 def test_validity_warnings_name_formula_and_range():
     with pytest.warns(UserWarning, match=r"Hamrock-Dowson.*1 <= k <= 8"):
         friction_coefficient(F, 3000.0, 300.0, 5.0, 5000.0, OIL, make_surface(0.4), film_method="point")
+    # default "auto" film: Hamrock-Dowson alone below k = 1 (Rx > Ry) is outside its fit
+    with pytest.warns(UserWarning, match=r"Hamrock-Dowson.*1 <= k <= 8"):
+        friction_coefficient(F, 3000.0, 300.0, 30.0, 12.0, OIL, make_surface(0.4))
+    with pytest.warns(UserWarning, match=r"Pan-Hamrock line-contact.*not elongated"):
+        friction_coefficient(F, 3000.0, 300.0, RX, 2.0 * RX, OIL, make_surface(0.4), film_method="line")
     with pytest.warns(UserWarning, match=r"Roelands viscosity.*3 GPa"):
         friction_coefficient(40000.0, 3000.0, 300.0, 5.0, 10.0, OIL, make_surface(0.4))
     with pytest.warns(UserWarning, match=r"Greenwood-Tripp.*0.005..0.2"):

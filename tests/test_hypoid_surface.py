@@ -71,6 +71,42 @@ def test_hand_of_spiral_matches_table1(design, grids, mf):
     assert abs(t @ e_phi) > 1.0
 
 
+def test_axial_plot_labels(design, grids):
+    """Issue 3 item 9: the axial-plane figure labels toe/heel and root/tip at the right
+    places -- toe at xi = -1, heel at xi = +1 (from the label positions, through the
+    pitch-generatrix distance), tip on the face cone, root below it by the flank height."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from gearjax.gears.hypoid import face_apex_offset
+    from gearjax.plot_flank import plot_flank_axial
+
+    fl, g = design.flank("pinion", "convex"), grids[("pinion", "convex")]
+    ax = plot_flank_axial(g, fl.blank, label="pinion convex")
+    try:
+        labels = {t.get_text(): np.asarray(t.xy, dtype=float) for t in ax.texts}
+        assert set(labels) == {"toe", "heel", "root", "tip"}
+        legend = {t.get_text() for t in ax.get_legend().get_texts()}
+        assert {"pinion convex", "face cone", "root cone"} <= legend
+        b = fl.blank
+        gp, gF = float(b.pitch_angle), float(b.face_angle)
+        Ao, F, xpf = float(b.outer_cone_distance), float(b.face_width), float(face_apex_offset(b))
+
+        def xi(p):
+            return 1.0 - 2.0 * (Ao - (math.cos(gp) * p[0] + math.sin(gp) * p[1])) / F
+
+        def face_gap(p):
+            return math.sin(gF) * (p[0] + xpf) - math.cos(gF) * p[1]
+
+        assert abs(xi(labels["toe"]) + 1.0) < 1e-9 and abs(xi(labels["heel"]) - 1.0) < 1e-9
+        assert abs(face_gap(labels["tip"])) < 1e-9
+        assert face_gap(labels["root"]) > 1.0            # mm below the face cone
+        assert abs(xi(labels["root"])) < 1e-9 and abs(xi(labels["tip"])) < 1e-9   # mid face
+    finally:
+        plt.close(ax.figure)
+
+
 @pytest.mark.parametrize("mf", [("pinion", "convex"), ("pinion", "concave")])
 def test_meshing_equation_independent(design, grids, mf):
     """n . v = 0 with v from seed 004's (w_c - w_w) x r + w_w x R in the machine frame."""

@@ -135,9 +135,14 @@ def test_gradients_match_central_differences():
         h = 1e-5 * max(1.0, abs(float(x[i])))
         e = jnp.zeros(5).at[i].set(h)
         cols.append((f(x + e) - f(x - e)) / (2 * h))
-    fd = jnp.stack(cols, 1)
-    scale = jnp.max(jnp.abs(J), axis=1, keepdims=True)
-    np.testing.assert_allclose(J, fd, rtol=1e-6, atol=1e-6 * float(jnp.max(scale)))
+    fd = np.asarray(jnp.stack(cols, 1))
+    J = np.asarray(J)
+    # 1e-6 relative on every entry; the absolute floor (1e-9 of the row's largest
+    # derivative) only matters for dSRR/dm_n, which is exactly 0 (SRR does not depend
+    # on the size of the pair).  Measured: <= 1.6e-9 relative on the other entries.
+    scale = np.max(np.abs(J), axis=1, keepdims=True)
+    assert np.all(np.abs(J - fd) <= 1e-6 * np.abs(fd) + 1e-9 * scale), np.abs(J - fd) / np.abs(fd)
+    assert abs(J[0, 0]) <= 1e-12 * scale[0, 0]
     # reverse mode through the nested implicit solves
     g = jax.jit(jax.grad(lambda v: outputs(v)[0]))(x)
     np.testing.assert_allclose(g, J[0], rtol=1e-10, atol=1e-12)

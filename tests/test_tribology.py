@@ -97,6 +97,12 @@ def test_hamrock_dowson_worked_example():
     assert float(hm) * 1e-3 == pytest.approx(hm_si, rel=1e-12)
     assert 0.5e-6 < hc_si < 2e-6  # about a micrometre, as expected for such a contact
     assert float(hm) < float(hc)
+    # worked by hand (factors to 5 digits): U^0.67 = 3.1144e-7, G^0.53 = 91.105,
+    # W^-0.067 = 1.9578, 1 - 0.61 e^-2.92 = 0.96710 -> H_c = 1.4452e-4, h_c = 1.4452 µm;
+    # U^0.68 = 2.4904e-7, G^0.49 = 64.812, W^-0.073 = 2.0792, 1 - e^-2.72 = 0.93413
+    # -> H_min = 1.1380e-4, h_min = 1.1380 µm
+    assert float(hc) * 1e3 == pytest.approx(1.4452, rel=1e-4)
+    assert float(hm) * 1e3 == pytest.approx(1.1380, rel=1e-4)
 
 
 def test_pan_hamrock_line_worked_example():
@@ -109,6 +115,11 @@ def test_pan_hamrock_line_worked_example():
     hc, hm = pan_hamrock_line(300.0, 10.0, 5000.0, 0.088, 0.022, E_PRIME)
     assert float(hc) * 1e-3 == pytest.approx(hc_si, rel=1e-12)
     assert float(hm) * 1e-3 == pytest.approx(hm_si, rel=1e-12)
+    # worked by hand: W' = 1.3252e-4; W'^-0.166 = 4.4025, U^0.692 = 1.9043e-7,
+    # G^0.470 = 54.665 -> h_c = 10 mm x 2.922 x ... = 1.3391 µm;
+    # W'^-0.128 = 3.1358, U^0.694 = 1.8210e-7, G^0.568 = 125.90 -> h_min = 1.2323 µm
+    assert float(hc) * 1e3 == pytest.approx(1.3391, rel=1e-4)
+    assert float(hm) * 1e3 == pytest.approx(1.2323, rel=1e-4)
 
 
 def test_groups_use_rx_not_geometric_mean():

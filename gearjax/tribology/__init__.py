@@ -7,7 +7,10 @@ Modules (imports flow downwards):
     asperity.py   Greenwood–Tripp F_2, F_5/2 by quadrature; film/asperity load sharing
     friction.py   μ = (f_c F_a + ∫τ dA)/F_n at contact points
     losses.py     sliding power loss, mesh efficiency, Stribeck curves
-    empirical.py  empirical gear friction formulas (for comparison only)
+
+The empirical gear friction formulas used only for comparison (Xu–Kahraman,
+ISO/TR 14179-2, Benedict–Kelley) live outside the package, in
+``experiments/friction_reference.py``; gearjax is not tuned to them.
 
 Hertz contact lives in :mod:`gearjax.contact`.  Units: mm, N, s, MPa; viscosity
 Pa·s; speeds mm/s.

@@ -241,11 +241,28 @@ def validate_contact_inputs(F, u_e, u_s, Rx, Ry, E_prime, allow_signed_us=False)
 
 
 def _warn_validity(out: FrictionResult, film_method: str, viscosity_model: str):
+    """Warn (naming formula and range) where a correlation is used outside its fit.
+
+    Film: Hamrock–Dowson is fitted for 1 <= k <= 8 ("point"; with "auto" it is used
+    alone for k <= 8, so k < 1 — the ellipse elongated along the rolling direction,
+    Rx > Ry — lies outside its fit); Pan–Hamrock is a line-contact formula, which
+    "line" applies also to contacts that are not elongated (k < 8).  Viscosity laws:
+    0–3 GPa.
+    """
     k = np.asarray(out.k)
     if film_method == "point" and (np.any(k > 8.0) or np.any(k < 1.0)):
         warnings.warn("Hamrock-Dowson film formula used outside its fitted ellipticity range "
                       f"1 <= k <= 8 (k from {k.min():.3g} to {k.max():.3g}); "
                       "consider film_method='auto'", stacklevel=3)
+    if film_method == "auto" and np.any(k < 1.0):
+        warnings.warn("Hamrock-Dowson film formula used outside its fitted ellipticity range "
+                      f"1 <= k <= 8 (k down to {k.min():.3g}: Rx > Ry, the contact is elongated "
+                      "along the rolling direction)", stacklevel=3)
+    if film_method == "line" and np.any(k < 8.0):
+        warnings.warn("Pan-Hamrock line-contact film formula applied to a contact that is not "
+                      f"elongated (k down to {k.min():.3g}; line contact needs k >> 8, the "
+                      "Hamrock-Dowson range is 1 <= k <= 8); consider film_method='auto'",
+                      stacklevel=3)
     pm = np.asarray(out.p_max)
     if np.any(pm > 3000.0):
         warnings.warn(f"{viscosity_model.capitalize()} viscosity law extrapolated above 3 GPa "

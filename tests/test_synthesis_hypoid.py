@@ -1,0 +1,43 @@
+"""Local synthesis on an offset hypoid pair (formate gear; gearjax.synthesis with the
+start of gearjax.formate_pair) and the shipped example it produced."""
+
+import math
+from dataclasses import replace
+
+import jax
+import numpy as np
+import pytest
+
+from gearjax import synthesis as sy
+from gearjax import tca_hypoid as th
+from gearjax.io import load_design
+from gearjax.tca import ARCSEC
+
+
+def test_generated_hypoid_gear_is_refused_as_start():
+    pair = th.pair_flanks(load_design("example:hypoid_iso_10x41"), "drive")
+    gear = replace(pair.gear, machine=replace(pair.gear.machine, generated=True))
+    with pytest.raises(ValueError, match="offset"):
+        sy.conjugate_start(replace(pair, gear=gear))
+
+
+def test_shipped_hypoid_example_has_the_synthesised_bearing():
+    d = load_design("example:hypoid_iso_10x41_synthesised")
+    base = load_design("example:hypoid_iso_10x41")
+    for flank in ("convex", "concave"):          # the gear is the original formate gear
+        a, b = d.flank("gear", flank), base.flank("gear", flank)
+        for x, y in zip(jax.tree_util.tree_leaves(a), jax.tree_util.tree_leaves(b)):
+            assert float(x) == pytest.approx(float(y), abs=1e-12)
+        assert a.machine.generated is False and b.machine.generated is False
+    for side, angle in (("drive", -45.0), ("coast", 45.0)):
+        st = sy.start(d, side, complementary=False)
+        assert st.pair.offset == pytest.approx(25.0)
+        tgt = sy.Targets(path_angle_deg=angle).resolved(st.pair)
+        _, _, aux = sy.residuals_and_jacobian(st, np.zeros(len(sy.VARIABLES)), tgt)
+        assert bool(aux["ok"]), side
+        assert abs(float(aux["xi1"]) - tgt[0]) < 1e-4
+        assert abs(float(aux["h1"]) - tgt[1]) < 1e-3
+        assert abs(float(aux["te_level_arcsec"]) - tgt[2] / ARCSEC) < 0.01
+        assert abs(float(aux["te_apex_arcsec"])) < 0.01
+        assert abs(float(aux["path_angle_deg"]) - math.degrees(tgt[3])) < 0.01
+        assert abs(float(aux["semi_major_mm"]) - tgt[4]) < 1e-3
