@@ -71,3 +71,6 @@ def test_bad_input_one_line(capsys):
     assert "positions" in capsys.readouterr().err
     assert main(["tca", DESIGN, "--misalign", "dX=1"]) == 2
     assert "dX" in capsys.readouterr().err
+    assert main(["tca", DESIGN, "--pitches", "5"]) == 2
+    err = capsys.readouterr().err
+    assert "pitches" in err and "4" in err and len(err.strip().splitlines()) == 1

@@ -52,7 +52,11 @@ def register(sub):
                    help="dE=mm,dP=mm,dG=mm,dSigma=deg (any subset; default all 0)")
     p.add_argument("--positions", type=float, default=61,
                    help="grid positions, 10k+1 (k >= 1): 4k steps per pitch, "
-                        "1.25 pitches each side")
+                        "1.25 pitches each side (with --pitches P: P pitches each side, "
+                        "8kP+1 positions)")
+    p.add_argument("--pitches", type=float, default=1.25,
+                   help="half-range of the grid in angular pitches (0.75 ... 4, default 1.25); "
+                        "widen it when the contact of one tooth pair spans more than the grid")
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.add_argument("--plot", default=None, help="write the TE and contact-pattern figure (PNG)")
     p.set_defaults(func=run)
@@ -95,18 +99,18 @@ def _nan_list(a):
     return [None if not np.isfinite(x) else float(x) for x in a.ravel()]
 
 
-def _involute_side(args, mis, m, side_name):
+def _involute_side(args, mis, m, side_name, half):
     from ..tca_involute import involute_limits, involute_tca
     _, des = _design(args.design)
     side = -1 if side_name == "drive" else 1
-    path, margin, multi = involute_tca(des, mis, side=side, steps_per_pitch=m, half_pitches=1.25)
+    path, margin, multi = involute_tca(des, mis, side=side, steps_per_pitch=m, half_pitches=half)
     return path, margin, multi, involute_limits(des, side), {}
 
 
-def _hypoid_side(design, mis, m, side_name):
+def _hypoid_side(design, mis, m, side_name, half):
     from .. import tca_hypoid as th
     prep = th.prepare(th.pair_flanks(design, side_name))
-    res = th.hypoid_tca(prep, mis, steps_per_pitch=m, half_pitches=1.25, n_pairs=3)
+    res = th.hypoid_tca(prep, mis, steps_per_pitch=m, half_pitches=half, n_pairs=3)
     prep_pair = prep.pair
     extra = {"xi1": res.coords["xi1"], "h1_mm": res.coords["h1"], "xi2": res.coords["xi2"],
              "h2_mm": res.coords["h2"]}
@@ -148,14 +152,16 @@ def run(args) -> int:
     if (n - 1) % 10:
         raise ValueError(f"positions = {n} must be of the form 10k+1 (11, 21, ..., 61, ...)")
     m = 4 * ((n - 1) // 10)
+    from ..errors import check_range
+    half = check_range("pitches", args.pitches, 0.75, 4.0)
     sides = ["drive", "coast"] if args.side == "both" else [args.side]
     if args.design.startswith("involute:"):
         _design(args.design)                       # validate before any tracing
-        solve = lambda side: _involute_side(args, mis, m, side)
+        solve = lambda side: _involute_side(args, mis, m, side, half)
     else:
         from ..io import load_design
         design = load_design(args.design)
-        solve = lambda side: _hypoid_side(design, mis, m, side)
+        solve = lambda side: _hypoid_side(design, mis, m, side, half)
     results = {}
     for side in sides:
         try:
@@ -171,7 +177,8 @@ def run(args) -> int:
         save_tca_plot(args.plot, [(sd, r[0], r[1], r[2]) for sd, r in results.items()],
                       [r[3] for r in results.values()], title=f"TCA {args.design}")
     outs = {sd: _side_json(r[0], r[1], r[2], r[4]) for sd, r in results.items()}
-    inp = {"design": args.design, "side": args.side, "misalign": mis_kv, "positions": n}
+    inp = {"design": args.design, "side": args.side, "misalign": mis_kv, "positions": n,
+           "pitches": half}
     if args.json:
         if len(sides) == 1:
             print(json.dumps({"input": inp, **outs[sides[0]]}, indent=1))
