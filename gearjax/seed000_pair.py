@@ -29,7 +29,6 @@ Units: mm, rad.  Reference: seed 000 (000_be2d122acb15edb3.txt) §2.
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 from typing import NamedTuple
 
 import jax.numpy as jnp
