@@ -29,7 +29,9 @@ def test_shipped_hypoid_example_has_the_synthesised_bearing():
         for x, y in zip(jax.tree_util.tree_leaves(a), jax.tree_util.tree_leaves(b)):
             assert float(x) == pytest.approx(float(y), abs=1e-12)
         assert a.machine.generated is False and b.machine.generated is False
-    for side, angle in (("drive", -45.0), ("coast", 45.0)):
+    # drive side only: the coast flank (other blade sign, a static field) would compile the
+    # (residual, Jacobian) function again; experiments/synthesis_hypoid.py re-checks both
+    for side, angle in (("drive", -45.0),):
         st = sy.start(d, side, complementary=False)
         assert st.pair.offset == pytest.approx(25.0)
         tgt = sy.Targets(path_angle_deg=angle).resolved(st.pair)
