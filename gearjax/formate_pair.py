@@ -146,14 +146,15 @@ def _gear_mean(pair):
     return q, n
 
 
-def mean_contact_angle(pair, hand: int, n_grid: int = 720):
+def mean_contact_angle(pair, hand: int, n_grid: int = 720, gear_mean=None):
     """Gear angles ``phi2`` (rad) at which the gear's mean flank point is in contact with
     the conjugate pinion, ``n . v21 = 0`` (``v21`` the velocity of the gear point relative
     to the pinion, pinion speed 1), each with the mean point's face-width position,
-    height above the pinion root cone and depth below its face cone on the pinion
-    blank; sorted by how well the point sits on the pinion blank."""
+    height above the pinion root cone, depth below its face cone on the pinion blank
+    and ``badness`` (``|xi|`` plus the distances outside root and face cone); sorted by
+    badness.  ``gear_mean``: the gear's mean point and normal, if already computed."""
     A = mesh_transform(pair, hand)
-    p_g, n_g = _gear_mean(pair)
+    p_g, n_g = _gear_mean(pair) if gear_mean is None else gear_mean
     ratio = pair.z1 / pair.z2
     ez = np.array([0.0, 0.0, 1.0])
 
@@ -188,7 +189,7 @@ def mean_contact_angle(pair, hand: int, n_grid: int = 720):
         badness = abs(xi) + max(0.0, -h) + max(0.0, -tip)
         out.append((badness, phi2, xi, h, tip))
     out.sort()
-    return [dict(phi2=o[1], xi=o[2], h=o[3], tip_gap=o[4]) for o in out]
+    return [dict(phi2=o[1], xi=o[2], h=o[3], tip_gap=o[4], badness=o[0]) for o in out]
 
 
 def generating_gear_pinion(pair, *, hand: int | None = None, depth: float | None = None):
@@ -208,22 +209,12 @@ def generating_gear_pinion(pair, *, hand: int | None = None, depth: float | None
     g = pair.gear
     if g.machine.generated:
         raise ValueError("generating_gear_pinion needs a formate (non-generated) gear flank")
-    if hand is None:
-        cands = []
-        for h in (1, -1):
-            sols = mean_contact_angle(pair, h)
-            if sols:
-                s = sols[0]
-                cands.append((abs(s["xi"]) + max(0.0, -s["h"]) + max(0.0, -s["tip_gap"]), h, s))
-        if not cands:
-            raise ConvergenceError("the gear's mean point is in contact at no gear angle")
-        cands.sort(key=lambda c: c[0])
-        _, hand, sol = cands[0]
-    else:
-        sols = mean_contact_angle(pair, hand)
-        if not sols:
-            raise ConvergenceError("the gear's mean point is in contact at no gear angle")
-        sol = sols[0]
+    gm = _gear_mean(pair)
+    cands = [(sols[0]["badness"], h, sols[0]) for h in ((1, -1) if hand is None else (hand,))
+             for sols in [mean_contact_angle(pair, h, gear_mean=gm)] if sols]
+    if not cands:
+        raise ConvergenceError("the gear's mean point is in contact at no gear angle")
+    _, hand, sol = min(cands, key=lambda c: c[0])
     D = float(mean_dedendum(pair.pinion.blank) + mean_dedendum(g.blank)) if depth is None else float(depth)
     G = _np(cutter_to_work(g.machine, 0.0))
     Cp = G @ _T(0.0, 0.0, -D) @ _RXPI                    # pinion blade -> gear work

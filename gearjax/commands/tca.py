@@ -142,7 +142,7 @@ def _side_json(path, margin, multi, extra):
 
 
 def run(args) -> int:
-    from ..errors import ConvergenceError, check_int
+    from ..errors import ConvergenceError, check_int, check_range
     from ..tca import Misalignment, NoContactError
 
     mis_kv = _parse_kv(args.misalign, {"dE", "dP", "dG", "dSigma"}, "misalign")
@@ -152,7 +152,6 @@ def run(args) -> int:
     if (n - 1) % 10:
         raise ValueError(f"positions = {n} must be of the form 10k+1 (11, 21, ..., 61, ...)")
     m = 4 * ((n - 1) // 10)
-    from ..errors import check_range
     half = check_range("pitches", args.pitches, 0.75, 4.0)
     sides = ["drive", "coast"] if args.side == "both" else [args.side]
     if args.design.startswith("involute:"):
