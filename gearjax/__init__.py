@@ -27,7 +27,8 @@ the core, never the other way round)::
     gearjax/plot_flank.py  axial-plane flank figure
     gearjax/examples/      packaged design files (8/43 HFT of seed 004, ...)
     gearjax/contact.py     Hertz point contact (exact, elliptic integrals by AGM;
-                           Hamrock-Brewe option; line-contact limit)
+                           Brewe-Hamrock 1977 and Hamrock-Brewe 1983 fits as options;
+                           line-contact limit)
     gearjax/tribology/     lubricant (Roelands/Barus, Dowson-Higginson, Ree-Eyring),
                            film (Hamrock-Dowson, line contact), asperity
                            (Greenwood-Tripp, load sharing), friction (seed 001 mu),

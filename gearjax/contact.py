@@ -53,11 +53,25 @@ Line contact is the limit Ry/Rx → ∞ at fixed load per unit length ``w'``:
 load intensity ``w'_c = π p_max b / 2 = 3F/(4a)`` satisfies ``b → 4 p_max Rx / E'``
 (tested).
 
-Hamrock–Brewe approximations (Hamrock & Brewe, J. Lubr. Technol. 105 (1983)
-171–177): ``k ≈ 1.0339 (Ry/Rx)^0.6360``, ``E ≈ 1.0003 + 0.5968 Rx/Ry``,
-``K ≈ 1.5277 + 0.6023 ln(Ry/Rx)``; fitted for 1 ≤ Ry/Rx ≤ 100 (a warning is
-issued outside that range).  Only ``Ry ≥ Rx`` is covered by the fit; for ``Ry < Rx``
-gearjax applies it to the swapped radii and swaps the semi-axes back.
+Curve-fit approximations (for hand checks and comparison with older design codes;
+``method`` of :func:`hertz_point`), with ``α_r = Ry/Rx ≥ 1``:
+
+* ``"brewe_hamrock_1977"`` (alias ``"hamrock_brewe"``) — least-squares fits of
+  Brewe & Hamrock, J. Lubr. Technol. 99 (1977) 485–487:
+  ``k ≈ 1.0339 α_r^0.6360``, ``ℰ ≈ 1.0003 + 0.5968/α_r``,
+  ``ℱ ≈ 1.5277 + 0.6023 ln α_r``;
+* ``"hamrock_brewe_1983"`` — the simplified forms of Hamrock & Brewe,
+  J. Lubr. Technol. 105 (1983) 171–177: ``k ≈ α_r^(2/π)``,
+  ``ℰ ≈ 1 + q/α_r``, ``ℱ ≈ π/2 + q ln α_r`` with ``q = π/2 - 1``; exact at the circle.
+
+(ℱ, ℰ: complete elliptic integrals of the first and second kind, ``K`` and ``E``
+here.)  Then ``a = (6 k² ℰ F R/(π E'))^(1/3)``, ``b = (6 ℰ F R/(π k E'))^(1/3)``,
+``δ = ℱ [9/(2 ℰ R) (F/(π k E'))²]^(1/3)``.  Both are applied to the larger/smaller
+radius ratio and the semi-axes are swapped back when ``Ry < Rx`` (the exact solution
+is symmetric under that swap; the 1983 paper's extension to ellipticities below 1 is
+this case).  gearjax warns outside ``1 ≤ max/min radius ≤ 100``.  Errors against the
+exact solution, measured by gearjax (the papers' own error tables were not available
+to us): ``docs/friction.md`` and ``tests/test_contact.py``.
 """
 
 from __future__ import annotations
@@ -215,16 +229,26 @@ def _hertz_exact(F, Rx, Ry, E_prime):
     return HertzResult(a, b, jnp.exp(t), p_max, p_max / 1.5, approach, K, E, conv)
 
 
-def _hertz_hamrock_brewe(F, Rx, Ry, E_prime):
+_FIT_METHODS = ("brewe_hamrock_1977", "hamrock_brewe", "hamrock_brewe_1983")
+_METHODS = ("exact",) + _FIT_METHODS
+
+
+def _fit_integrals(alpha_r, method):
+    """Curve-fit (k, ℰ, ℱ) for the radius ratio ``alpha_r = R_big/R_small ≥ 1``."""
+    if method == "hamrock_brewe_1983":
+        q = 0.5 * jnp.pi - 1.0
+        return alpha_r ** (2.0 / jnp.pi), 1.0 + q / alpha_r, 0.5 * jnp.pi + q * jnp.log(alpha_r)
+    return (1.0339 * alpha_r ** 0.6360, 1.0003 + 0.5968 / alpha_r,
+            1.5277 + 0.6023 * jnp.log(alpha_r))
+
+
+def _hertz_fit(F, Rx, Ry, E_prime, method):
     swap = Ry < Rx
     R_small = jnp.minimum(Rx, Ry)
     R_big = jnp.maximum(Rx, Ry)
-    alpha_r = R_big / R_small
-    k = 1.0339 * alpha_r ** 0.6360
-    E = 1.0003 + 0.5968 / alpha_r
-    K = 1.5277 + 0.6023 * jnp.log(alpha_r)
+    k, E, K = _fit_integrals(R_big / R_small, method)
     R = Rx * Ry / (Rx + Ry)
-    # Hamrock & Brewe: D_y = 2 (6 k² E F R/(π E'))^(1/3), D_x = 2 (6 E F R/(π k E'))^(1/3)
+    # D_y = 2 (6 k² ℰ F R/(π E'))^(1/3), D_x = 2 (6 ℰ F R/(π k E'))^(1/3)
     a_big = (6.0 * k * k * E * F * R / (jnp.pi * E_prime)) ** (1.0 / 3.0)  # along R_big
     b_small = (6.0 * E * F * R / (jnp.pi * k * E_prime)) ** (1.0 / 3.0)
     a = jnp.where(swap, b_small, a_big)
@@ -235,11 +259,16 @@ def _hertz_hamrock_brewe(F, Rx, Ry, E_prime):
                        jnp.ones_like(p_max, dtype=bool))
 
 
+def _method_error(method):
+    return ValueError(f"method = {method!r} must be one of {', '.join(map(repr, _METHODS))}")
+
+
 def hertz_point_traced(F, Rx, Ry, E_prime, method: str = "exact") -> HertzResult:
     """Traceable core of :func:`hertz_point` (no validation; jit/grad/vmap-friendly).
 
-    Broadcasts its array arguments.  ``method`` is ``"exact"`` or
-    ``"hamrock_brewe"`` (static).
+    Broadcasts its array arguments.  ``method`` is ``"exact"`` or one of the curve
+    fits ``"brewe_hamrock_1977"`` (= ``"hamrock_brewe"``), ``"hamrock_brewe_1983"``
+    (static).
     """
     F, Rx, Ry, E_prime = jnp.broadcast_arrays(*(jnp.asarray(v, float) for v in (F, Rx, Ry, E_prime)))
     if method == "exact":
@@ -248,9 +277,9 @@ def hertz_point_traced(F, Rx, Ry, E_prime, method: str = "exact") -> HertzResult
         shape = F.shape
         out = jax.vmap(_hertz_exact)(F.ravel(), Rx.ravel(), Ry.ravel(), E_prime.ravel())
         return HertzResult(*(jnp.reshape(v, shape) for v in out))
-    if method == "hamrock_brewe":
-        return _hertz_hamrock_brewe(F, Rx, Ry, E_prime)
-    raise ValueError(f"method = {method!r} must be 'exact' or 'hamrock_brewe'")
+    if method in _FIT_METHODS:
+        return _hertz_fit(F, Rx, Ry, E_prime, method)
+    raise _method_error(method)
 
 
 _hertz_point_jit = jax.jit(hertz_point_traced, static_argnames=("method",))
@@ -276,8 +305,9 @@ def hertz_point(F, Rx, Ry, E_prime, method: str = "exact", strict: bool = True) 
         directions, mm (> 0, finite; for an infinitely long line contact use
         :func:`hertz_line`).
     E_prime : reduced modulus E' = 2E*, MPa (> 0).
-    method : ``"exact"`` (AGM elliptic integrals + Newton for the ellipticity) or
-        ``"hamrock_brewe"`` (curve fits, warned outside 1 ≤ max/min radius ≤ 100).
+    method : ``"exact"`` (AGM elliptic integrals + Newton for the ellipticity) or a
+        curve fit: ``"brewe_hamrock_1977"`` (alias ``"hamrock_brewe"``) or
+        ``"hamrock_brewe_1983"`` (warned outside 1 ≤ max/min radius ≤ 100).
     strict : raise :class:`gearjax.errors.ConvergenceError` if a solve failed
         (default); with False the ``converged`` mask is returned instead.
 
@@ -290,14 +320,14 @@ def hertz_point(F, Rx, Ry, E_prime, method: str = "exact", strict: bool = True) 
     rx = _check_array_positive("Rx", Rx, "mm")
     ry = _check_array_positive("Ry", Ry, "mm")
     _check_array_positive("E_prime", E_prime, "MPa")
-    if method not in ("exact", "hamrock_brewe"):
-        raise ValueError(f"method = {method!r} must be 'exact' or 'hamrock_brewe'")
+    if method not in _METHODS:
+        raise _method_error(method)
     ratio = np.maximum(rx, ry) / np.minimum(rx, ry)
     if method == "exact" and np.any(np.abs(np.log(ratio)) > 34.0):
         raise ValueError(f"Ry/Rx = {float(np.max(ry / rx)):g} is outside the allowed range "
                          "[1e-15, 1e15]; use hertz_line for a line contact")
-    if method == "hamrock_brewe" and np.any(ratio > 100.0):
-        warnings.warn("Hamrock-Brewe approximations used outside their fitted range "
+    if method in _FIT_METHODS and np.any(ratio > 100.0):
+        warnings.warn(f"Hamrock-Brewe approximations ({method}) used outside their range "
                       f"1 <= Ry/Rx <= 100 (got {float(np.max(ratio)):g}); use method='exact'",
                       stacklevel=2)
     out = _hertz_point_jit(F, Rx, Ry, E_prime, method=method)
