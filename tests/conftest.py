@@ -1,9 +1,29 @@
+import os
+
 import jax
 import pytest
 
 jax.config.update("jax_enable_x64", True)
 
 import gearjax  # noqa: E402,F401  (enables float64 as well)
+
+
+def pytest_configure(config):
+    """Keep compiled XLA executables on disk for the rest of the run (and later runs).
+
+    The suite's time is mostly compilation of the large nested implicit solves (TCA,
+    synthesis), several of which are compiled again by later modules (the caches are
+    cleared between modules, see below; CLI tests compile what library tests did).
+    JAX's persistent compilation cache returns an executable compiled for the same
+    program, flags and JAX version instead; it changes no result.  It lives in
+    pytest's own cache directory (ignored by git), is shared by pytest-xdist workers,
+    and ``GEARJAX_TEST_NO_COMPILE_CACHE=1`` switches it off.
+    """
+    if os.environ.get("GEARJAX_TEST_NO_COMPILE_CACHE") == "1" or config.cache is None:
+        return
+    path = config.cache.mkdir("jax-compilation")
+    jax.config.update("jax_compilation_cache_dir", str(path))
+    jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.5)
 
 
 @pytest.fixture(autouse=True, scope="module")

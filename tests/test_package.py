@@ -24,7 +24,7 @@ def test_pyproject_metadata():
     assert runtime == {"jax", "jaxopt", "optax", "numpy", "matplotlib"}
     test = {re.split(r"[<>=!~ ;\[]", d, maxsplit=1)[0].lower()
             for d in proj["optional-dependencies"]["test"]}
-    assert {"pytest", "hypothesis"} <= test
+    assert {"pytest", "pytest-xdist", "hypothesis", "scipy"} <= test
     assert proj["scripts"]["gearjax"] == "gearjax.cli:main"
 
 
