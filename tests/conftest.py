@@ -17,11 +17,17 @@ def pytest_configure(config):
     JAX's persistent compilation cache returns an executable compiled for the same
     program, flags and JAX version instead; it changes no result.  It lives in
     pytest's own cache directory (ignored by git), is shared by pytest-xdist workers,
-    and ``GEARJAX_TEST_NO_COMPILE_CACHE=1`` switches it off.
+    ``GEARJAX_TEST_COMPILE_CACHE_DIR`` puts it elsewhere (the mutation runner,
+    tools/mutation_run.py, shares one between its temporary copies) and
+    ``GEARJAX_TEST_NO_COMPILE_CACHE=1`` switches it off.
     """
-    if os.environ.get("GEARJAX_TEST_NO_COMPILE_CACHE") == "1" or config.cache is None:
+    if os.environ.get("GEARJAX_TEST_NO_COMPILE_CACHE") == "1":
         return
-    path = config.cache.mkdir("jax-compilation")
+    path = os.environ.get("GEARJAX_TEST_COMPILE_CACHE_DIR")
+    if not path:
+        if getattr(config, "cache", None) is None:
+            return
+        path = config.cache.mkdir("jax-compilation")
     jax.config.update("jax_compilation_cache_dir", str(path))
     jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.5)
 
