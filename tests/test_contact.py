@@ -61,6 +61,8 @@ def test_exact_hertz_matches_independent_scipy_solution(Rx, Ry):
     assert float(res.b) == pytest.approx(b, rel=1e-10)
     assert float(res.p_max) == pytest.approx(p0, rel=1e-10)
     assert float(res.approach) == pytest.approx(d, rel=1e-10)
+    # mean pressure = load / ellipse area, with the scipy semi-axes (same 1e-10 level)
+    assert float(res.p_mean) == pytest.approx(F / (np.pi * a * b), rel=1e-10)
 
 
 def test_circle_closed_form():
@@ -125,6 +127,8 @@ def test_hamrock_brewe_error_levels(method):
         err = np.max(np.abs(np.asarray(getattr(fit, f)) / np.asarray(getattr(ex, f)) - 1))
         assert err < level + 5e-4, (f, err)
         assert err > 0.5 * level, (f, err)  # it really is the approximation
+    # mean pressure of the fitted ellipse: load over its area (round-off only)
+    np.testing.assert_allclose(fit.p_mean * np.pi * fit.a * fit.b, 1000.0, rtol=1e-13)
     # Rx > Ry: the same ellipse turned by 90 degrees (the 1983 paper's k < 1 case)
     swapped = hertz_point(1000.0, 10.0 * ratios[1:], 10.0, E_PRIME, method=method)
     np.testing.assert_allclose(swapped.a, fit.b[1:], rtol=1e-14)
@@ -189,5 +193,11 @@ def test_bad_input_refused(kw, name):
 
 def test_combined_modulus_steel():
     assert float(combined_modulus(206000.0, 0.3)) == pytest.approx(206000.0 / (1 - 0.09), rel=1e-14)
+    # two materials, steel (206 GPa, 0.3) on aluminium (70 GPa, 0.33), worked by hand:
+    # (1 - 0.09)/206000 = 4.417476e-6, (1 - 0.1089)/70000 = 1.273000e-5 per MPa,
+    # E' = 2/1.7147476e-5 = 116 635.24 MPa (7 digits of the hand sum: rel 1e-7);
+    # in either order (the formula is symmetric in the two bodies)
+    assert float(combined_modulus(206000.0, 0.3, 70000.0, 0.33)) == pytest.approx(116635.24, rel=1e-7)
+    assert float(combined_modulus(70000.0, 0.33, 206000.0, 0.3)) == pytest.approx(116635.24, rel=1e-7)
     with pytest.raises(ValueError, match="nu1"):
         combined_modulus(206000.0, 0.6)

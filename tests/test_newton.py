@@ -85,10 +85,41 @@ def test_non_convergence_is_flagged_not_returned_as_valid():
     assert res.converged.tolist() == [True, False]
 
 
+def test_affine_system_is_solved_by_one_exact_step():
+    """Newton is exact for an affine F: one step lands on the root.  The data are chosen so
+    that the step is exact in binary floating point (F = 0 exactly), so the count is 1."""
+    res = newton_solve(lambda x, th: 4.0 * x - th, 0.0, 6.0)
+    assert float(res.x) == 1.5 and float(res.residual) == 0.0
+    assert int(res.steps) == 1 and bool(res.converged)
+    res = newton_solve(lambda x, th: jnp.stack([2.0 * x[0] - 3.0, 0.5 * x[1] + 1.0]), jnp.zeros(2), ())
+    assert res.x.tolist() == [1.5, -2.0] and int(res.steps) == 1
+
+
+def test_reported_residual_is_max_abs_F_at_the_returned_x():
+    """residual = max|F(x)| evaluated here, independently, at the x the solver returns.  The
+    system has no root (x0^2 + 1 > 0) and one affine equation solved at once, so the two
+    components differ and a mean or another norm would not match; the solve runs to
+    max_steps and is flagged as not converged."""
+    F = lambda x, th: jnp.stack([x[0] ** 2 + 1.0, 0.25 * (x[1] - 2.0)])  # noqa: E731
+    res = newton_solve(F, jnp.array([0.6, 7.0]), (), max_steps=7)
+    fx = np.asarray(F(res.x, ()))
+    np.testing.assert_allclose(float(res.residual), np.max(np.abs(fx)), rtol=1e-15)
+    assert fx[0] >= 1.0 and abs(fx[1]) < 1e-15
+    assert not bool(res.converged) and int(res.steps) == 7
+
+
 def test_line_search_rescues_overshoot():
     # arctan: undamped Newton diverges from |x0| > 1.39; the backtracking converges
     res = newton_solve(lambda x, th: jnp.arctan(x), 3.0, ())
     assert bool(res.converged) and abs(float(res.x)) < 1e-12
+    # one step by hand: dx = -(1 + x0^2) arctan(x0) = -10 arctan(3); the Armijo test
+    # |F(x0 + a dx)| <= (1 - 1e-4 a)|F(x0)| fails for a = 1 (|F| = 1.466) and a = 1/2
+    # (1.272) and holds for a = 1/4 (0.122) against |F(x0)| = 1.249.  So with at most
+    # one halving the step ends at a = 1/2, with two at a = 1/4.
+    for halvings, a in ((1, 0.5), (2, 0.25)):
+        res = newton_solve(lambda x, th: jnp.arctan(x), 3.0, (), max_steps=1, max_halvings=halvings)
+        np.testing.assert_allclose(float(res.x), 3.0 - a * 10.0 * np.arctan(3.0), rtol=1e-14)
+        assert int(res.steps) == 1
 
 
 def test_mismatched_system_rejected():

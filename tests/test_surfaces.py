@@ -46,6 +46,15 @@ def test_sphere():
 
 def test_cylinder_curvatures_and_directions():
     uv = jnp.array([0.8, 1.2])
+    # tangents r_theta = R e_theta, r_z = e_z and the normal e_theta x e_z = e_r, by hand
+    er, et = np.array([np.cos(0.8), np.sin(0.8), 0.0]), np.array([-np.sin(0.8), np.cos(0.8), 0.0])
+    ru, rv = S.tangents(cylinder, uv)
+    np.testing.assert_allclose(ru, 2.5 * et, atol=1e-15)
+    np.testing.assert_allclose(rv, [0.0, 0.0, 1.0], atol=1e-15)
+    np.testing.assert_allclose(S.unit_normal(cylinder, uv), er, atol=1e-15)
+    k1, k2, e1, e2 = S.principal_curvatures(cylinder, uv)
+    np.testing.assert_allclose([k1, k2], [0.0, -1 / 2.5], atol=1e-15)
+    np.testing.assert_allclose(abs(float(e2 @ et)), 1.0, atol=1e-15)
     g = S.local_geometry(cylinder, uv)
     # normal = r_theta x r_z points outwards -> kappa = -1/R round the axis
     np.testing.assert_allclose([g.k1, g.k2], [0.0, -1 / 2.5], atol=1e-14)
@@ -92,6 +101,56 @@ def test_euler_and_bertrand_formulas(phi):
     I, II = S.fundamental_forms(torus, uv)
     w = np.linalg.lstsq(np.stack([g.ru, g.rv], 1), t, rcond=None)[0]
     np.testing.assert_allclose(kn, (w @ II @ w) / (w @ I @ w), atol=1e-14)
+
+
+def helicoid(q, c=1.5):
+    return jnp.array([q[0] * jnp.cos(q[1]), q[0] * jnp.sin(q[1]), c * q[1]])
+
+
+def test_helicoid_principal_curvatures_and_directions():
+    """Helicoid (u cos v, u sin v, c v), a minimal surface: principal curvatures
+    +-c/(c^2 + u^2), Gaussian curvature -c^2/(c^2 + u^2)^2 (do Carmo, *Differential
+    Geometry of Curves and Surfaces*, §3-3, example of the helicoid).  Its coordinate
+    lines are asymptotic (L = N = 0, F = 0), so the principal directions bisect r_u and
+    r_v: with n = r_u x r_v/|.| one has M = -c/sqrt(c^2 + u^2) < 0, hence kappa = +k along
+    a - b and -k along a + b (a, b unit r_u, r_v; worked out by hand).  Unlike the sphere
+    and cylinder, the shape operator is off-diagonal in the (r_u, n x r_u) frame here, so
+    the principal angle is exercised.  Tolerance: a few ulp of k."""
+    u, v, c = 0.8, 0.3, 1.5
+    g = S.local_geometry(helicoid, jnp.array([u, v]))
+    k = c / (c ** 2 + u ** 2)
+    np.testing.assert_allclose([g.k1, g.k2], [k, -k], rtol=1e-13)
+    a = np.array([np.cos(v), np.sin(v), 0.0])
+    b = np.array([-u * np.sin(v), u * np.cos(v), c]) / np.hypot(u, c)
+    np.testing.assert_allclose(abs(float(g.e1 @ (a - b))) / np.sqrt(2), 1.0, atol=1e-14)
+    np.testing.assert_allclose(abs(float(g.e2 @ (a + b))) / np.sqrt(2), 1.0, atol=1e-14)
+    I, II = S.fundamental_forms(helicoid, jnp.array([u, v]))
+    np.testing.assert_allclose(I, [[1.0, 0.0], [0.0, u ** 2 + c ** 2]], atol=1e-14)
+    np.testing.assert_allclose(II, [[0.0, -c / np.hypot(u, c)], [-c / np.hypot(u, c), 0.0]], atol=1e-14)
+
+
+def test_weingarten_and_direction_curvatures_closed_forms():
+    """Weingarten map dn = W dr in closed form: sphere with the inward normal n = -r/R gives
+    dn = -dr/R, W = -(I - n n^T)/R; cylinder with the outward normal e_r gives
+    dn = (r_theta . dr) e_theta / R^2, W = e_theta e_theta^T / R.  For the cylinder and the
+    tangent t = cos(phi) e_z + sin(phi) e_theta, by hand from W:
+    kappa_n = -sin^2(phi)/R and tau_g = sin(phi) cos(phi)/R.  The direction is passed with a
+    normal component and a length != 1, which the functions must discard.  Tolerance: ulp."""
+    uv = jnp.array([0.3, 0.5])
+    n = -sphere(uv) / R_S
+    np.testing.assert_allclose(S.weingarten(sphere, uv), -(np.eye(3) - np.outer(n, n)) / R_S, atol=1e-15)
+    th, R = 0.8, 2.5
+    er = np.array([np.cos(th), np.sin(th), 0.0])
+    et = np.array([-np.sin(th), np.cos(th), 0.0])
+    ez = np.array([0.0, 0.0, 1.0])
+    q = jnp.array([th, 1.2])
+    np.testing.assert_allclose(S.weingarten(cylinder, q), np.outer(et, et) / R, atol=1e-15)
+    for phi in (0.0, 0.6, 2.0):
+        t = np.cos(phi) * ez + np.sin(phi) * et
+        kn = S.normal_curvature(cylinder, q, 2.0 * t + 0.8 * er)
+        tg = S.geodesic_torsion(cylinder, q, 0.5 * t - 0.3 * er)
+        np.testing.assert_allclose(kn, -np.sin(phi) ** 2 / R, atol=1e-15)
+        np.testing.assert_allclose(tg, np.sin(phi) * np.cos(phi) / R, atol=1e-15)
 
 
 def test_weingarten_annihilates_normal_and_is_self_adjoint():
@@ -141,6 +200,16 @@ def test_envelope_meshing_residual_and_gradient():
     uv = jnp.array([0.3, 0.4])
     psi = GEN.solve(uv).x
     assert abs(float(S.meshing_function(swept_sphere, uv, psi))) < 1e-14
+    # the root in closed form: the sphere point at azimuth v is on the envelope when the
+    # centre is at psi = v (f below vanishes), whatever the starting guess nearby
+    np.testing.assert_allclose(S.solve_envelope(swept_sphere, uv, 0.0).x, 0.4, rtol=1e-14)
+    np.testing.assert_allclose(psi, 0.4, rtol=1e-14)
+    # away from the root, the closed form: n = -e(uv) (inward normal of this
+    # parametrisation), dr/dpsi = R_C (-sin psi, cos psi, 0), so
+    # f = n . dr/dpsi = -R_C cos(u) sin(v - psi)   (mm per rad)
+    for p in (0.1, 1.3):
+        np.testing.assert_allclose(S.meshing_function(swept_sphere, uv, p),
+                                   -R_C * np.cos(0.3) * np.sin(0.4 - p), rtol=1e-14)
     # d(point)/d(uv) through the implicit solve vs central differences
     J = jax.jacfwd(GEN)(uv)
     h = 1e-6

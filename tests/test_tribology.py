@@ -39,6 +39,10 @@ def test_roelands_z_from_alpha_matches_barus_slope_at_zero():
     seed_oil = make_oil(0.1, z=0.68)
     assert float(seed_oil.alpha) == pytest.approx(0.68 * (math.log(0.1) + 9.67) * 5.1e-3, rel=1e-12)
     assert 0.4 < float(roelands_z(oil.eta0, oil.alpha)) < 0.8
+    # roelands_z (the jnp route) gives the z whose Roelands law has initial slope α
+    z = roelands_z(0.196, 0.024)
+    slope = jax.grad(lambda p: jnp.log(roelands_viscosity(p, 0.196, z)))(0.0)
+    assert float(slope) == pytest.approx(0.024, rel=1e-12)
     # Roelands is below Barus at high pressure (the known Barus over-prediction)
     assert float(viscosity(1500.0, oil)) < float(viscosity(1500.0, oil, "barus"))
     assert float(barus_viscosity(100.0, 0.1, 0.02)) == pytest.approx(0.1 * math.exp(2.0), rel=1e-14)
@@ -120,6 +124,45 @@ def test_pan_hamrock_line_worked_example():
     # W'^-0.128 = 3.1358, U^0.694 = 1.8210e-7, G^0.568 = 125.90 -> h_min = 1.2323 µm
     assert float(hc) * 1e3 == pytest.approx(1.3391, rel=1e-4)
     assert float(hm) * 1e3 == pytest.approx(1.2323, rel=1e-4)
+
+
+def _ph_by_hand_SI(w_N_m, Rx_m, u, eta0, alpha_Pa, Ep_Pa):
+    U = eta0 * u / (Ep_Pa * Rx_m)
+    G = alpha_Pa * Ep_Pa
+    Wl = w_N_m / (Ep_Pa * Rx_m)
+    return (Rx_m * 2.922 * Wl ** -0.166 * U ** 0.692 * G ** 0.470,
+            Rx_m * 1.714 * Wl ** -0.128 * U ** 0.694 * G ** 0.568)
+
+
+def test_elongated_ellipse_film_uses_centre_line_load():
+    """film_method="line" on a Hertz ellipse: Pan–Hamrock (typed in SI) with the load per
+    unit length carried across the middle of the ellipse, obtained here by integrating
+    the Hertz pressure p_max sqrt(1 - x²/b²) along the rolling direction (scipy quad;
+    π p_max b/2 = 3F/(4a) in closed form).  Tolerance 1e-11: quadrature and the
+    SI/mm unit round trip."""
+    F, Rx = 1500.0, 10.0
+    hz = hertz_point(F, Rx, 1e4 * Rx, E_PRIME)
+    b, pm = float(hz.b), float(hz.p_max)
+    w = quad(lambda x: pm * math.sqrt(1.0 - (x / b) ** 2), -b, b, epsabs=0, epsrel=1e-13)[0]
+    hc_si, hm_si = _ph_by_hand_SI(w * 1e3, Rx * 1e-3, 4.0, 0.088, 22e-9, E_PRIME * 1e6)
+    hc, hm = film_thickness_traced(F, Rx, hz.k, hz.a, 4000.0, 0.088, 0.022, E_PRIME, "line")
+    assert float(hc) * 1e-3 == pytest.approx(hc_si, rel=1e-11)
+    assert float(hm) * 1e-3 == pytest.approx(hm_si, rel=1e-11)
+
+
+def test_auto_film_inside_the_blend():
+    """Inside the blend (8 < k < 64) "auto" is ln h = (1-s) ln h_HD + s ln h_PH with the
+    smoothstep s = 3x² - 2x³ of x = ln(k/8)/ln(64/8) (docs/friction.md; a gearjax
+    choice).  At k = 16, x = 1/3 and s = 7/27 exactly, so h = h_HD^(20/27) h_PH^(7/27)
+    with both formulas typed in SI (Hamrock–Dowson at k = 16, Pan–Hamrock with
+    w = 3F/(4a)).  Both h_c and h_min; tolerance 1e-12 (round-off of the powers)."""
+    F, Rx, a, k, ue = 1200.0, 10.0, 2.0, 16.0, 4000.0
+    hp = _hd_by_hand_SI(F, Rx * 1e-3, k, ue * 1e-3, 0.088, 22e-9, E_PRIME * 1e6)
+    hl = _ph_by_hand_SI(0.75 * F / a * 1e3, Rx * 1e-3, ue * 1e-3, 0.088, 22e-9, E_PRIME * 1e6)
+    auto = film_thickness_traced(F, Rx, k, a, ue, 0.088, 0.022, E_PRIME, "auto")
+    for got, p, l in zip(auto, hp, hl):
+        assert float(got) * 1e-3 == pytest.approx(p ** (20 / 27) * l ** (7 / 27), rel=1e-12)
+    assert float(blend_weight(k)) == pytest.approx(7 / 27, rel=1e-14)
 
 
 def test_groups_use_rx_not_geometric_mean():
@@ -208,8 +251,10 @@ def test_load_sharing_satisfies_both_equations(ue, sigma_um):
     phi, g1, hc = float(ls.phi), float(ls.gamma1), float(ls.h_c)
     assert 1.0 / g1 == pytest.approx(1.0 - phi, rel=1e-12, abs=1e-15)
     # fluid: Hamrock–Dowson (by hand, SI) with F/γ1 and E'/γ1
-    hc_si, _ = _hd_by_hand_SI(F / g1, Rx * 1e-3, float(hz.k), ue * 1e-3, 0.088, 22e-9, 226.374e9 / g1)
+    hc_si, hm_si = _hd_by_hand_SI(F / g1, Rx * 1e-3, float(hz.k), ue * 1e-3, 0.088, 22e-9,
+                                  226.374e9 / g1)
     assert hc * 1e-3 == pytest.approx(hc_si, rel=1e-9)
+    assert float(ls.h_min) * 1e-3 == pytest.approx(hm_si, rel=1e-9)  # same film, h_min formula
     # asperities: F_a = π a b K E' F_5/2(h/σ) with F_5/2 by scipy quad
     sig, dens, beta = float(s.sigma), float(s.density), float(s.beta)
     lam = hc / sig
@@ -217,6 +262,10 @@ def test_load_sharing_satisfies_both_equations(ue, sigma_um):
     K = 16 * math.sqrt(2) * math.pi / 15 * (dens * beta * sig) ** 2 * math.sqrt(sig / beta)
     Fa = math.pi * float(hz.a) * float(hz.b) * K * E_PRIME * F52
     assert phi * F == pytest.approx(Fa, rel=1e-8)
+    # real area ratio π²(η_s β σ)² F_2(λ) at the load-sharing film, F_2 in closed form
+    # (1 + λ²) Q(λ) - λ φ(λ); rel 1e-8 as F_a (λ carries the solve's tolerance)
+    F2 = (1 + lam * lam) * 0.5 * erfc(lam / math.sqrt(2)) - lam * norm.pdf(lam)
+    assert float(ls.area_ratio) == pytest.approx(math.pi ** 2 * (dens * beta * sig) ** 2 * F2, rel=1e-8)
 
 
 @pytest.mark.filterwarnings("ignore:Greenwood-Tripp asperity model")
