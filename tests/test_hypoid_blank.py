@@ -101,6 +101,57 @@ def test_three_routes_and_table():
     assert res["iso23509-method0"]["a1"] == 0.0
 
 
+@pytest.mark.parametrize("method", hb.METHODS)
+def test_blank_outputs_by_independent_relations(method):
+    """Outputs of blank_geometry that the ISO sample tables do not list, each against
+    a relation typed in from its definition (ISO 23509:2016 clause 7, seed 003):
+
+    * m_et2 = d_e2/z2 (126), a_p = R_m2 sin(beta_m1 - beta_m2) (115 with 27);
+    * d_e2 and b2 are the inputs; Method 0: common apex at the crossing point
+      (t_z1 = t_z2 = a1 = a2 = 0, pitch point at 90 deg from the common perpendicular:
+      theta1 = -90, theta2 = +90 deg), no offset angle;
+    * hypoid routes: theta2 = 90 deg - zeta_m (the pitch point seen from the gear
+      axis), a1 = t_z1, a2 = t_z2 (same apex in two routes);
+    * seed route: the ratio condition u r1 cos b1 = r2 cos b2 (Gleason's hypoid
+      factor, ISO (14)/(26)) and the pitch point at mid face, d_e2 = 2 (R_m2 + b2/2)
+      sin delta2 (seed 003 eq. (7));
+    * seed 003's machine table: dV = E sin theta2 - a1, dH = E cos theta2 + a2,
+      cradle = theta2 + 90 deg (left hand), X_G = a2, tilt NaN (no solution) and
+      the reciprocal tilt asin(tan alpha_lim / tan beta_m1).
+    Closed forms and converged solves: 1e-10 (measured <= 3e-12, in a1 - t_z1)."""
+    d = dict(SAMPLE2, method=method)
+    if method == "iso23509-method0":
+        d["offset_mm"] = 0.0
+    inp = BlankInput.from_dict(d)
+    b = {n: float(getattr(blank_geometry(inp), n)) for n, _, _ in hb.OUTPUTS}
+    E, u = inp.offset, 42 / 13
+    tol = dict(rtol=0, atol=1e-10)
+    np.testing.assert_allclose([b["de2"], b["b2"]], [170.0, 30.0], **tol)
+    np.testing.assert_allclose(b["m_et2"], 170.0 / 42, **tol)
+    np.testing.assert_allclose(b["a_p"], b["Rm2"] * math.sin(b["beta_m1"] - b["beta_m2"]), **tol)
+    if method == "iso23509-method0":
+        np.testing.assert_allclose([b["a1"], b["a2"], b["tz1"], b["tz2"], b["zeta_m"]], 0.0, **tol)
+        np.testing.assert_allclose([b["theta1"], b["theta2"]], [-math.pi / 2, math.pi / 2], **tol)
+    else:
+        np.testing.assert_allclose(b["theta2"], math.pi / 2 - b["zeta_m"], **tol)
+        np.testing.assert_allclose([b["a1"], b["a2"]], [b["tz1"], b["tz2"]], rtol=0, atol=1e-10)
+    if method == "seed003-tangency":
+        r1, r2 = b["Rm1"] * math.sin(b["delta1"]), b["Rm2"] * math.sin(b["delta2"])
+        np.testing.assert_allclose(u * r1 * math.cos(b["beta_m1"]), r2 * math.cos(b["beta_m2"]),
+                                   rtol=1e-11)
+        np.testing.assert_allclose(2 * (b["Rm2"] + 15.0) * math.sin(b["delta2"]), 170.0, **tol)
+    th2, a1, a2 = b["theta2"], b["a1"], b["a2"]
+    np.testing.assert_allclose([b["machine_dV"], b["machine_dH"], b["machine_cradle"],
+                                b["machine_X_G"]],
+                               [E * math.sin(th2) - a1, E * math.cos(th2) + a2, th2 + math.pi / 2,
+                                a2], **tol)
+    # the seed's tilt sin i = tan b1 / tan a_lim has no solution (|ratio| > 1, or
+    # a_lim = 0 for Method 0): NaN; the reciprocal reading asin(tan a_lim / tan b1)
+    assert math.isnan(b["machine_tilt"])
+    np.testing.assert_allclose(b["machine_tilt_reciprocal"],
+                               math.asin(math.tan(b["alpha_lim"]) / math.tan(b["beta_m1"])), **tol)
+
+
 def test_jit_matches_eager_and_no_nans():
     inp = BlankInput.from_dict(dict(SAMPLE2, method="seed003-tangency"))
     a = blank_geometry(inp)
@@ -133,6 +184,26 @@ def test_sensitivity_matches_central_differences(method):
     worst = int(np.argmax(np.max(np.abs(J - Jfd) / np.where(scale > 0, scale, 1), axis=1)))
     assert err < 1e-6, (err, s["outputs"][worst])
     np.testing.assert_allclose(s["values"], f(x0), rtol=1e-13)
+    # columns with a closed-form answer (independent of the difference quotients above,
+    # which share the design-vector wiring): d_e2 and b2 are returned unchanged, the
+    # limit curvature radius is the cutter radius (ISO 23509 (40)), m_et2 = d_e2/(u z1)
+    # (126).  Exact but for the implicit-Newton round-off (measured <= 1.7e-13): 1e-11.
+    col = {n: i for i, n in enumerate(hb.SENSITIVITY_INPUTS)}
+    row = {n: i for i, n in enumerate(s["outputs"])}
+    u = inp.z2 / inp.z1
+    expect = {("de2", "gear_outer_pitch_diameter"): 1.0, ("b2", "gear_face_width"): 1.0,
+              ("rho_lim", "cutter_radius"): 1.0, ("m_et2", "gear_outer_pitch_diameter"): 1 / inp.z2,
+              ("m_et2", "ratio"): -inp.gear_outer_pitch_diameter / (inp.z1 * u ** 2)}
+    if method == "seed003-tangency":
+        expect[("beta_m1", "spiral_angle")] = 1.0     # the pinion spiral angle is the input
+    for name in ("de2", "b2", "rho_lim", "m_et2") + (("beta_m1",) if method == "seed003-tangency" else ()):
+        for c in hb.SENSITIVITY_INPUTS:
+            np.testing.assert_allclose(J[row[name], col[c]], expect.get((name, c), 0.0),
+                                       rtol=0, atol=1e-11, err_msg=f"{name} / {c}")
+    # the values are the blank's outputs
+    b = blank_geometry(inp)
+    np.testing.assert_allclose(s["values"], [float(getattr(b, n)) for n in s["outputs"]],
+                               rtol=1e-13, atol=1e-13)
 
 
 @pytest.mark.parametrize("method", ["iso23509-method1", "seed003-tangency"])

@@ -14,11 +14,11 @@ import numpy as np
 import pytest
 
 from gearjax.errors import ConvergenceError
-from gearjax.gears.hypoid import (face_cone_gap, flank_points, flank_surface, mid_estimate,
+from gearjax.gears.hypoid import (axial_coords, face_cone_gap, flank_points, flank_surface,
+                                  mean_cone_distance, mid_estimate, pitch_distance,
                                   root_cone_gap, solve_point, solve_tip, spiral_angle_at,
                                   work_point, xi_of)
 from gearjax.io import load_design
-from gearjax.machines import roll_angle, work_to_machine
 
 FLANKS = [("pinion", "convex"), ("pinion", "concave"), ("gear", "convex"), ("gear", "concave")]
 NX, NS = 5, 4
@@ -32,6 +32,48 @@ def design():
 @pytest.fixture(scope="module")
 def grids(design):
     return {mf: flank_surface(design.flank(*mf), NX, NS) for mf in FLANKS}
+
+
+@pytest.mark.parametrize("member", ["pinion", "gear"])
+def test_blank_cones_by_hand(design, member):
+    """Cone geometry of the member blank in the axial plane (x along the axis from the
+    pitch apex, R the radius), typed in from the definitions:
+
+    * A_m = A_o - F/2 against the HFT formate hypoid paper's Table 1 (mean cone
+      distance 128.32 / 130.75 mm, printed to 0.01 mm: 5e-3 mm; measured 0);
+    * the pitch generatrix g = (cos gp, sin gp): xi = -1, 0, +1 at A_o - F, A_m, A_o,
+      and a step along the pitch-cone normal does not change l_p;
+    * the face cone passes through the heel addendum point A_o g + h_a n (n the unit
+      normal of the pitch cone) with angle gF: the signed gap is 0 along its
+      generatrix and -d a distance d outside; the root cone through A_o g - h_f n with
+      angle gR: 0 on it and +d a distance d above it.
+    Exact up to round-off (measured <= 3e-14 mm on ~150 mm): 1e-12."""
+    b = design.member_blank(member)
+    Ao, F, gp, gF, gR, ha, hf = (float(v) for v in (
+        b.outer_cone_distance, b.face_width, b.pitch_angle, b.face_angle, b.root_angle,
+        b.outer_addendum, b.outer_dedendum))
+    Am_table = {"pinion": 128.32, "gear": 130.75}[member]
+    assert abs(float(mean_cone_distance(b)) - Am_table) < 5e-3
+    # cone angles in rad from Table 1's degrees (pitch, face, root)
+    table = {"pinion": (12.55, 16.07, 11.93), "gear": (77.22, 77.85, 73.55)}[member]
+    np.testing.assert_allclose([gp, gF, gR], np.radians(table), rtol=1e-15)
+    g, n = np.array([math.cos(gp), math.sin(gp)]), np.array([-math.sin(gp), math.cos(gp)])
+
+    def pt(xr, az=0.7):                     # axial-plane point -> work frame, any azimuth
+        return jnp.array([xr[1] * math.cos(az), xr[1] * math.sin(az), xr[0]])
+
+    for L, xi in [(Ao - F, -1.0), (Ao - F / 2, 0.0), (Ao, 1.0)]:
+        np.testing.assert_allclose(float(xi_of(b, pt(L * g))), xi, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(float(pitch_distance(b, pt(L * g + 3.0 * n, -2.0))), L,
+                                   rtol=0, atol=1e-12)
+    np.testing.assert_allclose(axial_coords(pt([3.0, 4.0], 1.1)), [3.0, 4.0], rtol=0, atol=1e-14)
+    heel_a, heel_f = Ao * g + ha * n, Ao * g - hf * n
+    for (P0, ang, gap, outward) in [(heel_a, gF, face_cone_gap, -1.0), (heel_f, gR, root_cone_gap, 1.0)]:
+        t, m = np.array([math.cos(ang), math.sin(ang)]), np.array([-math.sin(ang), math.cos(ang)])
+        for k in (-30.0, 0.0, 10.0):
+            np.testing.assert_allclose(float(gap(b, pt(P0 + k * t))), 0.0, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(float(gap(b, pt(P0 - 20.0 * t + 2.5 * m, 2.0))), outward * 2.5,
+                                   rtol=0, atol=1e-12)
 
 
 @pytest.mark.parametrize("mf", FLANKS)
@@ -107,20 +149,38 @@ def test_axial_plot_labels(design, grids):
         plt.close(ax.figure)
 
 
+def _Mmw_ref(ms, phi):
+    """M_mw(phi) = T(0, E_m, X_B) Ry(pi/2 - gamma_m) T(0, 0, dX_D) Rz(phi), typed in with
+    NumPy from the cradle model (gearjax.machines docstring, Litvin & Fuentes ch. 21)."""
+    E, g, XB, dX = (float(v) for v in (ms.blank_offset, ms.machine_root_angle,
+                                       ms.sliding_base, ms.center_to_back))
+    a = math.pi / 2 - g
+    Ry = np.array([[math.cos(a), 0, math.sin(a)], [0, 1, 0], [-math.sin(a), 0, math.cos(a)]])
+    Rz = np.array([[math.cos(phi), -math.sin(phi), 0], [math.sin(phi), math.cos(phi), 0], [0, 0, 1]])
+    M = np.eye(4)
+    M[:3, :3] = Ry @ Rz
+    M[:3, 3] = np.array([0.0, E, XB]) + Ry @ np.array([0.0, 0.0, dX])
+    return M
+
+
 @pytest.mark.parametrize("mf", [("pinion", "convex"), ("pinion", "concave")])
 def test_meshing_equation_independent(design, grids, mf):
-    """n . v = 0 with v from seed 004's (w_c - w_w) x r + w_w x R in the machine frame."""
+    """n . v = 0 with v from seed 004's (w_c - w_w) x r + w_w x R in the machine frame;
+    the work placement is typed in (not gearjax.machines) and the roll is linear
+    (2C = 6D = 0 in the 8/43 settings): phi = R_a psi."""
     fl, g = design.flank(*mf), grids[mf]
     ms = fl.machine
+    assert float(ms.modified_roll_2c) == 0.0 and float(ms.modified_roll_6d) == 0.0
+    Ra = float(ms.ratio_of_roll)
     P, N, prm = (np.asarray(a) for a in (g.points, g.normals, g.params))
     worst = 0.0
     for i in range(NX):
         for j in range(NS):
             psi = float(prm[i, j, 2])
-            M = np.asarray(work_to_machine(ms, roll_angle(ms, psi)))
+            M = _Mmw_ref(ms, Ra * psi)
             r_m = M[:3, :3] @ P[i, j] + M[:3, 3]
             n_m = M[:3, :3] @ N[i, j]
-            dphi = float(jax.grad(lambda p: roll_angle(ms, p))(psi))
+            dphi = Ra
             w_c, w_w = np.array([0.0, 0.0, 1.0]), dphi * M[:3, 2]
             v = np.cross(w_c - w_w, r_m) + np.cross(w_w, M[:3, 3])
             worst = max(worst, abs(n_m @ v))

@@ -111,33 +111,102 @@ def test_method0_outer_diameters_follow_tooth_ratio():
         np.testing.assert_allclose(r["de2"], 200.0, rtol=1e-14)
 
 
-@pytest.mark.parametrize("taper", ["standard", "constant-slot", "modified-slot", "uniform"])
-def test_tapers_and_sample1_duplex(taper):
-    """Annex C.5 tapers; sample 1's manual theta_a2/theta_f2 are its constant-slot
-    (duplex) values: sum theta_f = 8.6276 deg, theta_a2 = 2.1342 deg."""
+def _sample1_by_hand(rc0):
+    """ISO 23509 sample 1 (annex F.2) basic data typed in from the formulae:
+    Method 0 (1)-(7), (116), (126), (132)-(136), (201); returns a dict."""
+    u, z2, de2, b2, beta, alpha = 39 / 14, 39.0, 176.893, 25.4, D(35.0), D(20.0)
+    khap, khfp, xhm1 = 1.0, 2.0 * (0.125 + 0.5), 2.0 * (0.5 - 0.24737)   # table 4
+    d2 = np.arctan(u)                                       # (1)-(2), Sigma = 90 deg
+    Re = de2 / (2 * np.sin(d2))                             # (3)
+    Rm = Re - b2 / 2                                        # (4)
+    mmn = 2 * Rm * np.sin(d2) * np.cos(beta) / z2           # (116)
+    s_c_deg = (90.0 * (de2 / z2) / (Re * np.tan(alpha) * np.cos(beta))
+               * (1 - Rm * np.sin(beta) / rc0))             # (C.5), in degrees as printed
+    return dict(d2=d2, Rm=Rm, hfm1=mmn * (khfp - xhm1), hfm2=mmn * (khfp + xhm1),
+                ham2=mmn * (khap - xhm1), hmw=2 * mmn * khap, s_c=D(s_c_deg))
+
+
+@pytest.mark.parametrize("taper,rc0", [("standard", 114.3), ("constant-slot", 114.3),
+                                       ("modified-slot", 114.3), ("modified-slot", 90.0),
+                                       ("uniform", 114.3), ("manual", 114.3)])
+def test_tapers_and_sample1_duplex(taper, rc0):
+    """Each depthwise taper of ISO 23509 annex C.5 by the equality the standard gives,
+    on sample 1 (annex F.2) with the basic data typed in from the formulae:
+
+    * standard (C.3): theta_a2 = atan(h_fm1/R_m2), theta_f2 = atan(h_fm2/R_m2);
+    * uniform: theta_a2 = theta_f2 = 0;
+    * constant-slot / duplex (C.5, C.8, C.9): sum = 90 m_et2/(R_e2 tan a_n cos b)
+      (1 - R_m2 sin b / r_c0) deg, theta_a2 = sum h_am2/h_mw, theta_f2 = sum - theta_a2;
+      sample 1's printed inputs (theta_a2 = 2.1342, sum = 8.6276 deg) are exactly these;
+    * modified-slot (C.6, C.10): sum = min(C.5, 1.3 sum_standard) -- r_c0 = 114.3 mm
+      takes the 1.3 cap (7.35 < 8.63 deg), r_c0 = 90 mm the C.5 value (7.04 deg);
+    * manual: the given angles.
+
+    Same formulae in a different arithmetic: 1e-13 rad (measured <= 2e-16 rad).
+    Printed sample values: 2e-4 deg (4 decimals, from the sample's rounded inputs;
+    measured 4e-5 deg for theta_a2, 1.3e-4 deg for the sum).
+    Then the face/root angles (140)-(149) with a = 0 (constant clearance)."""
     u = 39 / 14
     pc = iso.method0_pitch_cones(u, D(90.0), 176.893, 25.4, D(35.0))
     khap, khfp, xhm1 = _type2_to_type1(0.24737, 2.0, 0.125)
-    r = iso.gear_dimensions(pc, z1=14.0, u=u, Sigma=D(90.0), a=0.0, b2=25.4, rc0=114.3,
+    r = iso.gear_dimensions(pc, z1=14.0, u=u, Sigma=D(90.0), a=0.0, b2=25.4, rc0=rc0,
                             alpha_dD=D(20.0), alpha_dC=D(20.0), f_alim=0.0, khap=khap,
-                            khfp=khfp, xhm1=xhm1, taper=taper, pinion_rule="method0")
-    ta2, tf2 = np.rad2deg(float(r["theta_a2"])), np.rad2deg(float(r["theta_f2"]))
-    if taper == "constant-slot":
-        np.testing.assert_allclose([ta2, ta2 + tf2], [2.1342, 8.6276], atol=2e-3)
-    elif taper == "standard":
-        # addendum angles from the mating dedendum over the mean cone distance (C.3)
-        np.testing.assert_allclose(np.tan(float(r["theta_a2"])) * float(pc["Rm1"]),
-                                   r["hfm1"], rtol=1e-13)
+                            khfp=khfp, xhm1=xhm1, taper=taper, theta_a2=D(1.5),
+                            theta_f2=D(4.5), pinion_rule="method0")
+    h = _sample1_by_hand(rc0)
+    std_a, std_f = np.arctan(h["hfm1"] / h["Rm"]), np.arctan(h["hfm2"] / h["Rm"])
+    if taper == "standard":
+        ta2, tf2 = std_a, std_f
     elif taper == "uniform":
-        assert ta2 == 0.0 and tf2 == 0.0
+        ta2, tf2 = 0.0, 0.0
+    elif taper == "manual":
+        ta2, tf2 = D(1.5), D(4.5)
     else:
-        Rm = float(pc["Rm1"])
-        s_std = np.arctan(float(r["hfm1"]) / Rm) + np.arctan(float(r["hfm2"]) / Rm)
-        assert np.deg2rad(ta2 + tf2) <= 1.3 * s_std + 1e-15
-    # constant clearance for any taper (7.4, a = 0): the pinion face cone is parallel
-    # to the wheel root cone and vice versa, delta_a1 + delta_f2 = Sigma
+        tot = h["s_c"] if taper == "constant-slot" else min(h["s_c"], 1.3 * (std_a + std_f))
+        if taper == "modified-slot":      # the intended branch of the min is taken
+            assert (tot == h["s_c"]) == (rc0 == 90.0)
+        ta2 = tot * h["ham2"] / h["hmw"]
+        tf2 = tot - ta2
+    np.testing.assert_allclose([float(r["theta_a2"]), float(r["theta_f2"])], [ta2, tf2],
+                               rtol=0, atol=1e-13)
+    if taper == "constant-slot":
+        # printed to 4 decimals from rounded sample inputs: measured 4e-5 / 1.3e-4 deg
+        np.testing.assert_allclose(np.rad2deg([ta2, ta2 + tf2]), [2.1342, 8.6276], atol=2e-4)
+    # face and root angles (140), (141); a = 0: constant clearance (146)-(149)
+    d2 = h["d2"]
+    np.testing.assert_allclose([float(r["delta_a2"]), float(r["delta_f2"])],
+                               [d2 + ta2, d2 - tf2], rtol=0, atol=1e-13)
+    np.testing.assert_allclose([float(r["theta_a1"]), float(r["theta_f1"])], [tf2, ta2],
+                               rtol=0, atol=1e-13)
     np.testing.assert_allclose(r["delta_a1"] + r["delta_f2"], D(90.0), atol=1e-14)
     np.testing.assert_allclose(r["delta_f1"] + r["delta_a2"], D(90.0), atol=1e-14)
+
+
+def test_physical_branch_rules():
+    """The documented admissibility rules of a pitch-cone root, one at a time: pitch
+    angles in (0, Sigma), R_m1 > 0, rho_lim > 0 and delta1 + delta2 <= Sigma (an offset
+    opens the cones up, it never closes them: ISO 23509 6.2.2, Method 1 always gives
+    delta1 + delta2 < Sigma for a != 0 -- checked on sample 2)."""
+    S = D(90.0)
+    ok = (D(20.0), D(69.0), S, 70.0, 60.0)
+    assert bool(iso.physical_branch(*ok))
+    for i, bad in [(0, -D(1.0)), (1, -D(1.0)), (0, D(95.0)), (3, -5.0), (4, -60.0),
+                   (1, D(70.5))]:                            # last: delta1 + delta2 > Sigma
+        args = list(ok)
+        args[i] = bad
+        assert not bool(iso.physical_branch(*args)), (i, bad)
+    pc = iso.method1_pitch_cones(42 / 13, S, 15.0, 170.0, 30.0, D(50.0), 63.5)
+    assert 0 < float(S - pc["delta1"] - pc["delta2"]) < D(1.0)
+
+
+def test_unknown_taper_and_pinion_rule_raise():
+    pc = iso.method0_pitch_cones(3.0, D(90.0), 170.0, 25.0, D(35.0))
+    kw = dict(z1=12.0, u=3.0, Sigma=D(90.0), a=0.0, b2=25.0, rc0=100.0, alpha_dD=D(20.0),
+              alpha_dC=D(20.0), f_alim=0.0, khap=1.0, khfp=1.25, xhm1=0.0)
+    with pytest.raises(ValueError, match="taper"):
+        iso.gear_dimensions(pc, taper="steep", **kw)
+    with pytest.raises(ValueError, match="pinion_rule"):
+        iso.gear_dimensions(pc, pinion_rule="method2", **kw)
 
 
 def test_method1_zero_offset_limit_and_gradients():

@@ -115,6 +115,10 @@ def test_same_conditions_as_iso_method1(case):
     # ISO's offset angle in the axial plane (113) is the complement of the position
     # angle of the pitch point on the gear cone
     np.testing.assert_allclose(gd["zeta_m"], np.pi / 2 - sol.theta2, atol=1e-11)
+    # ... and ISO's wheel offset angle eta (Method 1's unknown, (16)-(17)) is the
+    # position angle of the pitch point on the pinion cone: eta = -pi/2 - theta1
+    # (both routes converged to 1e-12; measured 2e-16 rad)
+    np.testing.assert_allclose(m1["eta"], -np.pi / 2 - sol.theta1, atol=1e-11)
 
 
 def test_seed_route_vs_iso_route_documented_difference():
@@ -197,6 +201,26 @@ def test_non_convergence_raises_or_flags():
     assert not bool(sol.converged)
 
 
+@pytest.mark.parametrize("case", CASES)
+def test_normal_offset_component_by_linear_algebra(case):
+    """gamma = n.x_f from the normal conditions n.u1 = -sin d1, n.u2 = sin d2, |n| = 1
+    solved with NumPy (minimum-norm solution of the 2x3 system, then the x_f part);
+    delta2_from_normal inverts it.  Round-off only: gamma^2 = 1 - |n_par|^2 cancels
+    (measured 1.1e-15, a few ulp of 1) -> 4e-15; delta2 to 1e-14 rad (measured 3e-16)."""
+    u, S, E, de2, b2, beta, rc0 = case
+    u1, u2 = np.array([0.0, np.sin(S), np.cos(S)]), np.array([0.0, 0.0, 1.0])
+    for d1, d2 in [(D(17.0), S - D(17.0) - D(0.4)), (D(25.0), S - D(25.0) - D(2.0)),
+                   (D(20.0), S - D(20.0))]:
+        n_par = np.linalg.lstsq(np.stack([u1, u2]), [-np.sin(d1), np.sin(d2)], rcond=None)[0]
+        g2 = 1.0 - n_par @ n_par                 # gamma^2 (sqrt amplifies round-off at 0)
+        g = float(pc.normal_offset_component(d1, d2, S))
+        assert g <= 0.0
+        np.testing.assert_allclose(g ** 2, g2, rtol=0, atol=4e-15)
+        # spiral-bevel limit (d1 + d2 = Sigma): gamma = 0 exactly
+        gamma = 0.0 if abs(d1 + d2 - S) < 1e-15 else -np.sqrt(g2)
+        np.testing.assert_allclose(pc.delta2_from_normal(d1, gamma, S), d2, rtol=0, atol=1e-14)
+
+
 def test_seed_machine_settings_literal_and_tilt_slip():
     u, S, E, de2, b2, beta, rc0 = CASES[0]
     sol = pc.solve_pitch_cones(u, S, E, de2, b2, beta, rc0)
@@ -204,8 +228,25 @@ def test_seed_machine_settings_literal_and_tilt_slip():
     # the seed's tilt relation sin i = tan(beta1)/tan(alpha_lim) has no solution here
     assert abs(float(jnp.tan(sol.beta1) / jnp.tan(sol.alpha_lim))) > 20
     assert not bool(ms["tilt_valid"]) and np.isnan(ms["tilt"])
-    np.testing.assert_allclose(ms["cradle"] - pc.pinion_machine_settings(sol, E, "right")["cradle"],
-                               np.pi, atol=1e-14)
+    # the reciprocal reading asin(tan alpha_lim / tan beta1), typed in
+    t = float(np.tan(sol.alpha_lim) / np.tan(sol.beta1))
+    np.testing.assert_allclose(ms["tilt_reciprocal"], np.arcsin(t), rtol=0, atol=1e-15)
+    assert -0.1 < float(ms["tilt_reciprocal"]) < 0          # alpha_lim < 0, beta1 > 0
+    # cradle angle theta2 + 90 deg (left hand) / theta2 - 90 deg (right hand), with
+    # theta2 = 90 deg - zeta_m and the offset angle in the axial plane zeta_m typed in
+    # from ISO 23509 (110), (111), (113) -- a different formula for the same angle
+    # (measured 4e-16 rad; 1e-14)
+    dm1, dm2 = 2 * sol.R1 * np.sin(sol.delta1), 2 * sol.R2 * np.sin(sol.delta2)
+    zeta_m = np.arcsin(2 * E / (dm2 + dm1 * np.cos(sol.delta2) / np.cos(sol.delta1)))
+    np.testing.assert_allclose(ms["cradle"], np.pi - zeta_m, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(pc.pinion_machine_settings(sol, E, "right")["cradle"], -zeta_m,
+                               rtol=0, atol=1e-14)
+    # gear machine centre to back X_G = a2 (seed 003), a2 = ISO t_z2 for the same cone
+    # pair: formulae (129), (131) typed in (measured 1e-14 mm; 1e-10 mm)
+    dS = S - np.pi / 2
+    tzm2 = (dm1 * np.sin(sol.delta2) / (2 * np.cos(sol.delta1))
+            - 0.5 * np.cos(zeta_m) * np.tan(dS) * (dm2 + dm1 * np.cos(sol.delta2) / np.cos(sol.delta1)))
+    np.testing.assert_allclose(ms["X_G"], sol.R2 * np.cos(sol.delta2) - tzm2, rtol=0, atol=1e-10)
     # vertical wheel base from the cone geometry: E sin(theta2) - a1, with theta2 the
     # angle of the pitch point seen from the gear axis (P_y / r2 = sin theta2)
     P = pc.cone_tangency(sol.delta1, sol.delta2, S, E, sol.R2)["P"]
