@@ -20,12 +20,22 @@ STEPS, HALF = 8, 1.5          # 25 grid positions, 1.5 pitches each side
 MID = int(round(STEPS * HALF))
 
 
-@pytest.fixture(scope="module")
-def conjugate():
+def _complementary(side):
     d = load_design("example:spiral_bevel_10x30")
-    pair = th.pair_flanks(d, "drive")
+    pair = th.pair_flanks(d, side)
     p_fl, g_fl = th.complementary_pinion(pair.gear, pair.pinion.blank)
     return th.prepare(replace(pair, pinion=p_fl, gear=g_fl))
+
+
+@pytest.fixture(scope="module")
+def conjugate():
+    return _complementary("drive")
+
+
+@pytest.fixture(scope="module")
+def coast():
+    """Coast side: pinion convex flank on gear concave flank, complementary settings."""
+    return _complementary("coast")
 
 
 def _modified(prep, d_radius, c2):
@@ -67,8 +77,10 @@ def test_cutter_radius_mismatch_localises_with_zero_te(conjugate, point_tca):
     assert np.abs(np.asarray(p.te)[on]).max() / ARCSEC < 1e-6
     a, b = np.asarray(p.semi_major)[on], np.asarray(p.semi_minor)[on]
     assert np.all(np.isfinite(a)) and np.all(a > b) and np.all(b > 0.05)
-    # bearing at the reference is the pinion's mean point (mid face)
+    # bearing at the reference is the pinion's mean point (mid face, half blade height:
+    # prepare's x_ref[:2]; measured 3e-13)
     assert abs(float(res.coords["xi1"][MID])) < 0.1
+    np.testing.assert_allclose(np.asarray(p.uv1[MID]), conjugate.x_ref[:2], rtol=0, atol=1e-9)
     # the opposite mismatch (hollow pinion) has no such contact: the flanks cross
     bad = point_tca(_modified(conjugate, -2.0, 0.0))
     conv = np.asarray(bad.path.converged)
@@ -91,9 +103,161 @@ def test_modified_roll_gives_the_parabola_of_first_order_theory(conjugate, point
     assert abs(coef[1] / theory - 1.0) < 0.01
     fit = np.polyval(np.polyfit(x, te, 2), x)
     assert np.abs(fit - te).max() < 0.02 * np.ptp(te)        # a parabola over +-1.5 pitches
-    m = res.multi
-    assert np.isfinite(float(m.ptp)) and float(m.ptp) / ARCSEC > 1.0
-    assert 1.0 < float(m.contact_ratio) < 3.0
+    _check_envelope(res, conjugate.drive, pair.z1)
+
+
+def _check_envelope(res, drive, z1):
+    """Multi-pair results of a parabolic TE against a second route.
+
+    Pair k is pair 0 shifted by k pitches p = 2 pi/z1.  The least-squares quartic P of
+    pair 0's TE (on-flank points) gives the envelope max_k P(phi - k p) (flank pushing
+    for increasing phi1, ``drive``) or min_k (the other sense), the transfer points as
+    the roots of P(phi) - P(phi + p) and P(phi - p) - P(phi) next to the vertex -+ p/2,
+    and the contact ratio lies within one grid step of the number of on-flank grid
+    steps.  The parabola must open away from the envelope's side (otherwise the far
+    pairs would carry): that is the check of the side's sense of rotation.
+    Measured (drive / coast): vertex -0.094 / +0.162 pitch from the reference; transfers
+    1.8e-5 / 1.9e-5 pitch from the quartic crossings (tolerance 2e-4 pitch), envelope
+    5.5e-7 / 2.6e-7 arcsec and p-t-p (18.89 / 18.26 arcsec) 3e-7 / 1.4e-7 arcsec from the
+    shifted quartics (tolerance 1e-5 arcsec, the quartic's fit residual); contact ratio
+    1.220 / 1.243 within [1.125, 1.375] (10 on-flank points)."""
+    p, m = res.path, res.multi
+    pitch = 2 * np.pi / z1
+    phi = np.asarray(p.phi1) - float(p.phi1[MID])
+    on = np.asarray(m.inside)[1]
+    P = np.polynomial.Polynomial.fit(phi[on], np.asarray(p.te)[on], 4).convert()
+    vertex = P.deriv().roots()
+    vertex = vertex[np.abs(vertex.imag) < 1e-9].real
+    vertex = vertex[np.argmin(np.abs(vertex))]
+    assert P.deriv(2)(vertex) * (1 if drive else -1) < 0          # opens away
+
+    def cross(shift, near):
+        r = (P - P(np.polynomial.Polynomial([shift, 1.0]))).roots()
+        r = r[np.abs(r.imag) < 1e-9].real
+        return r[np.argmin(np.abs(r - near))]
+
+    quartic = [cross(pitch, vertex - pitch / 2), cross(-pitch, vertex + pitch / 2)]
+    tr = np.asarray(m.transfer_phi1) - float(p.phi1[MID])
+    np.testing.assert_allclose(tr, quartic, rtol=0, atol=2e-4 * pitch)
+    win = np.abs(np.arange(phi.size) - MID) <= STEPS // 2
+    pk = np.stack([P(phi[win] - k * pitch) for k in (-1, 0, 1)])
+    env = pk.max(axis=0) if drive else pk.min(axis=0)
+    np.testing.assert_allclose(np.asarray(m.envelope)[win] / ARCSEC, env / ARCSEC, rtol=0,
+                               atol=1e-5)
+    assert abs(float(m.ptp) - np.ptp(env)) / ARCSEC < 1e-5
+    n_on = int(np.sum(on))
+    assert np.all(np.diff(np.nonzero(on)[0]) == 1)                  # one on-flank stretch
+    assert (n_on - 1) / STEPS <= float(m.contact_ratio) <= (n_on + 1) / STEPS
+
+
+@pytest.fixture(scope="module")
+def coast_point_tca(coast):
+    f = jax.jit(partial(th.hypoid_tca_traced, line_contact=False, steps_per_pitch=STEPS,
+                        half_pitches=HALF, n_pairs=3, drive=coast.drive))
+    return lambda pair, mis=Misalignment.zero(): f(pair, mis, jnp.asarray(coast.x_ref),
+                                                   coast.phi1_ref)
+
+
+def test_coast_complementary_pair_is_conjugate(conjugate, coast):
+    """Coast flanks (pinion convex, gear concave) of the pair cut by one crown gear:
+    conjugate, TE == 0 wherever the contact line is on both flanks (measured 1.4e-10
+    arcsec; beyond the flank the analytic extension of the gear flank switches branch,
+    s2 jumps, TE of hundreds of arc-seconds at points flagged off the flank).  The coast
+    pinion flank faces the other way, so it pushes the gear for the opposite sense of
+    pinion rotation (``drive`` flag of ``prepare`` opposite to the drive side's: the
+    envelope is the other extremum) and its cutter blade is the other side."""
+    assert coast.drive != conjugate.drive
+    assert coast.pair.pinion.cutter.sign == -conjugate.pair.pinion.cutter.sign
+    res = th.hypoid_tca(coast, line_contact=True, steps_per_pitch=STEPS, half_pitches=HALF,
+                        n_pairs=3, strict=False)
+    p = res.path
+    on = np.asarray(res.margin) >= 0.0
+    assert on.sum() >= 6 and bool(np.all(np.asarray(p.converged)))
+    assert np.abs(np.asarray(p.te)[on]).max() / ARCSEC < 1e-6
+    assert float(np.max(np.asarray(p.residual))) < 1e-10
+    assert np.all(np.isinf(np.asarray(p.semi_major)))
+    assert np.any(np.asarray(res.margin) > 1.0)
+
+
+def test_coast_localised_pair_zero_te_and_modified_roll_parabola(coast, coast_point_tca):
+    """Coast pinion (convex) with a smaller blade point radius (dR = -2 mm, the convex
+    flank made more convex lengthwise; cones tangent along the mean blade): point
+    contact with TE identically zero (measured 9e-11 arcsec) and finite ellipses.  With
+    modified roll 2C the pinion's generated lines turn by -R_a C psi^2 about its axis;
+    a turn of the tooth is seen alike by both of its flanks, so the first-order TE is
+    the drive side's (z1/z2)(C/R_a)(phi1 - phi1_0)^2 with the same sign convention.
+    The coast flank pushes for the opposite sense of rotation (max envelope here), so it
+    is eased off by 2C < 0: with 2C = -0.02 the parabola opens downwards and the pair
+    nearest its vertex carries.  Measured: quadratic coefficient -218.15 arcsec/rad^2,
+    0.34 % from theory -217.42 (tolerance 1 %, the drive side's 0.27 %); envelope,
+    transfers and contact ratio as in _check_envelope."""
+    res0 = coast_point_tca(_modified(coast, -2.0, 0.0))
+    p0 = res0.path
+    on = np.asarray(res0.margin) >= 0
+    assert on.sum() >= 6 and bool(np.all(np.asarray(p0.converged)[on]))
+    assert np.abs(np.asarray(p0.te)[on]).max() / ARCSEC < 1e-6
+    a, b = np.asarray(p0.semi_major)[on], np.asarray(p0.semi_minor)[on]
+    assert np.all(np.isfinite(a)) and np.all(a > b) and np.all(b > 0.05)
+    assert abs(float(res0.coords["xi1"][MID])) < 0.1
+    np.testing.assert_allclose(np.asarray(p0.uv1[MID]), coast.x_ref[:2], rtol=0, atol=1e-9)
+    c2 = -0.02
+    pair = _modified(coast, -2.0, c2)
+    res = coast_point_tca(pair)
+    p = res.path
+    assert bool(np.all(np.asarray(p.converged)))
+    x = np.asarray(p.phi1) - float(p.phi1[MID])
+    te = np.asarray(p.te) / ARCSEC
+    coef = np.polyfit(x, te, 3)
+    theory = (pair.z1 / pair.z2) * (0.5 * c2 / float(pair.pinion.machine.ratio_of_roll)) / ARCSEC
+    assert abs(coef[1] / theory - 1.0) < 0.01
+    _check_envelope(res, coast.drive, pair.z1)
+
+
+def _point_and_jacobian(surf, uv):
+    return surf(uv), jax.jacfwd(surf)(uv)
+
+
+def _rx_np(a):
+    c, s_ = np.cos(a), np.sin(a)
+    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s_], [0.0, s_, c]])
+
+
+def test_misaligned_contact_points_coincide_in_the_fixed_frame(conjugate, point_tca):
+    """dE 0.05, dP 0.1, dG -0.1 mm, dSigma 2e-4 rad on the localised drive pair: pinion
+    and gear contact points, each from its own flank function and its own placement as
+    defined in the tca_hypoid docstring, typed here (pinion Rz(phi1) r1 + dP e_z; gear
+    (E + dE) e_x + dG R e_z + R Rz(phi2) r2 with R = Rx(dSigma) Rx(-h Sigma)), coincide
+    and the normals (from jacfwd of the flanks) are collinear (measured 3e-14 mm,
+    2e-15; tolerance 1e-9); the reported point is that point (3e-14 mm)."""
+    pair = _modified(conjugate, 2.0, 0.02)
+    vals = (0.05, 0.1, -0.1, 2e-4)
+    res = point_tca(pair, Misalignment(*(jnp.asarray(v) for v in vals)))
+    p = res.path
+    r1 = jax.jit(partial(_point_and_jacobian, th.flank_function(pair.pinion, pair.pinion_crossing)))
+    r2 = jax.jit(partial(_point_and_jacobian, th.flank_function(pair.gear, pair.gear_crossing)))
+    R = _rx_np(vals[3]) @ _rx_np(-pair.hand * float(pair.shaft_angle))
+    centre = np.array([float(pair.offset) + vals[0], 0.0, 0.0]) + vals[2] * R[:, 2]
+
+    def rz(a):
+        c, s_ = np.cos(a), np.sin(a)
+        return np.array([[c, -s_, 0.0], [s_, c, 0.0], [0.0, 0.0, 1.0]])
+
+    def pt_n(surf, uv):
+        q, J = surf(jnp.asarray(uv))
+        n = np.cross(np.asarray(J)[:, 0], np.asarray(J)[:, 1])
+        return np.asarray(q), n / np.linalg.norm(n)
+
+    on = np.nonzero(np.asarray(res.margin) >= 0.0)[0]
+    assert on.size >= 6
+    for i in (on[0], MID, on[-1]):
+        q1, m1 = pt_n(r1, p.uv1[i])
+        q2, m2 = pt_n(r2, p.uv2[i])
+        R1, R2 = rz(float(p.phi1[i])), R @ rz(float(p.phi2[i]))
+        p1 = R1 @ q1 + np.array([0.0, 0.0, vals[1]])
+        p2 = centre + R2 @ q2
+        np.testing.assert_allclose(p1, p2, rtol=0, atol=1e-9)
+        assert np.linalg.norm(np.cross(R1 @ m1, R2 @ m2)) < 1e-9
+        np.testing.assert_allclose(np.asarray(p.point[i]), p1, rtol=0, atol=1e-9)
 
 
 def test_gradients_match_central_differences(conjugate, point_tca):
