@@ -27,7 +27,7 @@ tooth (seed 000's orientation: ``R_eff > 0`` for a convex contact).  Definitions
 (gear = member 1): ``u_e = (u1 + u2)/2``, ``u_s = u1 - u2``, ``SRR = u_s/u_e``.
 Velocities in mm per radian of pinion roll (pinion speed 1 rad/s).
 
-Reference: seed 000 (000_be2d122acb15edb3.txt) §1-§2; Litvin & Fuentes, *Gear Geometry
+Reference: seed 000 (the eigenfunction paper on conjugate surfaces) §1-§2; Litvin & Fuentes, *Gear Geometry
 and Applied Theory*, 2nd ed., ch. 8-9 (relative velocity of the contact point).
 """
 

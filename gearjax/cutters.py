@@ -31,7 +31,7 @@ normal (angle ``alpha``) to ``-z_t`` (angle ``pi/2``):
     centre (radial, axial) = (R_p + sgn*s_min, -rho_f),
     point  = centre - rho_f * (sgn cos(phi), -sin(phi)),  phi in [alpha, pi/2].
 
-Units: mm, rad.  References: seed 004 (004_bb3a6051ad34f267.txt); Litvin & Fuentes,
+Units: mm, rad.  References: seed 004 (the HFT formate hypoid paper from Gleason No. 116 settings); Litvin & Fuentes,
 *Gear Geometry and Applied Theory*, 2nd ed., ch. 21 (head-cutters for spiral bevel
 gears).
 """

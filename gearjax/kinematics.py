@@ -50,7 +50,7 @@ Orientation: every scalar above changes sign with ``n`` except SRR; ``K_II`` and
 ``t = p/|p|`` and both normal curvatures taken with the common normal ``n``
 (induced curvature, Litvin & Fuentes §8); along the contact line it is zero.
 
-Reference: seed 000_be2d122acb15edb3.txt §1; Wu Xutang, *Principle of Gearing*
+Reference: seed 000 (the eigenfunction paper on conjugate surfaces) §1; Wu Xutang, *Principle of Gearing*
 (eigenfunctions); Litvin & Fuentes, *Gear Geometry and Applied Theory*, ch. 8–9.
 """
 

@@ -57,7 +57,7 @@ tilted cutter axis.  The seed gives only ``a11``; the remaining elements follow 
 this product and are tested by an independent route (both transforms place every
 cutter point on the same cone).
 
-Units: mm, rad.  References: seed 004 (004_bb3a6051ad34f267.txt), seed 003;
+Units: mm, rad.  References: seed 004 (the HFT formate hypoid paper from Gleason No. 116 settings), seed 003;
 Litvin & Fuentes, *Gear Geometry and Applied Theory*, 2nd ed., ch. 21-22.
 """
 

@@ -14,7 +14,7 @@ float64 parameter vector ``x`` (scaled by the caller to O(1)) and hands it here:
 
 Both return an :class:`OptResult` with the history of objective values, so a study
 can report how it got there; neither prints.  Reference: Kingma & Ba, Adam (2015);
-Byrd, Lu, Nocedal & Zhu, L-BFGS-B (1995); DESIGN.md "Dependencies".
+Byrd, Lu, Nocedal & Zhu, L-BFGS-B (1995).
 """
 
 from __future__ import annotations

@@ -23,7 +23,7 @@ the seed's slant length ``u`` (from the pitch plane, positive towards the gear
 root) is ``u = u_root - s``, ``u_root = h_fm2/cos(a)``; point radius
 ``R_p = r0 + shift - sb u_root sin(a)``, blade sign ``-sb``.
 
-Units: mm, rad.  Reference: seed 000 (000_be2d122acb15edb3.txt) §2.
+Units: mm, rad.  Reference: seed 000 (the eigenfunction paper on conjugate surfaces) §2.
 """
 
 from __future__ import annotations

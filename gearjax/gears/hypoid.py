@@ -8,7 +8,7 @@ the work frame and ``n_w`` its unit normal:
 
 * meshing equation (generated members)      f1 = n_w . dr_w/dpsi = 0   (mm/rad)
   The relative velocity is the autodiff derivative ``dr_w/dpsi`` of the carried
-  cutter point (DESIGN.md), not a hand-derived velocity formula; it equals seed
+  cutter point (the project's design rule), not a hand-derived velocity formula; it equals seed
   004's ``(omega_c - omega_w) x r + omega_w x R`` per unit cradle roll.
 * face-width condition                      f2 = l_p(r_w) - l_p(xi0) = 0   (mm)
   with the distance along the pitch generatrix ``l_p = cos(gp) x_A + sin(gp) R_A``
@@ -42,7 +42,7 @@ Work frame: origin at the pitch-cone apex, ``z_w`` the work axis pointing from t
 apex towards the heel; ``x_A = z_w``, ``R_A = sqrt(x_w^2 + y_w^2)``.
 Normals point out of the tooth material into the tooth space.
 
-Units: mm, rad.  References: seed 004 (004_bb3a6051ad34f267.txt); Litvin & Fuentes,
+Units: mm, rad.  References: seed 004 (the HFT formate hypoid paper from Gleason No. 116 settings); Litvin & Fuentes,
 *Gear Geometry and Applied Theory*, 2nd ed., ch. 6 (envelopes) and ch. 21-22.
 """
 

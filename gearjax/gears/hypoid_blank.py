@@ -21,7 +21,7 @@ Units inside: mm and rad.  Degrees appear only in ``from_dict``/``to_dict``/
 ``to_table``.  The geometry does not depend on the hand of spiral (mirror image);
 ``hand`` only selects the sign of the seed-003 cradle angle.
 
-Reference: ISO 23509:2016; seed 003 (``003_63264449d3453d54.txt``); docs in
+Reference: ISO 23509:2016; seed 003 (the hypoid pitch-cone tangency paper); docs in
 ``docs/hypoid_blank.md``.
 """
 

@@ -1,6 +1,6 @@
 """Meshing characteristics of a hypoid pair by eigenfunctions (seed 000, sections 2-3).
 
-The model of seed 000 ``000_be2d122acb15edb3.txt``: the gear flank is the surface
+The model of seed 000 (the eigenfunction paper on conjugate surfaces): the gear flank is the surface
 of a face-mill cutter placed at the pitch point and carried about the gear axis;
 the eigenfunctions of section 1 (:mod:`gearjax.kinematics`) then give the local
 kinematics of the gear and its conjugate pinion at every point of the flank.

@@ -1,6 +1,6 @@
 """Hypoid pitch cones by the tangency-contact condition (seed 003).
 
-Seed 003 (``003_63264449d3453d54.txt``) states the pitch-cone problem of a hypoid
+Seed 003 (the hypoid pitch-cone tangency paper) states the pitch-cone problem of a hypoid
 pair as the tangency of two skew cones: at the pitch point P the two cones have
 a common point (3 equations) and parallel normals (2 equations), equations (1)-(5);
 the wheel mean point is at mid face, ``r2 = (D - b sin delta2)/2`` (7); the pinion
