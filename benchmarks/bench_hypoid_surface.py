@@ -24,10 +24,10 @@ import jax.numpy as jnp
 import numpy as np
 from scipy.optimize import fsolve
 
-from gearjax.gears.hypoid import (face_apex_offset, flank_points, flank_surface, mid_estimate,
+from gearjax.gears.hypoid.flank import (face_apex_offset, flank_points, flank_surface, mid_estimate,
                                   solve_tip)
-from gearjax.io import load_design
-from gearjax.machines import work_to_machine
+from gearjax.gears.hypoid.design_file import load_design
+from gearjax.gears.hypoid.machine import work_to_machine
 
 
 def numpy_model(fl):
@@ -37,7 +37,7 @@ def numpy_model(fl):
     gp, gF = float(b.pitch_angle), float(b.face_angle)
     Ao, F = float(b.outer_cone_distance), float(b.face_width)
     xpf = float(face_apex_offset(b))
-    from gearjax.machines import cutter_to_cradle
+    from gearjax.gears.hypoid.machine import cutter_to_cradle
     Mc = np.asarray(cutter_to_cradle(ms))
     M0 = np.asarray(work_to_machine(ms, 0.0))
     Ra, C2, D6 = float(ms.ratio_of_roll), float(ms.modified_roll_2c), float(ms.modified_roll_6d)

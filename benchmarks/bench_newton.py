@@ -1,7 +1,7 @@
 """Newton throughput on envelope points, and the cost of gradients.
 
 Workload: 10^4 points of a rack-generated helical involute flank
-(:func:`gearjax.gears.involute.generated_flank`): each point solves the meshing
+(:func:`gearjax.gears.involute.geometry.generated_flank`): each point solves the meshing
 equation n.dr/dpsi = 0 for psi by the implicit-differentiated Newton.
 
 Baseline in the same process: a per-point ``scipy.optimize.fsolve`` loop on the
@@ -25,7 +25,7 @@ import numpy as np
 from scipy.optimize import fsolve
 
 import gearjax  # noqa: F401  (x64)
-from gearjax.gears.involute import generated_flank, rack_flank
+from gearjax.gears.involute.geometry import generated_flank, rack_flank
 
 
 def timeit(f, repeat=5):

@@ -18,9 +18,9 @@ import jax.numpy as jnp
 import numpy as np
 from scipy.optimize import fsolve
 
-from gearjax.gears.involute import InvolutePair, generated_flank
+from gearjax.gears.involute.geometry import InvolutePair, generated_flank
 from gearjax.tca import ARCSEC, Misalignment, contact_equations
-from gearjax.tca_involute import (InvoluteTCA, _reference_guess, crowned_pinion_flank,
+from gearjax.gears.involute.tca import (InvoluteTCA, _reference_guess, crowned_pinion_flank,
                                   involute_assembly, involute_tca, misalignment_sensitivity)
 
 

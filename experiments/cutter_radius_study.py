@@ -1,7 +1,7 @@
 """Seed 000: influence of the cutter-head radius on hypoid meshing characteristics.
 
 Reproduces seed 000 (``000_be2d122acb15edb3.txt``) sections 2-3 with
-:mod:`gearjax.gears.hypoid_kinematics`: the 6/39, 230 mm, E = 35 mm gear set
+:mod:`gearjax.studies.cutter_radius`: the 6/39, 230 mm, E = 35 mm gear set
 designed with 6-, 7.5- and 9-inch cutters (blank by the seed-003 tangency route,
 r0 as input; assumptions in docs/kinematics_study.md), Table 1 side by side with
 the seed, fields over the working gear flank (drive = convex side; the coast side
@@ -28,10 +28,10 @@ from pathlib import Path
 
 import numpy as np
 
-from gearjax.gears import hypoid_kinematics as hk
-from gearjax.gears.hypoid_blank import blank_geometry
+from gearjax.studies import cutter_radius as hk
+from gearjax.gears.hypoid.blank import blank_geometry
 from gearjax.io import atomic_write
-from gearjax.plot_kinematics import field_maps, save_figure, trend_plot
+from gearjax.plot.kinematics import field_maps, save_figure, trend_plot
 
 OUT = Path(__file__).resolve().parent / "results"
 
@@ -64,10 +64,10 @@ def _limits(f):
 
 def table1(log):
     rows = {}
-    for name, r0 in hk.SEED000_CUTTERS.items():
+    for name, r0 in hk.STUDY_CUTTERS.items():
         out = {}
-        for method in ("seed003-tangency", "iso23509-method1"):
-            b = blank_geometry(hk.seed000_blank_input(r0, method=method))
+        for method in ("tangent-cones", "iso23509-method1"):
+            b = blank_geometry(hk.study_blank_input(r0, method=method))
             out[method] = dict(b1=float(b.b1), alpha_D=math.degrees(float(b.alpha_nD)),
                                alpha_C=math.degrees(float(b.alpha_nC)),
                                delta1=math.degrees(float(b.delta1)),
@@ -95,7 +95,7 @@ def main(argv=None):
         sys.stderr.write(f"[{time.time() - t0:6.1f} s] {msg}\n")
 
     OUT.mkdir(parents=True, exist_ok=True)
-    res = {"seed": "000_be2d122acb15edb3.txt", "blank_input": hk.SEED000_BLANK,
+    res = {"seed": "000_be2d122acb15edb3.txt", "blank_input": hk.STUDY_BLANK,
            "grid": list(shape), "units": {"u_e, u_s": "mm per rad of pinion roll",
                                           "r_eff": "mm", "k_II": "1/mm", "srr": "-",
                                           "phi": "eigenfunction units (mm/rad^2 scale)"}}
@@ -103,10 +103,10 @@ def main(argv=None):
 
     # fields for the three cutters, both flanks
     fields, cases = {}, {}
-    for name, r0 in hk.SEED000_CUTTERS.items():
-        inp = hk.seed000_blank_input(r0)
+    for name, r0 in hk.STUDY_CUTTERS.items():
+        inp = hk.study_blank_input(r0)
         for flank in ("convex", "concave"):
-            s, f = hk.flank_fields(inp, hk.Settings.make(r0), flank, shape)
+            s, f = hk.flank_fields(inp, hk.StudySettings.make(r0), flank, shape)
             cases[f"{name}/{flank}"] = {"r0_mm": r0, "flank": flank,
                                         "blade_angle_deg": math.degrees(float(s.blade)),
                                         "stats": _stats(f), "limits": _limits(f)}
@@ -120,14 +120,14 @@ def main(argv=None):
     for flank in ("convex", "concave"):
         t = {}
         for q in ("abs_u_e", "abs_srr", "r_eff"):
-            t[q] = {stat: [cases[f"{n}/{flank}"]["stats"][q][stat] for n in hk.SEED000_CUTTERS]
+            t[q] = {stat: [cases[f"{n}/{flank}"]["stats"][q][stat] for n in hk.STUDY_CUTTERS]
                     for stat in ("mean", "min", "max")}
-        t["order"] = list(hk.SEED000_CUTTERS)
+        t["order"] = list(hk.STUDY_CUTTERS)
         trend[flank] = t
     res["trend"] = trend
 
     # continuous sweep by vmap with derivatives
-    inp = hk.seed000_blank_input(95.25)
+    inp = hk.study_blank_input(95.25)
     r0s = np.linspace(70.0, 125.0, nsweep)
     vals, ders = hk.cutter_radius_sweep(inp, r0s, shape=sshape)
     res["sweep"] = {"grid": list(sshape), "r0_mm": r0s.tolist(),
@@ -136,7 +136,7 @@ def main(argv=None):
     log("sweep")
 
     # gradients vs central differences at the 7.5-inch design
-    st = hk.Settings.make(95.25)
+    st = hk.StudySettings.make(95.25)
     g = hk.statistics_gradient(inp, st, shape=sshape)
     gc = {}
     for var, h in (("cutter_radius", 1e-2), ("blade_angle_delta", 1e-5), ("cutter_shift", 1e-3)):
@@ -144,7 +144,7 @@ def main(argv=None):
             kw = {"cutter_radius": st.cutter_radius, "blade_angle_delta": st.blade_angle_delta,
                   "cutter_shift": st.cutter_shift}
             kw[var] = kw[var] + d
-            return hk.flank_statistics(inp, hk.Settings(**kw), shape=sshape)
+            return hk.flank_statistics(inp, hk.StudySettings(**kw), shape=sshape)
         fp, fm = at(h), at(-h)
         for nm in ("mean_abs_srr", "max_abs_srr", "mean_r_eff", "min_r_eff", "mean_abs_u_e"):
             ad = float(getattr(g[nm], var))
@@ -159,7 +159,7 @@ def main(argv=None):
     final = {"cutter_radius_mm": float(best.cutter_radius),
              "blade_angle_delta_deg": math.degrees(float(best.blade_angle_delta)),
              "cutter_shift_mm": float(best.cutter_shift)}
-    inp_best = hk.seed000_blank_input(final["cutter_radius_mm"])
+    inp_best = hk.study_blank_input(final["cutter_radius_mm"])
     s0, f0 = hk.flank_fields(inp, st, "convex", shape)
     s1, f1 = hk.flank_fields(inp_best, best, "convex", shape)
     res["optimisation"] = {
@@ -182,7 +182,7 @@ def main(argv=None):
     keys = ["mean_abs_u_e", "mean_abs_srr", "max_abs_srr", "mean_r_eff", "min_r_eff"]
     save_figure(trend_plot(r0s, {k: np.asarray(vals[k]) for k in keys},
                            {k: np.asarray(ders[k]) for k in keys},
-                           marks=list(hk.SEED000_CUTTERS.values())),
+                           marks=list(hk.STUDY_CUTTERS.values())),
                 OUT / "cutter_radius_trends.png", dpi=70)
     import matplotlib.pyplot as plt
     fig = field_maps({"start 7.5in": f0, "optimised": f1})

@@ -1,4 +1,4 @@
-"""Local synthesis of the spiral-bevel example 10/30 (gearjax.synthesis).
+"""Local synthesis of the spiral-bevel example 10/30 (gearjax.gears.hypoid.synthesis).
 
 Gear settings of ``example:spiral_bevel_10x30`` (drive side; coast optional), pinion
 synthesised for the default targets (bearing at mid face / mid working depth,
@@ -21,20 +21,21 @@ from pathlib import Path
 
 import numpy as np
 
-from gearjax import synthesis as sy
-from gearjax import tca_hypoid as th
-from gearjax.io import atomic_write, dumps_toml, load_design
+from gearjax.gears.hypoid import synthesis as sy
+from gearjax.gears.hypoid import tca as th
+from gearjax.io import atomic_write, dumps_toml
+from gearjax.gears.hypoid.design_file import load_design
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "gearjax" / "examples" / \
     "spiral_bevel_10x30_synthesised.toml"
 
 HEADER = """\
-# Spiral-bevel set 10/30 with a synthesised (localised) pinion: gearjax.synthesis,
+# Spiral-bevel set 10/30 with a synthesised (localised) pinion: gearjax.gears.hypoid.synthesis,
 # written by experiments/synthesis_spiral_bevel.py.  Units: mm and degrees.
 # Gear: the blades and cradle positions of example spiral_bevel_10x30, re-generated
 # as the complementary crown-gear pair (machine root angle = pitch angle, ratio of
 # roll 1/sin(delta2), sliding base = -mean dedendum), see
-# gearjax.tca_hypoid.complementary_pinion.
+# gearjax.gears.hypoid.tca.complementary_pinion.
 # Pinion: {sides_note}
 # Drive-side targets at the mean contact: bearing at mid face (xi1 = 0) and mid
 # working depth (h1 = {h1:.4f} mm above the pinion root cone), TE drop 8 arcsec from
@@ -51,7 +52,7 @@ def fmt_v(v):
 
 
 def run_side(design, side, v0, targets=None):
-    """Synthesise one side (``targets``: :class:`gearjax.synthesis.Targets`, default the
+    """Synthesise one side (``targets``: :class:`gearjax.gears.hypoid.synthesis.Targets`, default the
     defaults), time it cold and warm, verify by a full TCA; returns (result, info)."""
     t = time.perf_counter()
     st = sy.start(design, side)
@@ -115,7 +116,7 @@ def main(argv=None):
         d, pairs, name="spiral_bevel_10x30_synthesised",
         description="Spiral-bevel set 10/30 of spiral_bevel_10x30: complementary gear, pinion "
                     "from local synthesis (bearing mid flank, 8 arcsec TE, 60 deg path, 5 mm ellipse)",
-        source="gearjax example, gearjax.synthesis (experiments/synthesis_spiral_bevel.py)")
+        source="gearjax example, gearjax.gears.hypoid.synthesis (experiments/synthesis_spiral_bevel.py)")
     if not a.no_write:
         atomic_write(EXAMPLE, HEADER.format(sides_note=note, h1=h1) + "\n" + dumps_toml(out.data))
         back = load_design("example:spiral_bevel_10x30_synthesised")

@@ -22,10 +22,11 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax import tca_hypoid as th
-from gearjax.io import atomic_write, load_design
+from gearjax.gears.hypoid import tca as th
+from gearjax.io import atomic_write
+from gearjax.gears.hypoid.design_file import load_design
 from gearjax.newton import newton_solve
-from gearjax.plot_tca import save_tca_plot
+from gearjax.plot.tca import save_tca_plot
 from gearjax.tca import ARCSEC, Misalignment, contact_equations
 
 OUT = Path(__file__).parent / "results"

@@ -16,7 +16,7 @@ from functools import reduce
 
 import jax.numpy as jnp
 
-__all__ = ["rot_x", "rot_y", "rot_z", "rot_axis", "translate", "compose",
+__all__ = ["matrix_x", "matrix_y", "matrix_z", "matrix_axis", "rotate_about", "rot_x", "rot_y", "rot_z", "rot_axis", "translate", "compose",
            "apply_point", "apply_vector", "rotation_part", "translation_part", "inverse"]
 
 
@@ -26,34 +26,61 @@ def _hom(R, t=None):
     return jnp.concatenate([top, jnp.array([[0.0, 0.0, 0.0, 1.0]], dtype)], axis=0)
 
 
-def rot_x(angle):
-    """Active rotation by ``angle`` (rad) about the x axis, as a 4x4 transform."""
+def matrix_x(angle):
+    """3x3 active rotation by ``angle`` (rad) about the x axis."""
     c, s = jnp.cos(angle), jnp.sin(angle)
     o, z = jnp.ones_like(c), jnp.zeros_like(c)
-    return _hom(jnp.stack([jnp.stack([o, z, z]), jnp.stack([z, c, -s]), jnp.stack([z, s, c])]))
+    return jnp.stack([jnp.stack([o, z, z]), jnp.stack([z, c, -s]), jnp.stack([z, s, c])])
+
+
+def matrix_y(angle):
+    """3x3 active rotation by ``angle`` (rad) about the y axis."""
+    c, s = jnp.cos(angle), jnp.sin(angle)
+    o, z = jnp.ones_like(c), jnp.zeros_like(c)
+    return jnp.stack([jnp.stack([c, z, s]), jnp.stack([z, o, z]), jnp.stack([-s, z, c])])
+
+
+def matrix_z(angle):
+    """3x3 active rotation by ``angle`` (rad) about the z axis."""
+    c, s = jnp.cos(angle), jnp.sin(angle)
+    o, z = jnp.ones_like(c), jnp.zeros_like(c)
+    return jnp.stack([jnp.stack([c, -s, z]), jnp.stack([s, c, z]), jnp.stack([z, z, o])])
+
+
+def matrix_axis(axis, angle):
+    """3x3 active rotation by ``angle`` about ``axis`` (normalised here), Rodrigues'
+    formula ``R = I + sin(a) K + (1 - cos(a)) K^2`` with ``K = [k]_x``."""
+    k = jnp.asarray(axis, float)
+    k = k / jnp.linalg.norm(k)
+    K = jnp.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+    return jnp.eye(3) + jnp.sin(angle) * K + (1.0 - jnp.cos(angle)) * (K @ K)
+
+
+def rotate_about(axis, angle, x):
+    """Rotate the vector ``x`` by ``angle`` about the *unit* ``axis`` through the origin
+    (Rodrigues: ``x cos a + (k x x) sin a + k (k.x)(1 - cos a)``)."""
+    c, s = jnp.cos(angle), jnp.sin(angle)
+    return c * x + s * jnp.cross(axis, x) + (1.0 - c) * jnp.dot(axis, x) * axis
+
+
+def rot_x(angle):
+    """Active rotation by ``angle`` (rad) about the x axis, as a 4x4 transform."""
+    return _hom(matrix_x(angle))
 
 
 def rot_y(angle):
     """Active rotation by ``angle`` (rad) about the y axis, as a 4x4 transform."""
-    c, s = jnp.cos(angle), jnp.sin(angle)
-    o, z = jnp.ones_like(c), jnp.zeros_like(c)
-    return _hom(jnp.stack([jnp.stack([c, z, s]), jnp.stack([z, o, z]), jnp.stack([-s, z, c])]))
+    return _hom(matrix_y(angle))
 
 
 def rot_z(angle):
     """Active rotation by ``angle`` (rad) about the z axis, as a 4x4 transform."""
-    c, s = jnp.cos(angle), jnp.sin(angle)
-    o, z = jnp.ones_like(c), jnp.zeros_like(c)
-    return _hom(jnp.stack([jnp.stack([c, -s, z]), jnp.stack([s, c, z]), jnp.stack([z, z, o])]))
+    return _hom(matrix_z(angle))
 
 
 def rot_axis(axis, angle):
     """Active rotation by ``angle`` about the unit vector ``axis`` (Rodrigues' formula)."""
-    k = jnp.asarray(axis, float)
-    k = k / jnp.linalg.norm(k)
-    K = jnp.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
-    R = jnp.eye(3) + jnp.sin(angle) * K + (1.0 - jnp.cos(angle)) * (K @ K)
-    return _hom(R)
+    return _hom(matrix_axis(axis, angle))
 
 
 def translate(dx=0.0, dy=0.0, dz=0.0):

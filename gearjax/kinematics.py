@@ -62,7 +62,7 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
-from .surfaces import curvature_in_direction, local_geometry
+from gearjax.surfaces import curvature_in_direction, local_geometry
 
 __all__ = ["Mesh", "parallel_axes", "crossed_axes", "relative_velocity", "Kinematics",
            "eigen_kinematics", "surface_kinematics"]

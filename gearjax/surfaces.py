@@ -41,7 +41,7 @@ from typing import Callable, NamedTuple
 import jax
 import jax.numpy as jnp
 
-from .newton import NewtonResult, newton_solve
+from gearjax.newton import NewtonResult, newton_solve
 
 __all__ = [
     "tangents", "unit_normal", "fundamental_forms", "weingarten", "LocalGeometry",

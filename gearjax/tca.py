@@ -63,9 +63,9 @@ contact ellipse ``t.B.t/2 = delta`` has semi-axes ``sqrt(2 delta/lambda_i)``
 infinite (reported as ``inf``).
 
 Family adapters build the flanks, the assembly, the initial guess and the flank
-boundaries: :mod:`gearjax.tca_involute` (rack-generated involute pairs) and
-:mod:`gearjax.tca_hypoid` (face-milled spiral-bevel and hypoid pairs).  Figures:
-:mod:`gearjax.plot_tca`; CLI: ``gearjax tca``; documentation: ``docs/tca.md``.
+boundaries: :mod:`gearjax.gears.involute.tca` (rack-generated involute pairs) and
+:mod:`gearjax.gears.hypoid.tca` (face-milled spiral-bevel and hypoid pairs).  Figures:
+:mod:`gearjax.plot.tca`; CLI: ``gearjax tca``; documentation: ``docs/tca.md``.
 
 Units: mm, rad inside; arc-seconds only in keys/fields named ``*_arcsec``.
 """
@@ -79,9 +79,10 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from .errors import ConvergenceError, check_int, check_range, require_converged
-from .newton import newton_solve
-from .surfaces import GeneratedSurface, local_geometry, unit_normal
+from gearjax.frames import matrix_axis, matrix_z
+from gearjax.errors import ConvergenceError, check_int, check_range, require_converged
+from gearjax.newton import newton_solve
+from gearjax.surfaces import GeneratedSurface, local_geometry, unit_normal
 
 __all__ = ["Misalignment", "Assembly", "contact_equations", "point_normal", "gear_mount",
            "ContactPath", "contact_path", "te_arcsec", "require_path",
@@ -150,16 +151,8 @@ class Assembly:
 
 
 def rotation_about(axis, angle):
-    """Rodrigues rotation matrix about the unit ``axis`` by ``angle`` (rad)."""
-    k = axis / jnp.linalg.norm(axis)
-    K = jnp.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
-    return jnp.eye(3) + jnp.sin(angle) * K + (1.0 - jnp.cos(angle)) * (K @ K)
-
-
-def _rz(phi):
-    c, s = jnp.cos(phi), jnp.sin(phi)
-    o, z = jnp.ones_like(phi), jnp.zeros_like(phi)
-    return jnp.array([[c, -s, z], [s, c, z], [z, z, o]])
+    """Rodrigues rotation matrix about ``axis`` by ``angle`` (rad); :func:`gearjax.frames.matrix_axis`."""
+    return matrix_axis(axis, angle)
 
 
 def gear_mount(asm: Assembly, mis: Misalignment):
@@ -309,8 +302,8 @@ def contact_equations(r1: Callable, r2: Callable, asm: Assembly, mis: Misalignme
 
     def F(x, ph1):
         uv1, uv2, ph2 = unpack(x)
-        R1 = _rz(ph1)
-        R2 = R @ _rz(ph2)
+        R1 = matrix_z(ph1)
+        R2 = R @ matrix_z(ph2)
         q1, m1 = point_normal(r1, uv1)
         q2, m2 = point_normal(r2, uv2)
         p1 = R1 @ q1 + mis.dP * ez
@@ -354,7 +347,7 @@ def contact_path(r1: Callable, r2: Callable, asm: Assembly, mis: Misalignment, p
 
     def frames(x, ph1):
         uv1, uv2, ph2 = unpack(x)
-        return uv1, uv2, ph2, _rz(ph1), R @ _rz(ph2)
+        return uv1, uv2, ph2, matrix_z(ph1), R @ matrix_z(ph2)
 
     x0 = jax.lax.stop_gradient(pack(jnp.asarray(x_ref, float)))
     # one scan, vmapped over the two directions (forwards from the reference and

@@ -89,7 +89,7 @@ def test_stribeck_bad_input(capsys, tmp_path):
 
 
 def test_mesh_friction_figure_written_atomically(tmp_path):
-    from gearjax.plot_tribology import mesh_friction_figure, save_figure_atomic
+    from gearjax.plot.tribology import mesh_friction_figure, save_figure_atomic
     fig = mesh_friction_figure(np.linspace(0, 1, 5), np.array([[0.05, 0.0], [0.04, 0.03]] * 2 + [[0.0, 0.05]]),
                                power_loss_W=np.arange(5.0))
     path = save_figure_atomic(fig, tmp_path / "m.png")

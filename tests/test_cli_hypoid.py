@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from gearjax.cli import main
-from gearjax.io import load_design
+from gearjax.gears.hypoid.design_file import load_design
 
 
 def test_example_list_and_show(capsys):

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from gearjax.cli import main
-from gearjax.gears.involute import InvolutePair, closed_form_path
+from gearjax.gears.involute.geometry import InvolutePair, closed_form_path
 
 ARGS = ["involute", "--z1", "20", "--z2", "40", "--module", "4", "--pressure-angle", "20",
         "--helix", "15", "--x1", "0.2", "--x2", "0", "--points", "5", "--rpm", "1500"]

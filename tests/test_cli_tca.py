@@ -6,7 +6,7 @@ import json
 import numpy as np
 
 from gearjax.cli import main
-from gearjax.gears.involute import InvolutePair, pair_geometry
+from gearjax.gears.involute.geometry import InvolutePair, pair_geometry
 
 DESIGN = "involute:z1=25,z2=41,m=2,alpha=20,b=20,crown=1e-4"
 

@@ -1,4 +1,4 @@
-"""Straight-blade face-mill cutter (gearjax.cutters): seed 004 surface, normals, fillet."""
+"""Straight-blade face-mill cutter (gearjax.gears.hypoid.cutter): seed 004 surface, normals, fillet."""
 
 import math
 
@@ -6,7 +6,7 @@ import jax
 import numpy as np
 import pytest
 
-from gearjax.cutters import (blade_radius, cutter_normal, cutter_point, cutter_tangents,
+from gearjax.gears.hypoid.cutter import (blade_radius, cutter_normal, cutter_point, cutter_tangents,
                              fillet_normal, fillet_point, fillet_start, make_cutter)
 
 

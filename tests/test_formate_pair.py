@@ -1,4 +1,4 @@
-"""Formate gears and the pinions they generate (gearjax.formate_pair): machine settings
+"""Formate gears and the pinions they generate (gearjax.gears.hypoid.formate): machine settings
 from placements, and hypoid (offset) conjugacy through TCA."""
 
 import math
@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 
 from gearjax import frames
-from gearjax import tca_hypoid as th
-from gearjax.formate_pair import formate_from_placement, generating_gear_pinion, settings_from_frames
-from gearjax.gears.hypoid import work_point
-from gearjax.io import load_design
-from gearjax.machines import MachineSettings, cutter_to_cradle, cutter_to_work, work_to_machine
+from gearjax.gears.hypoid import tca as th
+from gearjax.gears.hypoid.formate import formate_from_placement, generating_gear_pinion, settings_from_frames
+from gearjax.gears.hypoid.flank import work_point
+from gearjax.gears.hypoid.design_file import load_design
+from gearjax.gears.hypoid.machine import MachineSettings, cutter_to_cradle, cutter_to_work, work_to_machine
 from gearjax.tca import ARCSEC
 
 FIELDS = ("radial_distance", "cradle_angle", "tilt", "swivel", "blank_offset",
@@ -160,7 +160,7 @@ def test_hypoid_modified_roll_gives_theoretical_parabola(localised):
 def test_contact_point_velocity_matches_central_differences(localised):
     """The implicit derivative of the contact (contact-point velocity, actual gear
     speed) against 4th-order central differences of the path."""
-    from gearjax.contact_kinematics import path_kinematics
+    from gearjax.gears.hypoid.contact_kinematics import path_kinematics
     prep, out = localised
     k = path_kinematics(prep.pair, out.path)
     h = float(out.path.phi1[1] - out.path.phi1[0])

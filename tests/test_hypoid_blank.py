@@ -10,8 +10,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from gearjax.errors import ConvergenceError
-from gearjax.gears import hypoid_blank as hb
-from gearjax.gears.hypoid_blank import BlankInput, blank_geometry, blank_sensitivity
+from gearjax.gears.hypoid import blank as hb
+from gearjax.gears.hypoid.blank import BlankInput, blank_geometry, blank_sensitivity
 
 SAMPLE2 = dict(method="iso23509-method1", z1=13, z2=42, offset_mm=15.0,
                gear_outer_pitch_diameter_mm=170.0, gear_face_width_mm=30.0,
@@ -40,7 +40,7 @@ def test_round_trip_and_defaults():
        off=st.floats(1.0, 40.0))
 def test_round_trip_property(beta, alpha, sig, off):
     d = dict(SAMPLE2, spiral_angle_deg=beta, pressure_angle_drive_deg=alpha,
-             shaft_angle_deg=sig, offset_mm=off, method="seed003-tangency",
+             shaft_angle_deg=sig, offset_mm=off, method="tangent-cones",
              spiral_member="gear")
     inp = BlankInput.from_dict(d)
     assert BlankInput.from_dict(inp.to_dict()) == inp
@@ -94,8 +94,8 @@ def test_three_routes_and_table():
     # Method 1 = ISO sample 2 (annex F.3): delta_a1 - theta_a1 = delta1 ~ 21.289 deg
     assert abs(res["iso23509-method1"]["delta1"] - 21.2877) < 1e-3
     # seed route: contact point at mid face (seed eq. (7))
-    assert abs(res["seed003-tangency"]["c_be2"] - 0.5) < 1e-12
-    assert abs(res["seed003-tangency"]["beta_m1"] - 50.0) < 1e-10
+    assert abs(res["tangent-cones"]["c_be2"] - 0.5) < 1e-12
+    assert abs(res["tangent-cones"]["beta_m1"] - 50.0) < 1e-10
     # Method 0: closed-form bevel pitch angle, apexes at the crossing point
     assert abs(res["iso23509-method0"]["delta1"] - math.degrees(math.atan(13 / 42))) < 1e-12
     assert res["iso23509-method0"]["a1"] == 0.0
@@ -135,7 +135,7 @@ def test_blank_outputs_by_independent_relations(method):
     else:
         np.testing.assert_allclose(b["theta2"], math.pi / 2 - b["zeta_m"], **tol)
         np.testing.assert_allclose([b["a1"], b["a2"]], [b["tz1"], b["tz2"]], rtol=0, atol=1e-10)
-    if method == "seed003-tangency":
+    if method == "tangent-cones":
         r1, r2 = b["Rm1"] * math.sin(b["delta1"]), b["Rm2"] * math.sin(b["delta2"])
         np.testing.assert_allclose(u * r1 * math.cos(b["beta_m1"]), r2 * math.cos(b["beta_m2"]),
                                    rtol=1e-11)
@@ -153,7 +153,7 @@ def test_blank_outputs_by_independent_relations(method):
 
 
 def test_jit_matches_eager_and_no_nans():
-    inp = BlankInput.from_dict(dict(SAMPLE2, method="seed003-tangency"))
+    inp = BlankInput.from_dict(dict(SAMPLE2, method="tangent-cones"))
     a = blank_geometry(inp)
     b = jax.jit(lambda i: blank_geometry(i, strict=False))(inp)
     for n, _, _ in hb.OUTPUTS:
@@ -163,7 +163,7 @@ def test_jit_matches_eager_and_no_nans():
         assert np.isfinite(float(getattr(a, n))), n
 
 
-@pytest.mark.parametrize("method", ["iso23509-method1", "seed003-tangency"])
+@pytest.mark.parametrize("method", ["iso23509-method1", "tangent-cones"])
 def test_sensitivity_matches_central_differences(method):
     inp = BlankInput.from_dict(dict(SAMPLE2, method=method))
     s = blank_sensitivity(inp)
@@ -194,9 +194,9 @@ def test_sensitivity_matches_central_differences(method):
     expect = {("de2", "gear_outer_pitch_diameter"): 1.0, ("b2", "gear_face_width"): 1.0,
               ("rho_lim", "cutter_radius"): 1.0, ("m_et2", "gear_outer_pitch_diameter"): 1 / inp.z2,
               ("m_et2", "ratio"): -inp.gear_outer_pitch_diameter / (inp.z1 * u ** 2)}
-    if method == "seed003-tangency":
+    if method == "tangent-cones":
         expect[("beta_m1", "spiral_angle")] = 1.0     # the pinion spiral angle is the input
-    for name in ("de2", "b2", "rho_lim", "m_et2") + (("beta_m1",) if method == "seed003-tangency" else ()):
+    for name in ("de2", "b2", "rho_lim", "m_et2") + (("beta_m1",) if method == "tangent-cones" else ()):
         for c in hb.SENSITIVITY_INPUTS:
             np.testing.assert_allclose(J[row[name], col[c]], expect.get((name, c), 0.0),
                                        rtol=0, atol=1e-11, err_msg=f"{name} / {c}")
@@ -206,7 +206,7 @@ def test_sensitivity_matches_central_differences(method):
                                rtol=1e-13, atol=1e-13)
 
 
-@pytest.mark.parametrize("method", ["iso23509-method1", "seed003-tangency"])
+@pytest.mark.parametrize("method", ["iso23509-method1", "tangent-cones"])
 def test_seed000_cutter_study_trends(method):
     """Seed 000 table 1: a larger cutter gives a smaller pinion pitch angle, a smaller
     drive-side pressure angle and (slightly) a wider pinion; our numbers beside the
@@ -224,7 +224,7 @@ def test_seed000_cutter_study_trends(method):
 
 
 def test_non_convergence_strict_and_flag():
-    inp = BlankInput.from_dict(dict(SAMPLE2, method="seed003-tangency", cutter_radius_mm=2.0))
+    inp = BlankInput.from_dict(dict(SAMPLE2, method="tangent-cones", cutter_radius_mm=2.0))
     with pytest.raises(ConvergenceError):
         blank_geometry(inp)
     b = blank_geometry(inp, strict=False)
@@ -255,3 +255,11 @@ def test_cutter_too_small_for_face_width_is_a_value_error():
         blank_geometry(inp)
     b = blank_geometry(inp, strict=False)
     assert float(b.converged) == 1.0 and np.isnan(float(b.beta_e2))
+
+
+def test_former_method_name_still_loads():
+    """Design files written with the former method name load as "tangent-cones" and give
+    the same blank (old files must keep working)."""
+    old = BlankInput.from_dict(dict(SAMPLE2, method="seed003-tangency"))
+    new = BlankInput.from_dict(dict(SAMPLE2, method="tangent-cones"))
+    assert old.method == "tangent-cones" and old == new

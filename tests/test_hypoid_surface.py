@@ -1,4 +1,4 @@
-"""Hypoid flank grids by seed 004's algorithm (gearjax.gears.hypoid) on the 8/43 example.
+"""Hypoid flank grids by seed 004's algorithm (gearjax.gears.hypoid.flank) on the 8/43 example.
 
 Independent checks: meshing equation from the angular-velocity form (not the autodiff
 velocity the solver uses), generated-surface normal vs cutter normal, blank limits,
@@ -14,11 +14,11 @@ import numpy as np
 import pytest
 
 from gearjax.errors import ConvergenceError
-from gearjax.gears.hypoid import (axial_coords, face_cone_gap, flank_points, flank_surface,
+from gearjax.gears.hypoid.flank import (axial_coords, face_cone_gap, flank_points, flank_surface,
                                   mean_cone_distance, mid_estimate, pitch_distance,
                                   root_cone_gap, solve_point, solve_tip, spiral_angle_at,
                                   work_point, xi_of)
-from gearjax.io import load_design
+from gearjax.gears.hypoid.design_file import load_design
 
 FLANKS = [("pinion", "convex"), ("pinion", "concave"), ("gear", "convex"), ("gear", "concave")]
 NX, NS = 5, 4
@@ -121,8 +121,8 @@ def test_axial_plot_labels(design, grids):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from gearjax.gears.hypoid import face_apex_offset
-    from gearjax.plot_flank import plot_flank_axial
+    from gearjax.gears.hypoid.flank import face_apex_offset
+    from gearjax.plot.flank import plot_flank_axial
 
     fl, g = design.flank("pinion", "convex"), grids[("pinion", "convex")]
     ax = plot_flank_axial(g, fl.blank, label="pinion convex")
@@ -151,7 +151,7 @@ def test_axial_plot_labels(design, grids):
 
 def _Mmw_ref(ms, phi):
     """M_mw(phi) = T(0, E_m, X_B) Ry(pi/2 - gamma_m) T(0, 0, dX_D) Rz(phi), typed in with
-    NumPy from the cradle model (gearjax.machines docstring, Litvin & Fuentes ch. 21)."""
+    NumPy from the cradle model (gearjax.gears.hypoid.machine docstring, Litvin & Fuentes ch. 21)."""
     E, g, XB, dX = (float(v) for v in (ms.blank_offset, ms.machine_root_angle,
                                        ms.sliding_base, ms.center_to_back))
     a = math.pi / 2 - g
@@ -166,7 +166,7 @@ def _Mmw_ref(ms, phi):
 @pytest.mark.parametrize("mf", [("pinion", "convex"), ("pinion", "concave")])
 def test_meshing_equation_independent(design, grids, mf):
     """n . v = 0 with v from seed 004's (w_c - w_w) x r + w_w x R in the machine frame;
-    the work placement is typed in (not gearjax.machines) and the roll is linear
+    the work placement is typed in (not gearjax.gears.hypoid.machine) and the roll is linear
     (2C = 6D = 0 in the 8/43 settings): phi = R_a psi."""
     fl, g = design.flank(*mf), grids[mf]
     ms = fl.machine
@@ -290,7 +290,7 @@ def _root_gap_of_blade_tip(fl):
     tip = solve_tip(fl, 0.0, mid_estimate(fl))
     res = solve_point(fl, 0.0, 0.0, tip.x[1:])
     r, _ = work_point(fl, 0.0, res.x[0], res.x[1])
-    from gearjax.gears.hypoid import root_cone_gap as gap
+    from gearjax.gears.hypoid.flank import root_cone_gap as gap
     return gap(fl.blank, r), tip.converged & res.converged
 
 
@@ -319,7 +319,7 @@ def test_iso_route_example():
     """ISO-route hypoid: [blank_summary] is the blank module's output for [blank]
     (to the stored 1e-4 rounding), and the pinion flank meets its derivation
     condition (mean spiral angle 45 deg) with the left hand."""
-    from gearjax.gears.hypoid_blank import blank_geometry
+    from gearjax.gears.hypoid.blank import blank_geometry
     d = load_design("example:hypoid_iso_10x41")
     bd = blank_geometry(d.blank_input()).to_dict()
     p, g = d.data["blank_summary"]["pinion"], d.data["blank_summary"]["gear"]

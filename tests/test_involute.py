@@ -15,7 +15,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from gearjax.gears.involute import (InvolutePair, closed_form_path, generated_flank,
+from gearjax.gears.involute.geometry import (InvolutePair, closed_form_path, generated_flank,
                                     involute_polar_angle, pair_geometry, path_kinematics,
                                     path_kinematics_traced, wheel_flank_geometry)
 from gearjax.newton import newton_solve

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from gearjax import io
-from gearjax.gears.hypoid import flank_surface
-from gearjax.io import (design_from_dict, dumps_toml, load_design, save_design,
-                        write_csv, write_stl_flank, write_stl_tooth, write_xyz)
+from gearjax.gears.hypoid.flank import flank_surface
+from gearjax.io import dumps_toml, write_csv, write_stl_flank, write_stl_tooth, write_xyz
+from gearjax.gears.hypoid.design_file import design_from_dict, load_design, save_design
 
 
 @pytest.fixture(scope="module")

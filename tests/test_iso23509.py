@@ -17,8 +17,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from gearjax.gears import iso23509 as iso
-
+from gearjax.gears.hypoid import iso23509 as iso
 D = np.deg2rad
 ANGLE = ("delta", "beta", "zeta", "alpha", "theta")
 

@@ -1,4 +1,4 @@
-"""Cradle-type generator (gearjax.machines): No. 116 dials, M_ct, roll, relative velocity."""
+"""Cradle-type generator (gearjax.gears.hypoid.machine): No. 116 dials, M_ct, roll, relative velocity."""
 
 import math
 
@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from gearjax import frames
-from gearjax.cutters import cutter_point, make_cutter
-from gearjax.machines import (MACHINE_LENGTH, WEDGE_ANGLE, MachineSettings, No116Dials,
+from gearjax.gears.hypoid.cutter import cutter_point, make_cutter
+from gearjax.gears.hypoid.machine import (MACHINE_LENGTH, WEDGE_ANGLE, MachineSettings, No116Dials,
                               cutter_to_cradle, cutter_to_work, dial_cutter_to_cradle,
                               dials_to_geometric, geometric_to_dials, roll_angle,
                               work_to_machine)
@@ -268,7 +268,7 @@ def test_relative_velocity_matches_angular_velocity_formula():
     written in the machine frame and rotated into the work frame.  The machine
     frame, the work axis and the roll rate come from the hand-typed matrices and
     the hand-differentiated roll (R_a (1 - 2C psi - 6D psi^2 / 2)), not from
-    gearjax.machines.  Round-off only (measured 1.1e-13 mm/rad on ~600 mm/rad): 1e-11."""
+    gearjax.gears.hypoid.machine.  Round-off only (measured 1.1e-13 mm/rad on ~600 mm/rad): 1e-11."""
     k = MS_KW
     ms = _ms()
     c = make_cutter(117.475, 29.0, 1.0, "convex")

@@ -12,9 +12,8 @@ import pytest
 
 from gearjax.errors import ConvergenceError
 from gearjax.frames import apply_point, compose, rot_x, translate
-from gearjax.gears import iso23509 as iso
-from gearjax.gears import pitch_cones as pc
-
+from gearjax.gears.hypoid import iso23509 as iso
+from gearjax.gears.hypoid import pitch_cones as pc
 D = np.deg2rad
 
 # (u, Sigma, E, de2, b2, beta1, rc0): ISO 23509 sample 2 data, seed-000 7.5-inch case,

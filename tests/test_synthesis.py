@@ -1,4 +1,4 @@
-"""Local synthesis of the spiral-bevel pinion (gearjax.synthesis).
+"""Local synthesis of the spiral-bevel pinion (gearjax.gears.hypoid.synthesis).
 
 Two XLA compiles shared through module-scoped fixtures: the jitted (residual,
 Jacobian) function of the drive side (reused by the solve, the gradient check and
@@ -11,10 +11,10 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from gearjax import synthesis as sy
-from gearjax import tca_hypoid as th
+from gearjax.gears.hypoid import synthesis as sy
+from gearjax.gears.hypoid import tca as th
 from gearjax.errors import ConvergenceError
-from gearjax.io import load_design
+from gearjax.gears.hypoid.design_file import load_design
 from gearjax.tca import ARCSEC
 
 

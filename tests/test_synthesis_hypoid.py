@@ -1,5 +1,5 @@
-"""Local synthesis on an offset hypoid pair (formate gear; gearjax.synthesis with the
-start of gearjax.formate_pair) and the shipped example it produced."""
+"""Local synthesis on an offset hypoid pair (formate gear; gearjax.gears.hypoid.synthesis with the
+start of gearjax.gears.hypoid.formate) and the shipped example it produced."""
 
 import math
 from dataclasses import replace
@@ -8,9 +8,9 @@ import jax
 import numpy as np
 import pytest
 
-from gearjax import synthesis as sy
-from gearjax import tca_hypoid as th
-from gearjax.io import load_design
+from gearjax.gears.hypoid import synthesis as sy
+from gearjax.gears.hypoid import tca as th
+from gearjax.gears.hypoid.design_file import load_design
 from gearjax.tca import ARCSEC
 
 

@@ -12,10 +12,10 @@ import numpy as np
 import pytest
 
 from gearjax.errors import ConvergenceError
-from gearjax.gears.involute import InvolutePair, generated_flank, pair_geometry
+from gearjax.gears.involute.geometry import InvolutePair, generated_flank, pair_geometry
 from gearjax.tca import (ARCSEC, Misalignment, NoContactError, contact_path,
                          ellipse_from_weingarten)
-from gearjax.tca_involute import (InvoluteTCA, crowned_pinion_flank, involute_tca,
+from gearjax.gears.involute.tca import (InvoluteTCA, crowned_pinion_flank, involute_tca,
                                   misalignment_sensitivity, tca_summary, SUMMARY_KEYS)
 
 Z1, Z2, M, ALPHA = 25, 41, 2.0, 20.0
@@ -576,7 +576,7 @@ def test_validation_names_parameters(pair):
 
 
 def test_plot_written_atomically(tmp_path, pair, crowned):
-    from gearjax.plot_tca import ellipse_outline_axial, save_tca_plot
+    from gearjax.plot.tca import ellipse_outline_axial, save_tca_plot
     des, (path, margin, multi) = crowned
     out = save_tca_plot(tmp_path / "tca.png", [("drive", path, margin, multi)],
                         limits=dict(face_half=10.0, root_radius=22.0, tip_radius=27.0))

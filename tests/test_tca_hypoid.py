@@ -12,8 +12,8 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from gearjax.io import load_design
-from gearjax import tca_hypoid as th
+from gearjax.gears.hypoid.design_file import load_design
+from gearjax.gears.hypoid import tca as th
 from gearjax.tca import ARCSEC, Misalignment, NoContactError
 
 STEPS, HALF = 8, 1.5          # 25 grid positions, 1.5 pitches each side

@@ -1,8 +1,8 @@
 """``gearjax blank DESIGN``: blank data of a hypoid / spiral-bevel design.
 
 DESIGN is a path or ``example:NAME``; its ``[blank]`` table goes verbatim to
-:meth:`gearjax.gears.hypoid_blank.BlankInput.from_dict` and
-:func:`~gearjax.gears.hypoid_blank.blank_geometry` computes the blank."""
+:meth:`gearjax.gears.hypoid.blank.BlankInput.from_dict` and
+:func:`~gearjax.gears.hypoid.blank.blank_geometry` computes the blank."""
 
 from __future__ import annotations
 
@@ -19,8 +19,8 @@ def register(sub):
 
 
 def run(args) -> int:
-    from gearjax.gears.hypoid_blank import blank_geometry
-    from gearjax.io import load_design
+    from gearjax.gears.hypoid.blank import blank_geometry
+    from gearjax.gears.hypoid.design_file import load_design
     design = load_design(args.design)
     data = blank_geometry(design.blank_input())
     if args.json:

@@ -17,7 +17,8 @@ def register(sub):
 
 
 def run_list(args) -> int:
-    from gearjax.io import list_examples, load_design
+    from gearjax.io import list_examples
+    from gearjax.gears.hypoid.design_file import load_design
     for name in list_examples():
         try:
             desc = load_design(f"example:{name}").data.get("design", {}).get("description", "")

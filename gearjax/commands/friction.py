@@ -187,7 +187,7 @@ def run_stribeck(args) -> int:
         sys.stderr.write(f"gearjax: warning: {w.message}\n")
     fr = c.friction
     if args.plot is not None:
-        from gearjax.plot_tribology import save_figure_atomic, stribeck_figure
+        from gearjax.plot.tribology import save_figure_atomic, stribeck_figure
         fig = stribeck_figure([c], [f"F = {args.load_N:g} N, sigma = {args.sigma_um:g} um"])
         save_figure_atomic(fig, args.plot)
     out = {

@@ -1,8 +1,8 @@
 """``gearjax kinematics DESIGN``: seed-000 eigenfunction kinematics of a hypoid design.
 
-DESIGN is a path or ``example:NAME`` (e.g. ``example:seed000_6x39_7p5in``).  The
+DESIGN is a path or ``example:NAME`` (e.g. ``example:hypoid_6x39_7p5in``).  The
 model needs only the design's ``[blank]`` table (any hypoid route; the cutter radius
-of the table is the face-mill radius r0; see :mod:`gearjax.gears.hypoid_kinematics`):
+of the table is the face-mill radius r0; see :mod:`gearjax.studies.cutter_radius`):
 the gear flank is the cutter cone at the pitch point, the pinion its conjugate.
 Prints the field statistics (mean/min/max of u_e, u_s, SRR, R_eff, K_II, Phi_I,
 Phi_II over the working flank) and the limit checks (meshing limit Phi_I = 0,
@@ -51,8 +51,8 @@ def register(sub):
 def run(args) -> int:
     from pathlib import Path
 
-    from gearjax.gears import hypoid_kinematics as hk
-    from gearjax.io import load_design
+    from gearjax.studies import cutter_radius as hk
+    from gearjax.gears.hypoid.design_file import load_design
     shape = _grid(args.grid)
     if args.plot is not None:
         pp = Path(args.plot)
@@ -64,7 +64,7 @@ def run(args) -> int:
     inp = design.blank_input()
     if inp.method == "iso23509-method0" or float(inp.offset) <= 0.0:
         raise ValueError("blank.offset_mm must be > 0: the seed-000 model is for hypoid pairs")
-    st = hk.Settings.make(float(inp.cutter_radius), args.blade_angle_delta, args.cutter_shift)
+    st = hk.StudySettings.make(float(inp.cutter_radius), args.blade_angle_delta, args.cutter_shift)
     s, f = hk.flank_fields(inp, st, args.flank, shape)
     stats = hk.field_stats(f, _FIELDS)
     lim = hk.limit_report(f)
@@ -75,7 +75,7 @@ def run(args) -> int:
            "limits": {k: {kk: v[kk] for kk in ("inside", "fraction", "margin",
                                                "zero_curve_axial")} for k, v in lim.items()}}
     if args.plot is not None:
-        from gearjax.plot_kinematics import field_maps, save_figure
+        from gearjax.plot.kinematics import field_maps, save_figure
         save_figure(field_maps({f"{out['design']} {args.flank}": f}), args.plot)
     if args.json:
         sys.stdout.write(json.dumps(out, indent=1) + "\n")

@@ -1,6 +1,6 @@
 """``gearjax surface DESIGN``: a flank grid of a hypoid / spiral-bevel member, written
 to CSV, XYZ (points and normals) or STL (seed 004's algorithm, see
-:mod:`gearjax.gears.hypoid`)."""
+:mod:`gearjax.gears.hypoid.flank`)."""
 
 from __future__ import annotations
 
@@ -38,8 +38,9 @@ def register(sub):
 def run(args) -> int:
     from pathlib import Path
 
-    from gearjax.gears.hypoid import flank_surface
-    from gearjax.io import load_design, write_flank, write_stl_tooth
+    from gearjax.gears.hypoid.flank import flank_surface
+    from gearjax.io import write_flank, write_stl_tooth
+    from gearjax.gears.hypoid.design_file import load_design
     from gearjax.progress import Progress
     n_xi, n_s = _grid(args.grid)
     out = Path(args.out)
@@ -66,7 +67,7 @@ def run(args) -> int:
         write_flank(out, grids[args.flank], name=f"{design.name}_{args.member}_{args.flank}")
     g = grids[args.flank]
     if args.plot is not None:
-        from gearjax.plot_flank import save_flank_plot
+        from gearjax.plot.flank import save_flank_plot
         save_flank_plot(args.plot, g, design.member_blank(args.member),
                         title=f"{design.name}: {args.member} {args.flank} flank (axial plane)",
                         label=f"{args.member} {args.flank}")

@@ -5,7 +5,7 @@ DESIGN is either an involute pair given inline,
 (tooth numbers, normal module mm, normal pressure angle deg, face width mm, helix
 deg, profile shifts, pinion pressure-angle change deg, pinion profile and lead
 crown 1/mm), or a hypoid/spiral-bevel design file (a path or ``example:NAME``;
-:mod:`gearjax.tca_hypoid`; drive side = pinion concave on gear convex).
+:mod:`gearjax.gears.hypoid.tca`; drive side = pinion concave on gear convex).
 """
 
 from __future__ import annotations
@@ -81,8 +81,8 @@ def _parse_kv(text, allowed, what):
 
 
 def _design(text):
-    from ..gears.involute import InvolutePair
-    from ..tca_involute import InvoluteTCA
+    from gearjax.gears.involute.geometry import InvolutePair
+    from gearjax.gears.involute.tca import InvoluteTCA
 
     kv = _parse_kv(text[len("involute:"):], _ALLOWED, "design")
     missing = [k for k in ("z1", "z2", "m", "alpha", "b") if k not in kv]
@@ -100,7 +100,7 @@ def _nan_list(a):
 
 
 def _involute_side(args, mis, m, side_name, half):
-    from ..tca_involute import involute_limits, involute_tca
+    from gearjax.gears.involute.tca import involute_limits, involute_tca
     _, des = _design(args.design)
     side = -1 if side_name == "drive" else 1
     path, margin, multi = involute_tca(des, mis, side=side, steps_per_pitch=m, half_pitches=half)
@@ -108,7 +108,7 @@ def _involute_side(args, mis, m, side_name, half):
 
 
 def _hypoid_side(design, mis, m, side_name, half):
-    from .. import tca_hypoid as th
+    from gearjax.gears.hypoid import tca as th
     prep = th.prepare(th.pair_flanks(design, side_name))
     res = th.hypoid_tca(prep, mis, steps_per_pitch=m, half_pitches=half, n_pairs=3)
     prep_pair = prep.pair
@@ -118,7 +118,7 @@ def _hypoid_side(design, mis, m, side_name, half):
 
 
 def _side_json(path, margin, multi, extra):
-    from ..tca import ARCSEC
+    from gearjax.tca import ARCSEC
     conv = np.asarray(path.converged)
     on = (np.asarray(margin) >= 0.0) & conv
     te = np.where(on, np.asarray(path.te), np.nan) / ARCSEC
@@ -142,8 +142,8 @@ def _side_json(path, margin, multi, extra):
 
 
 def run(args) -> int:
-    from ..errors import ConvergenceError, check_int, check_range
-    from ..tca import Misalignment, NoContactError
+    from gearjax.errors import ConvergenceError, check_int, check_range
+    from gearjax.tca import Misalignment, NoContactError
 
     mis_kv = _parse_kv(args.misalign, {"dE", "dP", "dG", "dSigma"}, "misalign")
     mis = Misalignment.create(mis_kv.get("dE", 0.0), mis_kv.get("dP", 0.0),
@@ -158,7 +158,7 @@ def run(args) -> int:
         _design(args.design)                       # validate before any tracing
         solve = lambda side: _involute_side(args, mis, m, side, half)
     else:
-        from ..io import load_design
+        from gearjax.gears.hypoid.design_file import load_design
         design = load_design(args.design)
         solve = lambda side: _hypoid_side(design, mis, m, side, half)
     results = {}
@@ -172,7 +172,7 @@ def run(args) -> int:
             sys.stderr.write(f"gearjax: error: {side} side: the contact solve failed: {exc}\n")
             return 3
     if args.plot:
-        from ..plot_tca import save_tca_plot
+        from gearjax.plot.tca import save_tca_plot
         save_tca_plot(args.plot, [(sd, r[0], r[1], r[2]) for sd, r in results.items()],
                       [r[3] for r in results.values()], title=f"TCA {args.design}")
     outs = {sd: _side_json(r[0], r[1], r[2], r[4]) for sd, r in results.items()}

@@ -2,22 +2,22 @@
 study's cutter cone, the pinion it generates, and the link between the two models.
 
 Seed 000 (§2) models the gear flank as the face-mill cutter cone placed at the pitch
-point (:func:`gearjax.gears.hypoid_kinematics.pitch_setup`) and reads the meshing
+point (:func:`gearjax.studies.cutter_radius.pitch_setup`) and reads the meshing
 characteristics off the eigenfunctions, with the pinion only implied as the
 conjugate surface.  Here the same cone becomes a formate gear on the cradle machine
-of :mod:`gearjax.machines` (:func:`gearjax.formate_pair.formate_from_placement`:
+of :mod:`gearjax.gears.hypoid.machine` (:func:`gearjax.gears.hypoid.formate.formate_from_placement`:
 classical formate set-up, no tilt), the pinion is generated from it by the machine
-chain (:func:`gearjax.formate_pair.generating_gear_pinion`: the gear as generating
+chain (:func:`gearjax.gears.hypoid.formate.generating_gear_pinion`: the gear as generating
 gear, a tilted cutter), and tooth contact analysis
-(:mod:`gearjax.tca_hypoid`) finds the actual contact points; the kinematics there
-(:mod:`gearjax.contact_kinematics`) are compared with the seed's fields.
+(:mod:`gearjax.gears.hypoid.tca`) finds the actual contact points; the kinematics there
+(:mod:`gearjax.gears.hypoid.contact_kinematics`) are compared with the seed's fields.
 
-Frames: the seed's fixed frame ``S_f`` (:mod:`gearjax.gears.pitch_cones`: gear axis
+Frames: the seed's fixed frame ``S_f`` (:mod:`gearjax.gears.hypoid.pitch_cones`: gear axis
 ``u2 = e_z`` through the origin, which is the gear's crossing point; pinion axis
-``u1`` through ``C1 = (E, 0, 0)``) and the gear work frame of :mod:`gearjax.machines`
+``u1`` through ``C1 = (E, 0, 0)``) and the gear work frame of :mod:`gearjax.gears.hypoid.machine`
 (origin at the pitch apex ``A2 = P - R_m2 g2``, ``z`` apex to heel):
 ``p_f = A2 + Q p_w``, ``Q = [x_w, y_w, z_w]``.  The cutter frame of
-:mod:`gearjax.cutters` (blade tips in ``z_t = 0``, ``s`` along the blade from the
+:mod:`gearjax.gears.hypoid.cutter` (blade tips in ``z_t = 0``, ``s`` along the blade from the
 tip) is the seed's cone frame ``(x_c, y_c, z_c = k)`` shifted to the gear root:
 the seed's slant length ``u`` (from the pitch plane, positive towards the gear
 root) is ``u = u_root - s``, ``u_root = h_fm2/cos(a)``; point radius
@@ -34,23 +34,23 @@ from typing import NamedTuple
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax.cutters import FaceMillCutter
-from gearjax.formate_pair import formate_from_placement, generating_gear_pinion
-from gearjax.gears import pitch_cones
-from gearjax.gears.hypoid import FlankSpec, MemberBlank
-from gearjax.gears.hypoid_blank import BlankInput
-from gearjax.gears.hypoid_kinematics import Settings, pitch_setup
-from gearjax.tca_hypoid import HypoidPair
+from gearjax.gears.hypoid.cutter import FaceMillCutter
+from gearjax.gears.hypoid.formate import formate_from_placement, generating_gear_pinion
+from gearjax.gears.hypoid import pitch_cones
+from gearjax.gears.hypoid.flank import FlankSpec, MemberBlank
+from gearjax.gears.hypoid.blank import BlankInput
+from gearjax.studies.cutter_radius import StudySettings, pitch_setup
+from gearjax.gears.hypoid.tca import HypoidPair
 
-__all__ = ["Seed000Pair", "seed000_pair", "seed_uv"]
+__all__ = ["StudyPair", "study_pair", "study_uv"]
 
 
-class Seed000Pair(NamedTuple):
+class StudyPair(NamedTuple):
     """The machine-cut seed-000 pair and the frame data linking it to the seed's model.
 
-    pair : :class:`~gearjax.tca_hypoid.HypoidPair` (formate gear, generated pinion).
-    setup : the seed model's :class:`~gearjax.gears.hypoid_kinematics.PitchSetup`.
-    info : :func:`~gearjax.formate_pair.generating_gear_pinion`'s info.
+    pair : :class:`~gearjax.gears.hypoid.tca.HypoidPair` (formate gear, generated pinion).
+    setup : the seed model's :class:`~gearjax.studies.cutter_radius.PitchSetup`.
+    info : :func:`~gearjax.gears.hypoid.formate.generating_gear_pinion`'s info.
     A2 : (3,) gear pitch apex in ``S_f``; Q : (3, 3) gear work axes in ``S_f``.
     phi0 : work phase of the formate settings (flank of the settings = placed cone
         turned by ``phi0`` about the gear axis).
@@ -72,8 +72,8 @@ def _member_blank(bd, k: int, teeth: int, hand: str) -> MemberBlank:
                        f("beta_m"), teeth, hand)
 
 
-def seed000_pair(inp: BlankInput, settings: Settings, flank: str = "convex",
-                 edge_radius: float = 0.0) -> Seed000Pair:
+def study_pair(inp: BlankInput, settings: StudySettings, flank: str = "convex",
+                 edge_radius: float = 0.0) -> StudyPair:
     """The seed-000 set of ``inp`` with the cutter of ``settings`` as a machine-cut pair
     (module docstring; concrete).  ``flank`` is the gear flank ("convex": drive side,
     mating the pinion concave flank).  ``edge_radius`` of the blades (mm; the seed's
@@ -113,10 +113,10 @@ def seed000_pair(inp: BlankInput, settings: Settings, flank: str = "convex",
     pair = HypoidPair(placeholder, gear, f(inp.shaft_angle), f(inp.offset), f(t1), f(t2),
                       inp.z1, inp.z2, 1)
     pair, info = generating_gear_pinion(pair)
-    return Seed000Pair(pair, s, info, A2, Q, float(phi0), u_root)
+    return StudyPair(pair, s, info, A2, Q, float(phi0), u_root)
 
 
-def seed_uv(sp: Seed000Pair, p2_body) -> np.ndarray:
+def study_uv(sp: StudyPair, p2_body) -> np.ndarray:
     """Seed-000 flank parameters ``(u, theta)`` of gear body-frame points ``(..., 3)``
     (the TCA's ``path.p2_body``): into ``S_f`` (undoing the work phase ``phi0``), then
     into the seed's cone frame."""

@@ -16,7 +16,7 @@ import io as _io
 
 import numpy as np
 
-from .tca import ARCSEC
+from gearjax.tca import ARCSEC
 
 __all__ = ["ellipse_outline_axial", "plot_tca", "save_tca_plot"]
 
@@ -112,7 +112,7 @@ def save_tca_plot(path_png, results, limits=None, title="TCA"):
     """Render :func:`plot_tca` and write the PNG atomically; returns the path."""
     import matplotlib.pyplot as plt
 
-    from .io import atomic_write
+    from gearjax.io import atomic_write
 
     fig = plot_tca(results, limits, title)
     buf = _io.BytesIO()

@@ -25,9 +25,9 @@ def axial_projection(points):
 
 
 def plot_flank_axial(grid, blank=None, ax=None, label: str = "flank", color="C0"):
-    """Draw ``grid`` (a :class:`~gearjax.gears.hypoid.FlankGrid`) in the axial plane.
+    """Draw ``grid`` (a :class:`~gearjax.gears.hypoid.flank.FlankGrid`) in the axial plane.
 
-    ``blank`` (optional :class:`~gearjax.gears.hypoid.MemberBlank`) adds the face and
+    ``blank`` (optional :class:`~gearjax.gears.hypoid.flank.MemberBlank`) adds the face and
     root cones and the toe/heel lines (normal to the pitch generatrix at
     ``A_o - F`` and ``A_o``).  Returns the matplotlib Axes.
     """
@@ -44,7 +44,7 @@ def plot_flank_axial(grid, blank=None, ax=None, label: str = "flank", color="C0"
         ax.plot(x[i, :], R[i, :], color=color, lw=0.6, alpha=0.8)
     ax.plot([], [], color=color, label=label)
     if blank is not None:
-        from gearjax.gears.hypoid import face_apex_offset, root_apex_offset
+        from gearjax.gears.hypoid.flank import face_apex_offset, root_apex_offset
         gp, gF, gR = (float(v) for v in (blank.pitch_angle, blank.face_angle, blank.root_angle))
         Ao, F = float(blank.outer_cone_distance), float(blank.face_width)
         xs = np.linspace(x.min() - 0.15 * np.ptp(x) - 1, x.max() + 0.15 * np.ptp(x) + 1, 50)

@@ -5,15 +5,15 @@ of a face-mill cutter placed at the pitch point and carried about the gear axis;
 the eigenfunctions of section 1 (:mod:`gearjax.kinematics`) then give the local
 kinematics of the gear and its conjugate pinion at every point of the flank.
 
-Construction (all in the fixed frame ``S_f`` of :mod:`gearjax.gears.pitch_cones`:
+Construction (all in the fixed frame ``S_f`` of :mod:`gearjax.gears.hypoid.pitch_cones`:
 gear axis ``u2 = (0, 0, 1)`` through the origin, pinion axis ``u1`` through
 ``C1 = (E, 0, 0)``; mm, rad; pinion speed 1 rad/s so velocities are mm per radian
 of pinion roll, as the seed's non-dimensional "pinion speed 1"):
 
-1. Blank: :func:`gearjax.gears.hypoid_blank.blank_geometry`'s core with the cutter
-   radius ``r0`` as input (route ``seed003-tangency`` by default: the ratio holds
+1. Blank: :func:`gearjax.gears.hypoid.blank.blank_geometry`'s core with the cutter
+   radius ``r0`` as input (route ``tangent-cones`` by default: the ratio holds
    exactly at the pitch point).  Pitch point ``P``, common normal ``k`` (pinion
-   outward, into the gear) from :func:`gearjax.gears.pitch_cones.cone_tangency`.
+   outward, into the gear) from :func:`gearjax.gears.hypoid.pitch_cones.cone_tangency`.
 2. Motion: ``omega_p = u1`` (|omega_p| = 1), ``omega_g = s (z1/z2) u2`` with the sign
    ``s`` for which the pitch-point velocities of the two members point the same way
    (rolling cones).  In the seed's pitch-point frame these are its
@@ -66,14 +66,15 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from gearjax.frames import rotate_about
 from gearjax.errors import check_range, require_converged
-from gearjax.gears import pitch_cones
-from gearjax.gears.hypoid_blank import BlankInput, _core
+from gearjax.gears.hypoid import pitch_cones
+from gearjax.gears.hypoid.blank import BlankInput, _core
 from gearjax.kinematics import Mesh, eigen_kinematics
 from gearjax.newton import newton_solve
 from gearjax.surfaces import curvature_in_direction, local_geometry
 
-__all__ = ["SEED000_BLANK", "SEED000_CUTTERS", "seed000_blank_input", "Settings",
+__all__ = ["STUDY_BLANK", "STUDY_CUTTERS", "study_blank_input", "StudySettings",
            "PitchSetup", "pitch_setup", "FlankFields", "flank_fields", "field_stats",
            "euler_bertrand", "limit_report", "FIELDS", "conjugate_check", "grid_uv", "STAT_NAMES",
            "flank_statistics", "statistics_gradient", "cutter_radius_sweep",
@@ -88,15 +89,15 @@ _DEG = math.pi / 180.0
 #: profile shift x_hm1 = 0.5 (a 6-tooth pinion needs a long addendum: Gleason's
 #: gear addendum 0.21 + 0.29 (z1/z2)^2 of the working depth gives x ~ 0.57; with
 #: x_hm1 = 0 the gear tip region shows curvature interference, Phi_II < 0).
-SEED000_BLANK = {
-    "method": "seed003-tangency", "z1": 6, "z2": 39, "offset_mm": 35.0,
+STUDY_BLANK = {
+    "method": "tangent-cones", "z1": 6, "z2": 39, "offset_mm": 35.0,
     "gear_outer_pitch_diameter_mm": 230.0, "gear_face_width_mm": 0.155 * 230.0,
     "spiral_angle_deg": 25.0 + 5.0 * math.sqrt(39.0 / 6.0) + 90.0 * 35.0 / 230.0,
     "cutter_radius_mm": 95.25, "pressure_angle_drive_deg": 19.0,
     "pressure_angle_coast_deg": 19.0, "profile_shift": 0.5,
 }
 #: The seed's three cutters (nominal diameter in inches -> radius in mm).
-SEED000_CUTTERS = {"6in": 76.2, "7.5in": 95.25, "9in": 114.3}
+STUDY_CUTTERS = {"6in": 76.2, "7.5in": 95.25, "9in": 114.3}
 
 #: names of the scalar fields of :class:`FlankFields` that :func:`field_stats` reports
 FIELDS = ("phi_I", "phi_II", "u1", "u2", "u_e", "u_s", "srr", "k_II", "r_eff")
@@ -104,9 +105,9 @@ FIELDS = ("phi_I", "phi_II", "u1", "u2", "u_e", "u_s", "srr", "k_II", "r_eff")
 _FLANKS = ("convex", "concave")
 
 
-def seed000_blank_input(cutter_radius_mm=95.25, **overrides) -> BlankInput:
+def study_blank_input(cutter_radius_mm=95.25, **overrides) -> BlankInput:
     """Validated :class:`BlankInput` of the seed-000 set with cutter radius ``r0`` (mm)."""
-    d = dict(SEED000_BLANK)
+    d = dict(STUDY_BLANK)
     d["cutter_radius_mm"] = float(cutter_radius_mm)
     d.update(overrides)
     return BlankInput.from_dict(d)
@@ -114,7 +115,7 @@ def seed000_blank_input(cutter_radius_mm=95.25, **overrides) -> BlankInput:
 
 @jax.tree_util.register_dataclass
 @dataclass(frozen=True)
-class Settings:
+class StudySettings:
     """Differentiable inputs of the study (mm, rad).
 
     cutter_radius : r0, mean point radius of the face mill at the pitch plane (mm);
@@ -130,12 +131,12 @@ class Settings:
     cutter_shift: jnp.ndarray = 0.0
 
     @staticmethod
-    def make(cutter_radius, blade_angle_delta_deg=0.0, cutter_shift=0.0) -> "Settings":
+    def make(cutter_radius, blade_angle_delta_deg=0.0, cutter_shift=0.0) -> "StudySettings":
         """Validated settings from display units (mm, degrees)."""
         r0 = check_range("cutter_radius_mm", cutter_radius, 20.0, 400.0, unit="mm")
         da = check_range("blade_angle_delta_deg", blade_angle_delta_deg, -10.0, 10.0, unit="deg")
         sh = check_range("cutter_shift_mm", cutter_shift, -20.0, 20.0, unit="mm")
-        return Settings(jnp.asarray(r0, float), jnp.asarray(da * _DEG, float),
+        return StudySettings(jnp.asarray(r0, float), jnp.asarray(da * _DEG, float),
                         jnp.asarray(sh, float))
 
 
@@ -162,7 +163,7 @@ class PitchSetup(NamedTuple):
     blank: dict           # blank outputs (mm, rad)
 
 
-def pitch_setup(inp: BlankInput, settings: Settings, flank: str = "convex") -> PitchSetup:
+def pitch_setup(inp: BlankInput, settings: StudySettings, flank: str = "convex") -> PitchSetup:
     """Blank, pitch point frame, motion and cutter for ``settings`` (traceable).
 
     The blank is designed with ``settings.cutter_radius`` (``inp.cutter_radius`` is
@@ -218,12 +219,6 @@ def _cutter_point(s: PitchSetup, uv):
     rr = jnp.linalg.norm(s.centre - s.P) - s.sb * u * jnp.sin(s.blade)
     return (s.centre + rr * (jnp.cos(th) * s.xc + jnp.sin(th) * s.yc)
             + u * jnp.cos(s.blade) * s.zc)
-
-
-def _rot(axis, ang, x):
-    """Rodrigues rotation of ``x`` about the unit ``axis`` through the origin."""
-    c, sn = jnp.cos(ang), jnp.sin(ang)
-    return c * x + sn * jnp.cross(axis, x) + (1.0 - c) * jnp.dot(axis, x) * axis
 
 
 class FlankFields(NamedTuple):
@@ -296,15 +291,15 @@ def _point(s: PitchSetup, uv, tol=1e-11):
 
     def F(phi, th):
         r_, n_ = th
-        r = _rot(ax, phi, r_)
-        return jnp.dot(_rot(ax, phi, n_), jnp.cross(mesh.omega1, r)
+        r = rotate_about(ax, phi, r_)
+        return jnp.dot(rotate_about(ax, phi, n_), jnp.cross(mesh.omega1, r)
                        - jnp.cross(mesh.omega2, r - mesh.a))
 
     sol = newton_solve(F, 0.0, (r0, n0), tol=tol)
     phi = sol.x
 
     def surf(uv_):
-        return _rot(ax, phi, _cutter_point(s, uv_))
+        return rotate_about(ax, phi, _cutter_point(s, uv_))
 
     g = local_geometry(surf, uv)
     n = sn * g.n
@@ -313,7 +308,7 @@ def _point(s: PitchSetup, uv, tol=1e-11):
     # Euler/Bertrand route (seed 2.3): cone, k_e = cos a / r_u along the circle
     # direction, k_f = 0 along the blade; sign + when n points towards the cutter axis
     rr = jnp.linalg.norm(r0 - s.centre - jnp.dot(r0 - s.centre, s.zc) * s.zc)
-    e_dir = _rot(ax, phi, jnp.cross(s.zc, radial))
+    e_dir = rotate_about(ax, phi, jnp.cross(s.zc, radial))
     sig = -jnp.sign(jnp.dot(n0, radial))
     k_e = sig * jnp.cos(s.blade) / rr
     k_v_eb, tau_v_eb = euler_bertrand(k_e, 0.0 * k_e, e_dir, n, kin.v12)
@@ -348,12 +343,12 @@ def conjugate_check(s: PitchSetup, uv):
 
     def pinion_body(uv_):
         f = _point(s, uv_)
-        return _rot(ax_p, -ratio * f.phi, f.r - mesh.a)
+        return rotate_about(ax_p, -ratio * f.phi, f.r - mesh.a)
 
     psi0 = ratio * f0.phi
 
     def pinion_now(uv_):
-        return _rot(ax_p, psi0, pinion_body(uv_)) + mesh.a
+        return rotate_about(ax_p, psi0, pinion_body(uv_)) + mesh.a
 
     g = local_geometry(pinion_now, uv)
     sn = jnp.sign(jnp.dot(g.n, f0.n))
@@ -361,7 +356,7 @@ def conjugate_check(s: PitchSetup, uv):
     k_pin = curvature_in_direction(f0.n, sn * g.W, t)[0]
 
     def gear_now(uv_):
-        return _rot(ax_g, f0.phi, _cutter_point(s, uv_))
+        return rotate_about(ax_g, f0.phi, _cutter_point(s, uv_))
 
     gg = local_geometry(gear_now, uv)
     k_gear = curvature_in_direction(f0.n, jnp.sign(jnp.dot(gg.n, f0.n)) * gg.W, t)[0]
@@ -392,7 +387,7 @@ def _fields(inp, settings, flank, shape, extend):
 _fields_jit = jax.jit(_fields, static_argnums=(0, 2, 3, 4))
 
 
-def flank_fields(inp: BlankInput, settings: Settings, flank: str = "convex",
+def flank_fields(inp: BlankInput, settings: StudySettings, flank: str = "convex",
                  shape=(31, 15), extend: float = 1.0, *, strict: bool = True):
     """Seed-000 fields over a ``shape = (n_depth, n_face)`` grid of the gear flank.
 
@@ -499,7 +494,7 @@ def _stats_fn(inp, settings, flank, shape):
 _stats_jit = jax.jit(_stats_fn, static_argnums=(0, 2, 3))
 
 
-def flank_statistics(inp: BlankInput, settings: Settings, flank: str = "convex",
+def flank_statistics(inp: BlankInput, settings: StudySettings, flank: str = "convex",
                      shape=(15, 9)) -> dict:
     """:data:`STAT_NAMES` over the working flank as jnp scalars (jitted, differentiable
     in ``settings`` by ``jax.jacfwd``/``jax.grad``; ``max``/``min`` are the plain
@@ -514,9 +509,9 @@ def _stats_jac(inp, settings, flank, shape):
 _stats_jac_jit = jax.jit(_stats_jac, static_argnums=(0, 2, 3))
 
 
-def statistics_gradient(inp: BlankInput, settings: Settings, flank: str = "convex",
+def statistics_gradient(inp: BlankInput, settings: StudySettings, flank: str = "convex",
                         shape=(15, 9)) -> dict:
-    """``{stat: Settings of derivatives}`` (forward mode through the blank Newton
+    """``{stat: StudySettings of derivatives}`` (forward mode through the blank Newton
     and the meshing-equation Newton, implicit function theorem).  Units: per mm for
     ``cutter_radius`` and ``cutter_shift``, per rad for ``blade_angle_delta``."""
     return _stats_jac_jit(inp, settings, flank, tuple(int(x) for x in shape))
@@ -524,9 +519,9 @@ def statistics_gradient(inp: BlankInput, settings: Settings, flank: str = "conve
 
 def _sweep(inp, r0s, flank, shape):
     def one(r0):
-        st = Settings(r0, 0.0 * r0, 0.0 * r0)
+        st = StudySettings(r0, 0.0 * r0, 0.0 * r0)
         val = _stats_fn(inp, st, flank, shape)
-        der = jax.jacfwd(lambda x: _stats_fn(inp, Settings(x, 0.0 * x, 0.0 * x),
+        der = jax.jacfwd(lambda x: _stats_fn(inp, StudySettings(x, 0.0 * x, 0.0 * x),
                                              flank, shape))(r0)
         return val, der
     return jax.vmap(one)(r0s)
@@ -553,7 +548,7 @@ _OPT_SCALE = jnp.array([10.0, 1.0, 1.0])     # x = (r0/10 mm, d_alpha/deg, shift
 
 
 def _x_to_settings(x):
-    return Settings(x[0] * _OPT_SCALE[0], x[1] * _OPT_SCALE[1] * _DEG, x[2] * _OPT_SCALE[2])
+    return StudySettings(x[0] * _OPT_SCALE[0], x[1] * _OPT_SCALE[1] * _DEG, x[2] * _OPT_SCALE[2])
 
 
 def design_objective(inp, flank="convex", shape=(9, 7), r_ref=20.0, phi_floor=1.0,
@@ -578,11 +573,11 @@ def design_objective(inp, flank="convex", shape=(9, 7), r_ref=20.0, phi_floor=1.
     return J
 
 
-def optimise_design(inp: BlankInput, start: Settings, *, flank="convex", shape=(9, 7),
+def optimise_design(inp: BlankInput, start: StudySettings, *, flank="convex", shape=(9, 7),
                     steps: int = 40, learning_rate: float = 0.05):
     """Adam (optax, jitted ``lax.scan`` via :func:`gearjax.optimize.minimize_optax`)
     on :func:`design_objective` over (r0, blade angle change, cutter shift) within
-    :data:`OPT_BOUNDS`; forward-mode gradients.  Returns ``(OptResult, Settings)``."""
+    :data:`OPT_BOUNDS`; forward-mode gradients.  Returns ``(OptResult, StudySettings)``."""
     import optax
 
     from gearjax.optimize import minimize_optax

@@ -68,7 +68,7 @@ import jax
 import jax.numpy as jnp
 
 from gearjax.errors import require_converged
-from gearjax.gears import iso23509
+from gearjax.gears.hypoid import iso23509
 from gearjax.newton import newton_solve
 
 __all__ = ["cone_tangency", "normal_offset_component", "delta2_from_normal",

@@ -2,7 +2,7 @@
 
 Frames (all right-handed, transforms from :mod:`gearjax.frames`, active rotations):
 
-* S_t  cutter frame (see :mod:`gearjax.cutters`): ``z_t`` is the cutter axis,
+* S_t  cutter frame (see :mod:`gearjax.gears.hypoid.cutter`): ``z_t`` is the cutter axis,
   pointing from the cutter head towards the work; blade tips lie in ``z_t = 0``.
 * S_c  cradle frame: ``z_c`` is the cradle axis (same sense as ``z_t`` at zero
   tilt), origin at the machine centre in the machine plane (the plane of the blade
@@ -183,11 +183,7 @@ class No116Dials:
 
 def _rot_k(phi_t, eps):
     """Active rotation by phi_t about k = (sin eps, 0, cos eps) (the tilt drum axis)."""
-    k = jnp.stack([jnp.sin(eps), 0.0 * eps, jnp.cos(eps)])
-    K = jnp.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
-    R = jnp.eye(3) + jnp.sin(phi_t) * K + (1.0 - jnp.cos(phi_t)) * (K @ K)
-    top = jnp.concatenate([R, jnp.zeros((3, 1))], axis=1)
-    return jnp.concatenate([top, jnp.array([[0.0, 0.0, 0.0, 1.0]])], axis=0)
+    return frames.rot_axis(jnp.stack([jnp.sin(eps), 0.0 * eps, jnp.cos(eps)]), phi_t)
 
 
 _MIRROR_Y = jnp.diag(jnp.array([1.0, -1.0, 1.0, 1.0]))

@@ -1,8 +1,8 @@
 """Face-milled hypoid and spiral-bevel tooth flanks by seed 004's algorithm.
 
 A flank is the envelope of a straight-blade face-mill cutter cone
-(:mod:`gearjax.cutters`) carried by a cradle-type generator
-(:mod:`gearjax.machines`), or for a formate (non-generated) member the cutter cone
+(:mod:`gearjax.gears.hypoid.cutter`) carried by a cradle-type generator
+(:mod:`gearjax.gears.hypoid.machine`), or for a formate (non-generated) member the cutter cone
 itself placed by the settings.  With ``r_w(s, theta, psi)`` the cutter surface in
 the work frame and ``n_w`` its unit normal:
 
@@ -57,9 +57,9 @@ import jax.numpy as jnp
 import numpy as np
 
 from gearjax import frames
-from gearjax.cutters import FaceMillCutter, cutter_normal, cutter_point, fillet_start
+from gearjax.gears.hypoid.cutter import FaceMillCutter, cutter_normal, cutter_point, fillet_start
 from gearjax.errors import check_int, check_positive, check_range, require_converged
-from gearjax.machines import MachineSettings, cutter_to_work, work_to_machine
+from gearjax.gears.hypoid.machine import MachineSettings, cutter_to_work, work_to_machine
 from gearjax.newton import newton_solve
 
 __all__ = ["MemberBlank", "FlankSpec", "FlankGrid", "make_member_blank", "mean_cone_distance",

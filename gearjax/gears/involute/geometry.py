@@ -47,10 +47,11 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ..errors import check_int, check_range, require_converged
-from ..kinematics import Kinematics, Mesh, eigen_kinematics, parallel_axes
-from ..newton import newton_solve
-from ..surfaces import GeneratedSurface, local_geometry, unit_normal
+from gearjax.frames import matrix_z
+from gearjax.errors import check_int, check_range, require_converged
+from gearjax.kinematics import Kinematics, Mesh, eigen_kinematics, parallel_axes
+from gearjax.newton import newton_solve
+from gearjax.surfaces import GeneratedSurface, local_geometry, unit_normal
 
 __all__ = ["InvolutePair", "rack_flank", "generated_flank", "pair_geometry",
            "PathResult", "path_kinematics", "path_kinematics_traced", "closed_form_path",
@@ -261,11 +262,6 @@ def _pair_mesh(pair, geo, omega1):
     return parallel_axes(geo["a_w"], pair.z2 / pair.z1, omega1=omega1)
 
 
-def _rotz(phi, v):
-    c, s = jnp.cos(phi), jnp.sin(phi)
-    return jnp.stack([c * v[0] - s * v[1], s * v[0] + c * v[1], v[2]])
-
-
 def _contact_at(pair: InvolutePair, geo: dict, mesh: Mesh, rho1, side):
     """Contact of the pinion flank ``side`` at transverse roll distance rho1, z = 0.
 
@@ -277,8 +273,8 @@ def _contact_at(pair: InvolutePair, geo: dict, mesh: Mesh, rho1, side):
     def resid(x, rho):
         uv, phi = x[:2], x[2]
         p = flank(uv)
-        pf = _rotz(phi, p)
-        nf = _rotz(phi, unit_normal(flank, uv))
+        pf = matrix_z(phi) @ p
+        nf = matrix_z(phi) @ unit_normal(flank, uv)
         v12 = jnp.cross(mesh.omega1, pf) - jnp.cross(mesh.omega2, pf - mesh.a)
         return jnp.stack([p[2], (p[0] ** 2 + p[1] ** 2 - rb1 ** 2 - rho ** 2) / r1,
                           jnp.dot(nf, v12) / jnp.linalg.norm(mesh.omega1)])
@@ -317,13 +313,13 @@ def path_kinematics_traced(pair: InvolutePair, t, side=-1, omega1=1.0) -> PathRe
 
     def one(rho):
         uv, phi, g, sol, env = _contact_at(pair, geo, mesh, rho, side)
-        pf = _rotz(phi, g.r)
+        pf = matrix_z(phi) @ g.r
         # orient n into the pinion tooth: the outward normal of flank `side` points
         # towards -side * (circumferential direction z x r)
         tdir = jnp.cross(jnp.array([0.0, 0.0, 1.0]), g.r)
         out = -side * jnp.sign(jnp.dot(g.n, tdir))
         s = -out
-        nf = _rotz(phi, s * g.n)
+        nf = matrix_z(phi) @ (s * g.n)
         Rm = jnp.array([[jnp.cos(phi), -jnp.sin(phi), 0.0], [jnp.sin(phi), jnp.cos(phi), 0.0],
                         [0.0, 0.0, 1.0]])
         Wf = Rm @ (s * g.W) @ Rm.T

@@ -1,4 +1,4 @@
-"""Seed 000 on a machine-cut pair (gearjax.seed000_pair, gearjax.contact_kinematics):
+"""Seed 000 on a machine-cut pair (gearjax.studies.cutter_radius_pair, gearjax.gears.hypoid.contact_kinematics):
 the seed's cutter cone as a formate gear, the pinion it generates, TCA contact points,
 and the kinematics there against the seed's eigenfunction model."""
 
@@ -7,17 +7,17 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from gearjax import tca_hypoid as th
-from gearjax.contact_kinematics import path_kinematics
-from gearjax.gears import hypoid_kinematics as hk
-from gearjax.seed000_pair import seed000_pair, seed_uv
+from gearjax.gears.hypoid import tca as th
+from gearjax.gears.hypoid.contact_kinematics import path_kinematics
+from gearjax.studies import cutter_radius as hk
+from gearjax.studies.cutter_radius_pair import study_pair, study_uv
 from gearjax.tca import ARCSEC
 
 
 @pytest.fixture(scope="module")
 def conj():
-    inp = hk.seed000_blank_input(95.25)
-    sp = seed000_pair(inp, hk.Settings.make(95.25), "convex")
+    inp = hk.study_blank_input(95.25)
+    sp = study_pair(inp, hk.StudySettings.make(95.25), "convex")
     prep = th.prepare(sp.pair)
     out = th.hypoid_tca(prep, line_contact=True, steps_per_pitch=8, half_pitches=1.0, n_pairs=3,
                         strict=False)
@@ -51,7 +51,7 @@ def test_contact_kinematics_equal_the_seed_model(conj):
     route (contact-point velocity from the TCA, both flanks' curvatures) agree."""
     sp, prep, out = conj
     k = path_kinematics(prep.pair, out.path, line_contact=True)
-    uv = seed_uv(sp, out.path.p2_body)
+    uv = study_uv(sp, out.path.p2_body)
     f = jax.vmap(lambda q: hk._point(sp.setup, q))(jnp.asarray(uv))
     assert np.asarray(f.converged).all()
     for name in ("u1", "u2", "u_e", "u_s", "srr", "r_eff", "phi_I", "phi_II", "k_II"):

@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 from gearjax.errors import ConvergenceError
-from gearjax.gears import hypoid_kinematics as hk
-from gearjax.gears.hypoid_blank import blank_geometry
+from gearjax.studies import cutter_radius as hk
+from gearjax.gears.hypoid.blank import blank_geometry
 
 SHAPE = (7, 5)
 
@@ -26,8 +26,8 @@ SEED_TABLE1 = {76.2: (47.365, 15.940, -22.060, 12.493, 76.650, 8.774, 70.906),
 
 @pytest.fixture(scope="module")
 def base():
-    inp = hk.seed000_blank_input(95.25)
-    st = hk.Settings.make(95.25)
+    inp = hk.study_blank_input(95.25)
+    st = hk.StudySettings.make(95.25)
     s, f = hk.flank_fields(inp, st, "convex", SHAPE)
     return inp, st, s, f
 
@@ -35,9 +35,9 @@ def base():
 def test_seed_angular_velocities_in_pitch_frame():
     """Seed 2.3: omega(2) = |w2|(-c d2 s b2, c d2 c b2, -s d2), omega(1) = |w1|(c d1 s b1,
     -c d1 c b1, -s d1) in i-j-k, with the blank's pitch and spiral angles."""
-    for r0 in hk.SEED000_CUTTERS.values():
-        inp = hk.seed000_blank_input(r0)
-        s = hk.pitch_setup(inp, hk.Settings.make(r0))
+    for r0 in hk.STUDY_CUTTERS.values():
+        inp = hk.study_blank_input(r0)
+        s = hk.pitch_setup(inp, hk.StudySettings.make(r0))
         M = np.stack([np.asarray(s.i), np.asarray(s.j), np.asarray(s.k)])
         d1, d2, b1, b2 = (float(s.blank[k]) for k in ("delta1", "delta2", "beta_m1", "beta_m2"))
         wg = np.asarray(s.mesh.omega1)
@@ -106,12 +106,12 @@ def test_k_II_equals_curvature_difference_of_conjugate_flanks(base):
 def test_seed_designs_free_of_limits_and_table1(base):
     """The three seed-000 designs (x_hm1 = 0.5): no meshing limit or curvature
     interference on the working convex flank; Table 1 trends and values.  (The
-    blank is re-designed from ``Settings.cutter_radius``; ``inp.cutter_radius`` is
+    blank is re-designed from ``StudySettings.cutter_radius``; ``inp.cutter_radius`` is
     not used by the model, so one compiled program serves all three.)"""
     prev = None
     for r0, row in SEED_TABLE1.items():
-        inp = hk.seed000_blank_input(r0)
-        _, f = hk.flank_fields(base[0], hk.Settings.make(r0), "convex", SHAPE)
+        inp = hk.study_blank_input(r0)
+        _, f = hk.flank_fields(base[0], hk.StudySettings.make(r0), "convex", SHAPE)
         lim = hk.limit_report(f)
         assert not lim["meshing_limit"]["inside"]
         assert not lim["curvature_interference"]["inside"]
@@ -131,8 +131,8 @@ def test_seed_designs_free_of_limits_and_table1(base):
 def test_curvature_interference_detected_and_located():
     """x_hm1 = 0 (long gear addendum): Phi_II = 0 crosses the working flank near the
     gear tip; the reported zero curve is where the recomputed Phi_II vanishes."""
-    inp = hk.seed000_blank_input(95.25, profile_shift=0.0)
-    s, f = hk.flank_fields(inp, hk.Settings.make(95.25), "convex", SHAPE)
+    inp = hk.study_blank_input(95.25, profile_shift=0.0)
+    s, f = hk.flank_fields(inp, hk.StudySettings.make(95.25), "convex", SHAPE)
     lim = hk.limit_report(f)["curvature_interference"]
     assert lim["inside"] and 0 < lim["fraction"] < 0.5
     pts = np.array(lim["zero_curve_uv"])
@@ -171,7 +171,7 @@ def test_gradients_vs_central_differences(base):
             kw = {"cutter_radius": st.cutter_radius, "blade_angle_delta": st.blade_angle_delta,
                   "cutter_shift": st.cutter_shift}
             kw[field_name] = kw[field_name] + d
-            return hk.flank_statistics(inp, hk.Settings(**kw), shape=SHAPE)
+            return hk.flank_statistics(inp, hk.StudySettings(**kw), shape=SHAPE)
         fp, fm = at(h), at(-h)
         for nm in names:
             fd = (float(fp[nm]) - float(fm[nm])) / (2 * h)
@@ -194,16 +194,16 @@ def test_vmap_sweep_and_its_derivative(base):
 
 def test_validation_and_strict():
     with pytest.raises(ValueError, match="cutter_radius_mm"):
-        hk.Settings.make(5.0)
+        hk.StudySettings.make(5.0)
     with pytest.raises(ValueError, match="blade_angle_delta_deg"):
-        hk.Settings.make(95.25, blade_angle_delta_deg=30.0)
-    inp = hk.seed000_blank_input(95.25)
+        hk.StudySettings.make(95.25, blade_angle_delta_deg=30.0)
+    inp = hk.study_blank_input(95.25)
     with pytest.raises(ValueError, match="flank"):
-        hk.flank_fields(inp, hk.Settings.make(95.25), "left")
+        hk.flank_fields(inp, hk.StudySettings.make(95.25), "left")
     with pytest.raises(ValueError, match="shape"):
-        hk.flank_fields(inp, hk.Settings.make(95.25), "convex", (1, 5))
+        hk.flank_fields(inp, hk.StudySettings.make(95.25), "convex", (1, 5))
     # no physical blank for a 2 mm cutter (docs/hypoid_blank.md): raises by default
-    bad = hk.Settings(jnp.asarray(2.0), 0.0, 0.0)
+    bad = hk.StudySettings(jnp.asarray(2.0), 0.0, 0.0)
     with pytest.raises(ConvergenceError):
         hk.flank_fields(inp, bad, "convex", SHAPE)
     s, f = hk.flank_fields(inp, bad, "convex", SHAPE, strict=False)

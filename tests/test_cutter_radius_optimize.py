@@ -4,12 +4,10 @@ and the final design passes the full forward model's limit checks."""
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax.gears import hypoid_kinematics as hk
-
-
+from gearjax.studies import cutter_radius as hk
 def test_optimise_design_improves_and_rechecks():
-    inp = hk.seed000_blank_input(95.25)
-    start = hk.Settings.make(95.25)
+    inp = hk.study_blank_input(95.25)
+    start = hk.StudySettings.make(95.25)
     res, best = hk.optimise_design(inp, start, shape=(5, 4), steps=6)
     h = np.asarray(res.history)
     assert h.shape == (6,) and np.all(np.isfinite(h))

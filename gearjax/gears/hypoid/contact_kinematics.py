@@ -1,7 +1,7 @@
 """Rolling, sliding and curvature at the contact points of a hypoid/spiral-bevel TCA.
 
 For every point of a :class:`~gearjax.tca.ContactPath` of a
-:class:`~gearjax.tca_hypoid.HypoidPair` this module computes the quantities of seed
+:class:`~gearjax.gears.hypoid.tca.HypoidPair` this module computes the quantities of seed
 000 §1 twice:
 
 * **model** -- the eigenfunction kinematics of seed 000 (:func:`gearjax.kinematics.
@@ -39,11 +39,12 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
-from gearjax import tca_hypoid as th
-from gearjax.gears.hypoid import work_point
+from gearjax.gears.hypoid import tca as th
+from gearjax.gears.hypoid.flank import work_point
+from gearjax.frames import matrix_z
 from gearjax.kinematics import Kinematics, Mesh, eigen_kinematics
 from gearjax.surfaces import GeneratedSurface, curvature_in_direction, local_geometry
-from gearjax.tca import (ContactPath, Misalignment, _rz, contact_equations, gear_mount,
+from gearjax.tca import (ContactPath, Misalignment, contact_equations, gear_mount,
                          relative_curvature)
 
 __all__ = ["PathKinematics", "path_kinematics"]
@@ -93,7 +94,7 @@ def path_kinematics(pair: th.HypoidPair, path: ContactPath, mis: Misalignment | 
                     *, line_contact: bool = False) -> PathKinematics:
     """Model and pair kinematics at every point of ``path`` (module docstring; jitted).
 
-    ``path`` is the :attr:`~gearjax.tca_hypoid.HypoidTCA.path` of a TCA of ``pair``
+    ``path`` is the :attr:`~gearjax.gears.hypoid.tca.HypoidTCA.path` of a TCA of ``pair``
     with misalignment ``mis`` (default none) in the same contact mode
     (``line_contact``).  Points where the path did not converge give meaningless
     values: mask them with ``path.converged``.
@@ -110,7 +111,7 @@ def path_kinematics(pair: th.HypoidPair, path: ContactPath, mis: Misalignment | 
 
     def point(x, ph1):
         uv1, _, _ = unpack(x)
-        return _rz(ph1) @ r1(uv1) + mis.dP * ez
+        return matrix_z(ph1) @ r1(uv1) + mis.dP * ez
 
     def one(uv1, uv2, ph2, ph1):
         x = pack(jnp.concatenate([uv1, uv2, jnp.stack([ph2])]))
@@ -119,7 +120,7 @@ def path_kinematics(pair: th.HypoidPair, path: ContactPath, mis: Misalignment | 
         dx = -jnp.linalg.solve(Fx, Fp)
         r, v_c = jax.jvp(point, (x, ph1), (dx, jnp.ones_like(ph1)))
         dph2 = dx[-1]
-        R1, R2 = _rz(ph1), R @ _rz(ph2)
+        R1, R2 = matrix_z(ph1), R @ matrix_z(ph2)
         n = R1 @ _outward_normal(pair.pinion, r1, uv1)
         g1, g2 = local_geometry(r1, uv1), local_geometry(r2, uv2)
         W1 = jnp.sign(jnp.dot(R1 @ g1.n, n)) * (R1 @ g1.W @ R1.T)

@@ -5,8 +5,8 @@ Three routes to the same blank, chosen by ``BlankInput.method``:
 ``"iso23509-method0"``  spiral bevel (offset 0), ISO 23509:2016 6.2.1 + clause 7;
 ``"iso23509-method1"``  hypoid, the Gleason method, ISO 23509:2016 6.2.2 + clause 7
                         (face milling: limit curvature radius = cutter radius);
-``"seed003-tangency"``  hypoid pitch cones by the tangency of two skew cones
-                        (seed 003, :mod:`gearjax.gears.pitch_cones`): two-variable
+``"tangent-cones"``  hypoid pitch cones by the tangency of two skew cones
+                        (seed 003, :mod:`gearjax.gears.hypoid.pitch_cones`): two-variable
                         Newton in the pitch angles with the ratio and cutter-radius
                         conditions, contact point at mid face (seed eq. (7)); the
                         remaining dimensions by ISO 23509 clause 7.
@@ -36,12 +36,14 @@ import jax.numpy as jnp
 import numpy as np
 
 from gearjax.errors import check_int, check_range, require_converged
-from gearjax.gears import iso23509, pitch_cones
-
-__all__ = ["METHODS", "BlankInput", "BlankData", "OUTPUTS", "blank_geometry",
+from gearjax.gears.hypoid import iso23509
+from gearjax.gears.hypoid import pitch_cones
+__all__ = ["METHODS", "METHOD_ALIASES", "BlankInput", "BlankData", "OUTPUTS", "blank_geometry",
            "blank_sensitivity", "SENSITIVITY_INPUTS"]
 
-METHODS = ("iso23509-method0", "iso23509-method1", "seed003-tangency")
+METHODS = ("iso23509-method0", "iso23509-method1", "tangent-cones")
+#: former names of the methods, still accepted in design files and constructors
+METHOD_ALIASES = {"seed003-tangency": "tangent-cones"}
 _HANDS = ("left", "right")
 _MEMBERS = ("pinion", "gear")
 
@@ -191,6 +193,10 @@ class BlankInput:
                 out[key] = float(v)
         return out
 
+    def __post_init__(self):
+        if isinstance(self.method, str) and self.method in METHOD_ALIASES:
+            object.__setattr__(self, "method", METHOD_ALIASES[self.method])
+
     def validate(self) -> "BlankInput":
         """Check concrete values; raise ``ValueError`` naming field, value and range."""
         if self.method not in METHODS:
@@ -204,7 +210,7 @@ class BlankInput:
         if self.method == "iso23509-method1" and self.spiral_member != "pinion":
             raise ValueError("spiral_member = 'gear' is not available with method "
                              "iso23509-method1 (its input is the pinion spiral angle); "
-                             "use 'pinion' or method seed003-tangency")
+                             "use 'pinion' or method tangent-cones")
         z1 = check_int("z1", self.z1, 1, 400)
         z2 = check_int("z2", self.z2, 1, 2000)
         check_range("ratio z2/z1", z2 / z1, 1.0, None)

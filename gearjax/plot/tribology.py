@@ -89,7 +89,7 @@ def save_figure_atomic(fig, path, dpi=120):
     ``os.replace``; see :func:`gearjax.io.atomic_write`)."""
     import io as _io
 
-    from .io import atomic_write
+    from gearjax.io import atomic_write
 
     path = os.fspath(path)
     ext = os.path.splitext(path)[1] or ".png"

@@ -1,15 +1,15 @@
 """Seed 000 repeated on machine-cut pairs: TCA contact points against the seed's model.
 
 For the 6/39, 230 mm, E = 35 mm set with the 6-, 7.5- and 9-inch cutters
-(:mod:`gearjax.gears.hypoid_kinematics`, assumptions in docs/kinematics_study.md):
+(:mod:`gearjax.studies.cutter_radius`, assumptions in docs/kinematics_study.md):
 
-1. **Conjugate machine-cut pair** (:func:`gearjax.seed000_pair.seed000_pair`):
+1. **Conjugate machine-cut pair** (:func:`gearjax.studies.cutter_radius_pair.study_pair`):
    the seed's cutter cone as a formate gear on the cradle machine, the pinion
    generated from it (tilted cutter, cradle = gear).  Line-contact TCA at several
    pinion blade positions sweeps the working flank; at every contact point on both
    flanks the kinematics of the pair (contact-point velocity from the TCA, both
-   flanks' curvatures; :mod:`gearjax.contact_kinematics`) are compared with the seed's
-   model at the same gear-flank point (:func:`gearjax.gears.hypoid_kinematics` fields
+   flanks' curvatures; :mod:`gearjax.gears.hypoid.contact_kinematics`) are compared with the seed's
+   model at the same gear-flank point (:func:`gearjax.studies.cutter_radius` fields
    at the mapped ``(u, theta)``), and field statistics are formed over the contact
    points.
 2. **Localised pair**: the same pinion with the blade point radius +2 mm (blade kept
@@ -17,7 +17,7 @@ For the 6/39, 230 mm, E = 35 mm set with the 6-, 7.5- and 9-inch cutters
    the pair's u_e, SRR and R_eff along the path against the seed's conjugate model.
 
 Writes ``experiments/results/seed000_machine_pair.json`` and
-``seed000_machine_pair.png``.  Run: ``python experiments/seed000_machine_pair.py``
+``seed000_machine_pair.png``.  Run: ``python experiments/cutter_radius_machine_pair.py``
 (about 4-6 min on 2 CPU cores, mostly XLA compiles).
 """
 
@@ -33,13 +33,13 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax import tca_hypoid as th
-from gearjax.contact_kinematics import path_kinematics
-from gearjax.gears import hypoid_kinematics as hk
-from gearjax.gears.hypoid import mid_estimate, solve_tip
-from gearjax.seed000_pair import seed000_pair, seed_uv
+from gearjax.gears.hypoid import tca as th
+from gearjax.gears.hypoid.contact_kinematics import path_kinematics
+from gearjax.studies import cutter_radius as hk
+from gearjax.gears.hypoid.flank import mid_estimate, solve_tip
+from gearjax.studies.cutter_radius_pair import study_pair, study_uv
 from gearjax.io import atomic_write
-from gearjax.plot_kinematics import save_figure
+from gearjax.plot.kinematics import save_figure
 from gearjax.tca import ARCSEC
 
 OUT = Path(__file__).resolve().parent / "results"
@@ -53,7 +53,7 @@ def _stats(a):
 
 
 def _seed_fields(sp, p2_body):
-    uv = seed_uv(sp, p2_body)
+    uv = study_uv(sp, p2_body)
     f = jax.vmap(lambda q: hk._point(sp.setup, q))(jnp.asarray(uv))
     return uv, f
 
@@ -156,9 +156,9 @@ def main():
     out = {"seed": "000_be2d122acb15edb3.txt", "flank": "gear convex (drive)",
            "units": {"u_e, u_s": "mm per rad of pinion roll", "r_eff": "mm"}, "cutters": {}}
     axial_75 = curves = None
-    for label, r0 in hk.SEED000_CUTTERS.items():
-        inp = hk.seed000_blank_input(r0)
-        sp = seed000_pair(inp, hk.Settings.make(r0), "convex")
+    for label, r0 in hk.STUDY_CUTTERS.items():
+        inp = hk.study_blank_input(r0)
+        sp = study_pair(inp, hk.StudySettings.make(r0), "convex")
         ms = sp.pair.pinion.machine
         entry = {"r0_mm": r0, "hand": sp.info["hand"], "chain_error_mm": sp.info["chain_error"],
                  "pinion_settings": {"radial_distance_mm": float(ms.radial_distance),
@@ -174,7 +174,7 @@ def main():
         conj, axial = conjugate_sweep(sp)
         entry["conjugate"] = conj
         # the seed model's own grid statistics, for the comparison of the trends
-        _, f = hk.flank_fields(inp, hk.Settings.make(r0), "convex", shape=(31, 15))
+        _, f = hk.flank_fields(inp, hk.StudySettings.make(r0), "convex", shape=(31, 15))
         entry["seed_model_grid_stats"] = {n: _stats(np.asarray(getattr(f, n))) for n in FIELDS}
         entry["seed_model_grid_stats"]["abs_srr"] = _stats(np.abs(np.asarray(f.srr)))
         loc, cur = localised(sp)

@@ -1,0 +1,1 @@
+"""Face-milled spiral-bevel and hypoid gears."""

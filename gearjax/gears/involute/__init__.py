@@ -1,0 +1,1 @@
+"""Rack-generated involute spur and helical gears."""
