@@ -1,10 +1,10 @@
 """Benchmark: a 41x21 hypoid flank grid with gearjax vs a per-point SciPy ``fsolve`` loop.
 
-Same design (seed 004's 8/43 pinion, convex flank), same equations (meshing,
+Same design ([HFT-hypoid] 8/43 pinion, convex flank), same equations (meshing,
 face-width, face-cone), same continuation order (tip row from mid face outwards, then
 each row from the tip down) and the same tolerance (residual <= 1e-10 mm, checked
 for both).  The SciPy side evaluates the equations with NumPy (no JAX in its loop)
-and the meshing equation from seed 004's angular-velocity form.  Then the gradient
+and the meshing equation from the angular-velocity form of [HFT-hypoid].  Then the gradient
 cost: ``jax.jacfwd`` of all grid points w.r.t. all 11 machine settings and the
 cutter radius against central differences over the same 12 parameters.
 

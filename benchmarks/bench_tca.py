@@ -20,7 +20,7 @@ from scipy.optimize import fsolve
 
 from gearjax.gears.involute.geometry import InvolutePair, generated_flank
 from gearjax.tca import ARCSEC, Misalignment, contact_equations
-from gearjax.gears.involute.tca import (InvoluteTCA, _reference_guess, crowned_pinion_flank,
+from gearjax.gears.involute.tca import (InvoluteTCA, reference_guess, crowned_pinion_flank,
                                   involute_assembly, involute_tca, misalignment_sensitivity)
 
 
@@ -51,7 +51,7 @@ def main():
     F, _, _ = contact_equations(r1, r2, involute_assembly(pair), mis, False)
     Fj = jax.jit(F)
     Jj = jax.jit(jax.jacfwd(F))
-    x_ref, _, _ = _reference_guess(des, side)
+    x_ref, _, _ = reference_guess(des, side)
     phis = np.asarray(path.phi1)
     mid = phis.size // 2
     Fj(jnp.asarray(x_ref), phis[mid]).block_until_ready()

@@ -1,28 +1,35 @@
-"""Seed 000 repeated on machine-cut pairs: TCA contact points against the seed's model.
+"""[Eigenfunctions] repeated on machine-cut pairs: TCA contact points against its model.
+
+[Eigenfunctions]: see docs/references.md.
 
 For the 6/39, 230 mm, E = 35 mm set with the 6-, 7.5- and 9-inch cutters
 (:mod:`gearjax.studies.cutter_radius`, assumptions in docs/kinematics_study.md):
 
 1. **Conjugate machine-cut pair** (:func:`gearjax.studies.cutter_radius_pair.study_pair`):
-   the seed's cutter cone as a formate gear on the cradle machine, the pinion
+   the paper's cutter cone as a formate gear on the cradle machine, the pinion
    generated from it (tilted cutter, cradle = gear).  Line-contact TCA at several
    pinion blade positions sweeps the working flank; at every contact point on both
    flanks the kinematics of the pair (contact-point velocity from the TCA, both
-   flanks' curvatures; :mod:`gearjax.gears.hypoid.contact_kinematics`) are compared with the seed's
-   model at the same gear-flank point (:func:`gearjax.studies.cutter_radius` fields
+   flanks' curvatures; :mod:`gearjax.gears.hypoid.contact_kinematics`) are compared with
+   the paper's model at the same gear-flank point (:func:`gearjax.studies.cutter_radius` fields
    at the mapped ``(u, theta)``), and field statistics are formed over the contact
    points.
 2. **Localised pair**: the same pinion with the blade point radius +2 mm (blade kept
    through the mean point) and modified roll 2C = 0.02 -- point contact along a path;
-   the pair's u_e, SRR and R_eff along the path against the seed's conjugate model.
+   the pair's u_e, SRR and R_eff along the path against the paper's conjugate model.
+3. **Gradient** of the machine-cut pair with respect to the study's cutter radius:
+   ``jax.jacfwd`` of the generated pinion's machine settings (through the blank
+   design, the formate placement and the generating-gear chain) against
+   Richardson-extrapolated central differences (steps 0.1 and 0.05 mm).
 
 Writes ``experiments/results/seed000_machine_pair.json`` and
 ``seed000_machine_pair.png``.  Run: ``python experiments/cutter_radius_machine_pair.py``
-(about 4-6 min on 2 CPU cores, mostly XLA compiles).
+(about 5-7 min on 2 CPU cores, mostly XLA compiles).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import time
@@ -54,7 +61,7 @@ def _stats(a):
 
 def _seed_fields(sp, p2_body):
     uv = study_uv(sp, p2_body)
-    f = jax.vmap(lambda q: hk._point(sp.setup, q))(jnp.asarray(uv))
+    f = jax.vmap(lambda q: hk.point_fields(sp.setup, q))(jnp.asarray(uv))
     return uv, f
 
 
@@ -130,6 +137,33 @@ def localised(sp, d_radius=2.0, c2=0.02):
     return res, curves
 
 
+GRAD_SETTINGS = ("radial_distance", "cradle_angle", "tilt", "swivel", "sliding_base",
+                 "center_to_back")
+
+
+def cutter_radius_gradient(r0, h=0.1):
+    """d/dr0 of the generated pinion's settings (mm/mm, rad/mm), its point radius and
+    the mean-contact gear angle: autodiff against ``(4 D(h/2) - D(h))/3`` (``D`` the
+    central difference, error O(h^4))."""
+    inp = hk.study_blank_input(r0)
+
+    def f(r):
+        sp = study_pair(inp, dataclasses.replace(hk.StudySettings.make(r0), cutter_radius=r), "convex")
+        pin = sp.pair.pinion
+        v = [getattr(pin.machine, n) for n in GRAD_SETTINGS]
+        return jnp.stack(v + [pin.cutter.point_radius, sp.info["phi2m"]])
+
+    ad = np.asarray(jax.jacfwd(f)(jnp.asarray(float(r0))))
+    d = {}
+    for step in (h, 0.5 * h):
+        d[step] = (np.asarray(f(jnp.asarray(r0 + step))) - np.asarray(f(jnp.asarray(r0 - step)))) / (2 * step)
+    fd = (4.0 * d[0.5 * h] - d[h]) / 3.0
+    names = GRAD_SETTINGS + ("point_radius", "phi2m")
+    return {n: {"autodiff": float(a), "central_difference": float(b),
+                "rel_error": float(abs(a - b) / abs(a)) if a != 0.0 else float(abs(b))}
+            for n, a, b in zip(names, ad, fd)}
+
+
 def _figure(path, axial, curves):
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(1, 3, figsize=(15, 4.4))
@@ -160,7 +194,7 @@ def main():
         inp = hk.study_blank_input(r0)
         sp = study_pair(inp, hk.StudySettings.make(r0), "convex")
         ms = sp.pair.pinion.machine
-        entry = {"r0_mm": r0, "hand": sp.info["hand"], "chain_error_mm": sp.info["chain_error"],
+        entry = {"r0_mm": r0, "hand": sp.info["hand"], "chain_error_mm": float(sp.info["chain_error"]),
                  "pinion_settings": {"radial_distance_mm": float(ms.radial_distance),
                                      "cradle_angle_deg": math.degrees(float(ms.cradle_angle)),
                                      "tilt_deg": math.degrees(float(ms.tilt)),
@@ -173,7 +207,7 @@ def main():
                                      "point_radius_mm": float(sp.pair.pinion.cutter.point_radius)}}
         conj, axial = conjugate_sweep(sp)
         entry["conjugate"] = conj
-        # the seed model's own grid statistics, for the comparison of the trends
+        # the [Eigenfunctions] model's own grid statistics, for the comparison of the trends
         _, f = hk.flank_fields(inp, hk.StudySettings.make(r0), "convex", shape=(31, 15))
         entry["seed_model_grid_stats"] = {n: _stats(np.asarray(getattr(f, n))) for n in FIELDS}
         entry["seed_model_grid_stats"]["abs_srr"] = _stats(np.abs(np.asarray(f.srr)))
@@ -182,6 +216,7 @@ def main():
         out["cutters"][label] = entry
         if label == "7.5in":
             axial_75, curves = axial, cur
+            entry["d_dr0_pinion"] = cutter_radius_gradient(r0)
     out["seconds"] = time.perf_counter() - t0
     OUT.mkdir(exist_ok=True)
     atomic_write(OUT / "seed000_machine_pair.json", json.dumps(out, indent=1).encode())

@@ -1,10 +1,10 @@
-"""Seed 000: influence of the cutter-head radius on hypoid meshing characteristics.
+"""[Eigenfunctions]: influence of the cutter-head radius on hypoid meshing characteristics.
 
-Reproduces seed 000 (``000_be2d122acb15edb3.txt``) sections 2-3 with
+Reproduces [Eigenfunctions] (docs/references.md) §2-§3 with
 :mod:`gearjax.studies.cutter_radius`: the 6/39, 230 mm, E = 35 mm gear set
-designed with 6-, 7.5- and 9-inch cutters (blank by the seed-003 tangency route,
+designed with 6-, 7.5- and 9-inch cutters (blank by the [Tangent-cones] tangency route,
 r0 as input; assumptions in docs/kinematics_study.md), Table 1 side by side with
-the seed, fields over the working gear flank (drive = convex side; the coast side
+the paper's, fields over the working gear flank (drive = convex side; the coast side
 as statistics), the trend with the cutter radius as numbers, a continuous vmap
 sweep with derivatives, gradient checks against central differences, and an
 optax optimisation re-checked by the full forward model.
@@ -35,7 +35,7 @@ from gearjax.plot.kinematics import field_maps, save_figure, trend_plot
 
 OUT = Path(__file__).resolve().parent / "results"
 
-SEED_TABLE1 = {  # seed 000 Table 1 (deg, mm)
+SEED_TABLE1 = {  # [Eigenfunctions] Table 1 (deg, mm)
     "6in": dict(b1=47.365, alpha_D=15.940, alpha_C=-22.060, delta1=12.493, beta1=76.650,
                 beta2=8.774, delta2=70.906),
     "7.5in": dict(b1=47.403, alpha_D=14.841, alpha_C=-23.159, delta1=10.441, beta1=78.833,
@@ -115,7 +115,7 @@ def main(argv=None):
         log(f"fields {name}")
     res["cases"] = cases
 
-    # trend with decreasing cutter radius (seed: u_e up, SRR down, R_eff up)
+    # trend with decreasing cutter radius ([Eigenfunctions]: u_e up, SRR down, R_eff up)
     trend = {}
     for flank in ("convex", "concave"):
         t = {}

@@ -7,8 +7,8 @@ by an independent full TCA, written to
 ``gearjax/examples/spiral_bevel_10x30_synthesised.toml`` and re-loaded.
 
 Run: ``python experiments/synthesis_spiral_bevel.py [--no-write] [--coast]``
-(about 4-5 min on 2 CPU cores, mostly XLA compiles: the (residual, Jacobian)
-function and the verification TCA; ``--coast`` adds the same for the coast side).
+(about 4-5 min on 2 CPU cores, mostly XLA compiles: the jitted Levenberg-Marquardt
+solve and the verification TCA; ``--coast`` adds the same for the coast side).
 """
 
 from __future__ import annotations
@@ -64,7 +64,8 @@ def run_side(design, side, v0, targets=None):
     ver = sy.verify(res.pair, res.targets)
     info = dict(side=side, drive=st.drive, start_s=t_start, solve_first_call_s=res.seconds,
                 solve_warm_s=t_warm, iterations=res.iterations, evaluations=res.evaluations,
-                converged=res.converged, history=res.history,
+                converged=res.converged, status=res.status, message=res.message,
+                history=res.history,
                 singular_values=res.singular_values.tolist(),
                 v_file_units=fmt_v(res.v), residuals=dict(zip(sy.RESIDUAL_NAMES, res.residuals.tolist())),
                 achieved=res.achieved,
@@ -121,7 +122,7 @@ def main(argv=None):
         atomic_write(EXAMPLE, HEADER.format(sides_note=note, h1=h1) + "\n" + dumps_toml(out.data))
         back = load_design("example:spiral_bevel_10x30_synthesised")
         st_f = sy.start(back, "drive", complementary=False)
-        r, _, aux = sy.residuals_and_jacobian(st_f, np.zeros(6), res.targets)
+        r, _, aux = sy.residuals_and_jacobian(st_f, np.zeros(len(sy.VARIABLES)), res.targets)
         print("reloaded file, drive residuals (unscaled):", (r * sy.SCALES).tolist(),
               {k: float(aux[k]) for k in ("xi1", "h1", "te_level_arcsec", "path_angle_deg",
                                           "semi_major_mm")}, flush=True)

@@ -5,7 +5,7 @@
 2. the same pair with the pinion cutter radius +2 mm (blade through the mean point)
    and modified roll 2C = 0.02: TE parabola against first-order theory, contact
    ratio, ellipses, and the misalignment (V-H) table by jax.jacfwd;
-3. the seed-004 8/43 hypoid set with the settings derived in docs/hypoid.md: where
+3. the [HFT-hypoid] 8/43 hypoid set (docs/references.md) with the settings derived in docs/hypoid.md: where
    (and whether) its flanks touch.
 
 Writes experiments/results/tca_spiral_bevel.json and tca_spiral_bevel.png.
@@ -82,7 +82,7 @@ def main():
                                  "seconds_incl_compile": time.perf_counter() - t}
     save_tca_plot(OUT / "tca_spiral_bevel.png", [("localised 10/30, drive", p, res.margin, res.multi)],
                   [th.pinion_outline(loc.pair)], title="spiral bevel 10/30")
-    # the 8/43 hypoid set of seed 004 with the derived settings
+    # the 8/43 hypoid set of [HFT-hypoid] with the derived settings
     d843 = load_design("example:hft_8x43")
     rep = {}
     for side in ("drive", "coast"):

@@ -19,8 +19,8 @@ The modulus is the *reduced modulus of elasticity* of Hamrock and Dowson,
     E' = 2 / [(1 - ν1²)/E1 + (1 - ν2²)/E2]  = 2 E*,
 
 E* being the contact modulus of Johnson (Contact Mechanics, 1985).  E' is also
-what the EHL film formulas use (``gearjax.tribology.film``).  The seed
-(001, eq. for a, b) writes ``a = k_a [3w / (2E'(A+B))]^(1/3)`` without defining E';
+what the EHL film formulas use (``gearjax.tribology.film``).  [VH-CATT]
+(see docs/references.md; eq. for a, b) writes ``a = k_a [3w / (2E'(A+B))]^(1/3)`` without defining E';
 gearjax uses E' = 2E* everywhere and says so.
 
 Exact solution (Johnson 1985, §4.2; Hamrock, Schmid & Jacobson, *Fundamentals of
@@ -212,7 +212,7 @@ def _solve_t(log_ratio):
     return res.x, res.converged
 
 
-def _hertz_exact(F, Rx, Ry, E_prime):
+def hertz_exact(F, Rx, Ry, E_prime):
     lr = jnp.log(Ry) - jnp.log(Rx)
     t, conv = _solve_t(lr)
     K, D = elliptic_KD(t)
@@ -273,9 +273,9 @@ def hertz_point_traced(F, Rx, Ry, E_prime, method: str = "exact") -> HertzResult
     F, Rx, Ry, E_prime = jnp.broadcast_arrays(*(jnp.asarray(v, float) for v in (F, Rx, Ry, E_prime)))
     if method == "exact":
         if F.ndim == 0:
-            return _hertz_exact(F, Rx, Ry, E_prime)
+            return hertz_exact(F, Rx, Ry, E_prime)
         shape = F.shape
-        out = jax.vmap(_hertz_exact)(F.ravel(), Rx.ravel(), Ry.ravel(), E_prime.ravel())
+        out = jax.vmap(hertz_exact)(F.ravel(), Rx.ravel(), Ry.ravel(), E_prime.ravel())
         return HertzResult(*(jnp.reshape(v, shape) for v in out))
     if method in _FIT_METHODS:
         return _hertz_fit(F, Rx, Ry, E_prime, method)

@@ -1,7 +1,10 @@
 """Exception types and validation helpers used at the library boundary.
 
 Validation happens on concrete values (constructors meant for users, file loaders,
-the CLI) before anything is traced; traced code never validates.
+the CLI) before anything is traced; traced code never validates.  The helpers let a
+traced value (a ``jax`` tracer, e.g. inside ``jax.grad`` of a function that calls a
+validated constructor) through unchanged: its value is not known, so it cannot be
+checked, and the constructors stay usable in differentiated code.
 """
 
 from __future__ import annotations
@@ -9,11 +12,17 @@ from __future__ import annotations
 import math
 from typing import Any
 
+import jax
 import numpy as np
 
 
 class ConvergenceError(RuntimeError):
     """A solver did not converge where a valid result was required."""
+
+
+def is_traced(value: Any) -> bool:
+    """True for a JAX tracer (a value whose number is not known while tracing)."""
+    return isinstance(value, jax.core.Tracer)
 
 
 def _fmt(value: Any) -> str:
@@ -28,8 +37,10 @@ def check_range(name: str, value: Any, lo: float | None = None, hi: float | None
     """Return ``float(value)`` or raise ``ValueError`` naming the parameter and range.
 
     ``lo``/``hi`` are the bounds (None for unbounded); ``lo_open``/``hi_open`` make a
-    bound exclusive.
+    bound exclusive.  A traced value is returned unchanged (not checked).
     """
+    if is_traced(value) or is_traced(lo) or is_traced(hi):
+        return value
     try:
         v = float(value)
     except (TypeError, ValueError):

@@ -240,8 +240,8 @@ def tooth_mesh(convex, concave, teeth: int):
 
     The convex flank is turned by ``k 2 pi / teeth`` (k in -1, 0, 1) so that both
     flanks bound one tooth: each flank's outward normal at mid face points away
-    from the other flank.  The root face joins the fillet-start rows (seed 004's
-    flank grid ends there).  Returns triangles (T, 3, 3) in mm.
+    from the other flank.  The root face joins the fillet-start rows (the flank
+    grid of [HFT-hypoid] ends there).  Returns triangles (T, 3, 3) in mm.
     """
     Pv, Nv = _np(convex.points), _np(convex.normals)
     Pc, Nc = _np(concave.points), _np(concave.normals)

@@ -1,4 +1,4 @@
-"""Eigenfunction kinematics of conjugate surfaces (seed 000, section 1).
+"""Eigenfunction kinematics of conjugate surfaces ([Eigenfunctions] §1).
 
 Two members rotate with constant angular velocities: member 1 with ``omega1``
 about an axis through the origin, member 2 with ``omega2`` about an axis through
@@ -18,7 +18,7 @@ At a contact point ``r`` with common unit normal ``n`` and the Weingarten map
 
 (``v_ri`` is the velocity of the contact point over surface i.)  ``p`` lies in the
 tangent plane and is normal to the instantaneous contact line, whose direction is
-``n x p``.  Seed 000 writes ``p = w12 x n - v12 d1n/ds``; ``v12 d1n/ds`` is the
+``n x p``.  [Eigenfunctions] writes ``p = w12 x n - v12 d1n/ds``; ``v12 d1n/ds`` is the
 directional derivative of n along v12, i.e. ``W1 v12``; with the normal curvature
 and geodesic torsion of Sigma_1 in the direction of v12 it is
 ``p = w12 x n + k_v v12 + tau_v (n x v12)`` — both forms are tested.
@@ -33,12 +33,12 @@ Derived quantities (components normal to the contact line, along ``p/|p|``):
     K_II = |p|^2/Phi_II,  R_eff = 1/K_II = Phi_II/|p|^2
     n0  = (v12 x q)/|v12 x q|                    limit normal (meshing limit)
 
-Seed slips corrected here (documented and tested):
+Slips of [Eigenfunctions] corrected here (documented and tested):
 
-* Seed 000 states ``SRR = 2 (Phi_II - Phi_I)/(Phi_I + Phi_II)``, which is minus
-  its own ``u_s/u_e``.  gearjax uses ``SRR = u_s/u_e`` with the seed's ``u_s`` and
+* [Eigenfunctions] states ``SRR = 2 (Phi_II - Phi_I)/(Phi_I + Phi_II)``, which is minus
+  its own ``u_s/u_e``.  gearjax uses ``SRR = u_s/u_e`` with its own ``u_s`` and
   ``u_e``; the sign of SRR then tells whether member 1's surface is faster (> 0).
-* The seed's alternative form ``q = (omega1 x omega2) x r - (omega2.omega1) a`` holds
+* Its alternative form ``q = (omega1 x omega2) x r - (omega2.omega1) a`` holds
   only for a particular direction of ``a``; from the definition of ``q`` one gets
   ``q = (omega1 x omega2) x r + (omega1.omega2) a - (omega1.a) omega2`` for the
   point ``a`` on axis 2 used here (the last term vanishes when ``a`` is the foot of
@@ -50,8 +50,8 @@ Orientation: every scalar above changes sign with ``n`` except SRR; ``K_II`` and
 ``t = p/|p|`` and both normal curvatures taken with the common normal ``n``
 (induced curvature, Litvin & Fuentes §8); along the contact line it is zero.
 
-Reference: seed 000 (the eigenfunction paper on conjugate surfaces) §1; Wu Xutang, *Principle of Gearing*
-(eigenfunctions); Litvin & Fuentes, *Gear Geometry and Applied Theory*, ch. 8–9.
+References (docs/references.md): [Eigenfunctions] §1; [WuXutang] (eigenfunctions);
+[Litvin2004] ch. 8–9.
 """
 
 from __future__ import annotations

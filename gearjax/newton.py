@@ -18,6 +18,12 @@ itself differentiable) and ``vmap``/``jit``.  Functions ``F`` may close over tra
 values; they are hoisted into explicit parameters with ``jax.closure_convert`` so
 that derivatives flow through them too.
 
+The rule differentiates ``F`` only with respect to the parameters whose tangent is
+not a symbolic zero, so a solve nested in another solve's Jacobian does not carry
+zero tangents through ``F``.  An eager call (outside any trace, parameters concrete
+arrays) runs as one ``jax.jit`` program cached on ``F`` (by identity) and the
+options: a module-level ``F`` is traced and compiled once per process.
+
 Every solve returns a :class:`NewtonResult` with the residual norm
 ``max|F(x)|``, the number of Newton steps and a ``converged`` flag
 (finite, residual <= ``tol``).  Nothing here raises on non-convergence — that is
@@ -36,6 +42,7 @@ from typing import Any, Callable, NamedTuple
 import jax
 import jax.numpy as jnp
 import numpy as np
+from jax.custom_derivatives import SymbolicZero
 
 __all__ = ["NewtonResult", "newton_solve"]
 
@@ -82,10 +89,13 @@ def _loop(F, tol, xtol, max_steps, max_halvings, x0, theta):
         ok = jnp.all(jnp.isfinite(dx))
         dx = jnp.where(ok, dx, 0.0)
 
+        # the full step is the loop's first pass (i = -1 -> 0, alpha = 1), so ``F``
+        # appears once in the line search, not twice (half the program to trace and
+        # compile for an ``F`` that itself contains solves)
         def ls_cond(s):
             alpha, xn, fn, rn, i = s
             good = rn <= (1.0 - 1e-4 * alpha) * res
-            return (i < max_halvings) & jnp.logical_not(good)
+            return (i < 0) | ((i < max_halvings) & jnp.logical_not(good))
 
         def ls_body(s):
             alpha, _, _, _, i = s
@@ -96,12 +106,8 @@ def _loop(F, tol, xtol, max_steps, max_halvings, x0, theta):
             rn = jnp.where(jnp.isfinite(rn), rn, jnp.inf)
             return alpha, xn, fn, rn, i + 1
 
-        x1 = x + dx
-        f1 = f(x1)
-        r1 = jnp.max(jnp.abs(f1))
-        r1 = jnp.where(jnp.isfinite(r1), r1, jnp.inf)
         alpha, xn, fn, rn, _ = jax.lax.while_loop(
-            ls_cond, ls_body, (jnp.asarray(1.0, x.dtype), x1, f1, r1, 0))
+            ls_cond, ls_body, (jnp.asarray(2.0, x.dtype), x, fx, res, -1))
         step = jnp.max(jnp.abs(alpha * dx))
         small = step <= xtol * (1.0 + jnp.max(jnp.abs(xn)))
         done = jnp.logical_not(ok) | ((rn <= tol) & small) | (rn == 0.0)
@@ -122,7 +128,6 @@ def _solve(F, tol, xtol, max_steps, max_halvings, x0, theta):
     return _loop(F, tol, xtol, max_steps, max_halvings, jax.lax.stop_gradient(x0), theta)
 
 
-@_solve.defjvp
 def _solve_jvp(F, tol, xtol, max_steps, max_halvings, primals, tangents):
     x0, theta = primals
     _, theta_dot = tangents
@@ -133,12 +138,31 @@ def _solve_jvp(F, tol, xtol, max_steps, max_halvings, primals, tangents):
     def fx(x):
         return jnp.reshape(F(jnp.reshape(x, shape), theta), (-1,))
 
-    J = jax.jacfwd(fx)(jnp.reshape(xs, (-1,)))
-    _, f_dot = jax.jvp(lambda th: jnp.reshape(F(xs, th), (-1,)), (theta,), (theta_dot,))
-    x_dot = jnp.reshape(-jnp.linalg.solve(J, f_dot), shape)
+    # differentiate F only with respect to the parameters whose tangent is not a
+    # symbolic zero (typically a few of the many arrays F closes over): the zero
+    # tangents of the others would otherwise be carried through F, in every
+    # Newton solve nested inside another's Jacobian, and traced and compiled
+    leaves, treedef = jax.tree_util.tree_flatten(theta)
+    t_leaves = treedef.flatten_up_to(theta_dot)
+    nz = [i for i, t in enumerate(t_leaves) if not isinstance(t, SymbolicZero)]
+    if not nz:
+        x_dot = jnp.zeros_like(xs)
+    else:
+        def f_theta(*vals):
+            th = list(leaves)
+            for i, v in zip(nz, vals):
+                th[i] = v
+            return jnp.reshape(F(xs, jax.tree_util.tree_unflatten(treedef, th)), (-1,))
+
+        J = jax.jacfwd(fx)(jnp.reshape(xs, (-1,)))
+        _, f_dot = jax.jvp(f_theta, tuple(leaves[i] for i in nz), tuple(t_leaves[i] for i in nz))
+        x_dot = jnp.reshape(-jnp.linalg.solve(J, f_dot), shape)
     zero_int = np.zeros(jnp.shape(out[2]), dtype=jax.dtypes.float0)
     zero_bool = np.zeros(jnp.shape(out[3]), dtype=jax.dtypes.float0)
     return out, (x_dot, jnp.zeros_like(out[1]), zero_int, zero_bool)
+
+
+_solve.defjvp(_solve_jvp, symbolic_zeros=True)
 
 
 def newton_solve(F: Callable, x0, theta=(), *, tol: float = 1e-10, xtol: float = 1e-12,
@@ -166,6 +190,12 @@ def newton_solve(F: Callable, x0, theta=(), *, tol: float = 1e-10, xtol: float =
     x0 = jnp.asarray(x0, dtype=jnp.result_type(float))
     if x0.ndim > 1:
         raise ValueError(f"x0 must be a scalar or a 1-D array, got shape {x0.shape}")
+    if _eager(theta):
+        # an eager call runs as one jitted program cached on ``F`` (by identity) and
+        # the options: a module-level ``F`` is traced and compiled once per process
+        # instead of at every call (an eager ``while_loop`` compiles its loop anew)
+        return _newton_jit(F, float(tol), float(xtol), int(max_steps), int(max_halvings),
+                           x0, theta)
     converted, consts = jax.closure_convert(lambda x, th: F(x, th), x0, theta)
 
     def F_all(x, th_all):
@@ -175,3 +205,21 @@ def newton_solve(F: Callable, x0, theta=(), *, tol: float = 1e-10, xtol: float =
     x, res, steps, conv = _solve(F_all, float(tol), float(xtol), int(max_steps),
                                  int(max_halvings), x0, (theta, tuple(consts)))
     return NewtonResult(x, res, steps, conv)
+
+
+def _eager(theta) -> bool:
+    """True outside any trace when every parameter is a concrete ``jax.Array``."""
+    try:
+        from jax._src.core import trace_state_clean
+        if not trace_state_clean():
+            return False
+    except ImportError:  # pragma: no cover - other JAX versions: stay on the plain path
+        return False
+    return all(isinstance(t, jax.Array) and not isinstance(t, jax.core.Tracer)
+               for t in jax.tree_util.tree_leaves(theta))
+
+
+@partial(jax.jit, static_argnums=(0, 1, 2, 3, 4))
+def _newton_jit(F, tol, xtol, max_steps, max_halvings, x0, theta):
+    return newton_solve(F, x0, theta, tol=tol, xtol=xtol, max_steps=max_steps,
+                        max_halvings=max_halvings)

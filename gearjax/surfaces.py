@@ -14,9 +14,9 @@ no hand-derived derivative formulas:
       kappa_n(t) = -dn[t].t = II(w, w)/I(w, w),      tau_g(t) = -dn[t].(n x t),
 
   so that ``dn[t] = -kappa_n t - tau_g (n x t)`` (Rodrigues/Bertrand; the
-  convention of seed 000 eq. for p).  With this sign a sphere of radius R with
-  its *outward* normal has kappa_n = -1/R: curvature is positive when the surface
-  bends towards ``n``;
+  convention of the equation for p in [Eigenfunctions] §1, docs/references.md).
+  With this sign a sphere of radius R with its *outward* normal has
+  kappa_n = -1/R: curvature is positive when the surface bends towards ``n``;
 * principal curvatures ``k1 >= k2`` and unit principal directions ``e1, e2``
   (Euler: ``kappa_n = k1 cos^2 phi + k2 sin^2 phi``, ``tau_g = (k2 - k1) sin phi cos phi``).
 
@@ -36,6 +36,7 @@ Litvin & Fuentes, *Gear Geometry and Applied Theory*, 2nd ed., ch. 6–8.
 
 from __future__ import annotations
 
+from functools import partial
 from typing import Callable, NamedTuple
 
 import jax
@@ -138,7 +139,13 @@ def _principal_from_W(n, W, ru):
 
 
 def local_geometry(r: Callable, uv) -> LocalGeometry:
-    """Position, normal, Weingarten map, principal curvatures and directions at ``uv``."""
+    """Position, normal, Weingarten map, principal curvatures and directions at ``uv``.
+
+    For a :class:`GeneratedSurface` one envelope solve and first-order implicit
+    derivatives suffice (:func:`_generated_local_geometry`).
+    """
+    if isinstance(r, GeneratedSurface):
+        return _generated_local_geometry(r, uv)
     uv = jnp.asarray(uv, float)
     J = jax.jacfwd(r)(uv)
     ru, rv = J[:, 0], J[:, 1]
@@ -189,10 +196,10 @@ def meshing_function(family: Callable, uv, psi):
     parameter ``psi``; ``n_w`` is its unit normal at fixed ``psi``.
     """
     uv = jnp.asarray(uv, float)
-    J = jax.jacfwd(family, argnums=0)(uv, psi)
+    # one forward-mode pass for the tangents and the relative velocity
+    J, v = jax.jacfwd(family, argnums=(0, 1))(uv, jnp.asarray(psi, float))
     N = jnp.cross(J[:, 0], J[:, 1])
     n = N / jnp.linalg.norm(N)
-    v = jax.jacfwd(family, argnums=1)(uv, psi)
     return jnp.dot(n, v)
 
 
@@ -232,6 +239,11 @@ class GeneratedSurface:
 
     def solve(self, uv) -> NewtonResult:
         uv = jnp.asarray(uv, float)
+        if _cacheable(self):
+            return _cached("solve", self, uv)
+        return self._solve(uv)
+
+    def _solve(self, uv) -> NewtonResult:
         return solve_envelope(self.family, uv, jax.lax.stop_gradient(self._psi0(uv)),
                               **self.newton_options)
 
@@ -241,6 +253,99 @@ class GeneratedSurface:
 
     def tool_normal(self, uv):
         """Unit normal of the tool surface at the contact (orientation of the tool)."""
+        return self.point_normal(uv)[1]
+
+    def point_normal(self, uv):
+        """Generated point and tool normal at the solved motion (one envelope solve)."""
         uv = jnp.asarray(uv, float)
-        psi = self.solve(uv).x
-        return unit_normal(lambda q: self.family(q, psi), uv)
+        if _cacheable(self):
+            return _cached("point_normal", self, uv)
+        return self._point_normal(uv)
+
+    def _point_normal(self, uv):
+        psi = self._solve(uv).x
+        return self.family(uv, psi), unit_normal(lambda q: self.family(q, psi), uv)
+
+
+# --------------------------------------------------------------------------- trace once
+#
+# A generated surface is evaluated many times in one program: every contact
+# equation, every Newton step and line search, every Jacobian (``jacfwd`` = ``vmap``
+# of ``jvp``) and every implicit-derivative rule calls the envelope solve again, and
+# Python would trace the tool family, its meshing function and the Newton loop
+# anew each time (hundreds of thousands of primitive binds for one hypoid TCA).
+# When the family is a :class:`jax.tree_util.Partial` of a module-level function
+# (a pytree: the function is static, its arguments are leaves) and ``psi0`` is a
+# number or such a ``Partial``, the solve, the point-and-normal and the local
+# geometry go through ``jax.jit`` functions of ``(family, psi0, uv)``: each is
+# traced once per argument structure and shape, and JAX caches the jvp, vmap,
+# partial-evaluation and transpose of that one jaxpr, so nested transformations
+# reuse it instead of tracing the Python again.  Values are unchanged.
+
+def _cacheable(surf) -> bool:
+    P = jax.tree_util.Partial
+    return isinstance(surf.family, P) and (isinstance(surf.psi0, P) or not callable(surf.psi0))
+
+
+def _cached(what, surf, uv):
+    psi0 = surf.psi0 if callable(surf.psi0) else jnp.asarray(surf.psi0, float)
+    opts = tuple(sorted(surf.newton_options.items()))
+    return _surface_jit(what, opts, surf.family, psi0, uv)
+
+
+@partial(jax.jit, static_argnums=(0, 1))
+def _surface_jit(what, opts, family, psi0, uv):
+    surf = GeneratedSurface(family, psi0, **dict(opts))
+    if what == "solve":
+        return surf._solve(uv)
+    if what == "point_normal":
+        return surf._point_normal(uv)
+    return _generated_local_geometry_impl(surf, uv)
+
+
+def _generated_local_geometry(surf: GeneratedSurface, uv) -> LocalGeometry:
+    uv = jnp.asarray(uv, float)
+    if _cacheable(surf):
+        return _cached("geometry", surf, uv)
+    return _generated_local_geometry_impl(surf, uv)
+
+
+def _generated_local_geometry_impl(surf: GeneratedSurface, uv) -> LocalGeometry:
+    """:func:`local_geometry` of an enveloped surface with one envelope solve.
+
+    With ``z = (u, v, psi)``, ``g(z)`` the tool family, ``n_t(z)`` its unit normal at
+    fixed ``psi`` and ``f(z) = n_t . g_psi`` the meshing function, the solution
+    ``psi*(uv)`` of ``f = 0`` has ``dpsi*/duv = -f_uv/f_psi`` (implicit function
+    theorem), the envelope's tangents are ``J = g_uv + g_psi dpsi*/duv`` and its unit
+    normal is ``n = J_u x J_v/|.|`` -- the same quantities that differentiating
+    ``r(uv) = g(uv, psi*(uv))`` gives.  Along a regular envelope the envelope and
+    the tool share their tangent plane, ``n(uv) = sgn n_t(uv, psi*(uv))`` (``sgn =
+    +-1``), so the Weingarten map needs only *first* derivatives of ``psi*``:
+    ``dn/duv = sgn (n_t,uv + n_t,psi dpsi*/duv)`` -- no second derivative through
+    the implicit solve (which would trace and compile the solve again for every
+    order).  Derivatives with respect to anything the family closes over flow
+    through ``psi*`` (custom JVP of the solve) and ``g``.
+    """
+    psi = surf._solve(uv).x
+    z = jnp.concatenate([uv, jnp.reshape(psi, (1,))])
+
+    def g(z):
+        return surf.family(z[:2], z[2])
+
+    def nf(z):
+        Jz = jax.jacfwd(g)(z)
+        N = jnp.cross(Jz[:, 0], Jz[:, 1])
+        nt = N / jnp.linalg.norm(N)
+        return jnp.concatenate([nt, jnp.stack([jnp.dot(nt, Jz[:, 2])])]), (Jz, nt)
+
+    D, (Jz, nt) = jax.jacfwd(nf, has_aux=True)(z)      # (4, 3): d(n_t, f)/dz
+    psi_uv = -D[3, :2] / D[3, 2]
+    J = Jz[:, :2] + jnp.outer(Jz[:, 2], psi_uv)
+    ru, rv = J[:, 0], J[:, 1]
+    N = jnp.cross(ru, rv)
+    n = N / jnp.linalg.norm(N)
+    sgn = jnp.sign(jnp.dot(n, nt))
+    Jn = sgn * (D[:3, :2] + jnp.outer(D[:3, 2], psi_uv))
+    W = Jn @ jnp.linalg.solve(J.T @ J, J.T)
+    k1, k2, e1, e2 = _principal_from_W(n, W, ru)
+    return LocalGeometry(surf.family(uv, psi), n, ru, rv, W, k1, k2, e1, e2)

@@ -119,16 +119,13 @@ class Misalignment:
 
     @classmethod
     def create(cls, dE=0.0, dP=0.0, dG=0.0, dSigma_deg=0.0):
-        """Validated constructor (mm, mm, mm, degrees) for user input."""
-        import math
-        vals = dict(dE=dE, dP=dP, dG=dG, dSigma=dSigma_deg)
-        for k, v in vals.items():
-            v = float(v)
-            if not math.isfinite(v) or abs(v) > (5.0 if k == "dSigma" else 50.0):
-                lim = "|dSigma| <= 5 deg" if k == "dSigma" else f"|{k}| <= 50 mm"
-                raise ValueError(f"{k} = {v!r} out of the allowed range ({lim})")
-        return cls(jnp.asarray(float(dE)), jnp.asarray(float(dP)), jnp.asarray(float(dG)),
-                   jnp.asarray(math.radians(float(dSigma_deg))))
+        """Validated constructor (mm, mm, mm, degrees) for user input: |dE|, |dP|, |dG|
+        <= 50 mm, |dSigma| <= 5 deg.  Traced values (inside ``jax.grad``) pass through."""
+        vals = [check_range(k, v, -lim, lim, unit=u) for k, v, lim, u in
+                (("dE", dE, 50.0, "mm"), ("dP", dP, 50.0, "mm"), ("dG", dG, 50.0, "mm"),
+                 ("dSigma", dSigma_deg, 5.0, "deg"))]
+        return cls(*(jnp.asarray(v, float) for v in vals[:3]),
+                   jnp.asarray(vals[3] * (np.pi / 180.0), float))
 
 
 @jax.tree_util.register_dataclass
@@ -255,8 +252,7 @@ def point_normal(surf, uv):
     """
     uv = jnp.asarray(uv, float)
     if isinstance(surf, GeneratedSurface):
-        psi = surf.solve(uv).x
-        return surf.family(uv, psi), unit_normal(lambda q: surf.family(q, psi), uv)
+        return surf.point_normal(uv)
     return surf(uv), unit_normal(surf, uv)
 
 

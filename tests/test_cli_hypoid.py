@@ -30,7 +30,7 @@ def test_blank_table_and_json(capsys):
     assert "blank of hft_8x43" in out and "deg" in out
     assert main(["blank", "example:hft_8x43", "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
-    # the ISO 23509 blank of the seed-004 input reproduces Table 1's cone angles and
+    # the ISO 23509 blank of the [HFT-hypoid] input reproduces its Table 1's cone angles and
     # mean cone distance (given there to 0.01 deg / 0.01 mm) within 0.05 deg / 0.1 mm
     assert abs(data["delta1"] - 12.55) < 0.05 and abs(data["delta2"] - 77.22) < 0.05
     assert abs(data["Rm1"] - 128.32) < 0.1 and abs(data["Rm2"] - 130.75) < 0.1

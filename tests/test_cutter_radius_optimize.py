@@ -1,5 +1,6 @@
-"""Seed-000 design optimisation: the jitted optax loop lowers the documented objective
-and the final design passes the full forward model's limit checks."""
+"""[Eigenfunctions] design optimisation (docs/references.md): the jitted optax loop
+lowers the documented objective and the final design passes the full forward model's
+limit checks."""
 
 import jax.numpy as jnp
 import numpy as np

@@ -1,9 +1,9 @@
-"""Seed 000 (sections 2-3): hypoid meshing characteristics by eigenfunctions.
+"""[Eigenfunctions] §2-§3 (docs/references.md): hypoid meshing characteristics by eigenfunctions.
 
-References are independent of the code under test: the seed's own angular-velocity
+References are independent of the code under test: the paper's own angular-velocity
 formulas, the ratio condition at the pitch point, Euler/Bertrand closed forms for
 the cutter cone, the conjugate pinion flank built explicitly (K_II = k_gear - k_pinion),
-the seed's Table 1 and central differences."""
+the paper's Table 1 and central differences."""
 
 from collections import namedtuple
 
@@ -18,7 +18,7 @@ from gearjax.gears.hypoid.blank import blank_geometry
 
 SHAPE = (7, 5)
 
-# seed 000 Table 1: r0 -> (b1 mm, alpha_D, alpha_C, delta1, beta1, beta2, delta2) deg
+# [Eigenfunctions] Table 1: r0 -> (b1 mm, alpha_D, alpha_C, delta1, beta1, beta2, delta2) deg
 SEED_TABLE1 = {76.2: (47.365, 15.940, -22.060, 12.493, 76.650, 8.774, 70.906),
                95.25: (47.403, 14.841, -23.159, 10.441, 78.833, 8.76, 72.901),
                114.3: (47.423, 14.106, -23.894, 9.075, 80.289, 8.754, 74.333)}
@@ -33,7 +33,7 @@ def base():
 
 
 def test_seed_angular_velocities_in_pitch_frame():
-    """Seed 2.3: omega(2) = |w2|(-c d2 s b2, c d2 c b2, -s d2), omega(1) = |w1|(c d1 s b1,
+    """[Eigenfunctions] §2.3: omega(2) = |w2|(-c d2 s b2, c d2 c b2, -s d2), omega(1) = |w1|(c d1 s b1,
     -c d1 c b1, -s d1) in i-j-k, with the blank's pitch and spiral angles."""
     for r0 in hk.STUDY_CUTTERS.values():
         inp = hk.study_blank_input(r0)
@@ -64,7 +64,7 @@ def test_meshing_equation_and_convergence(base):
     v = np.cross(wg, r) - np.cross(wp, r - a)
     assert np.max(np.abs(np.sum(n * v, -1)) / np.linalg.norm(v, axis=-1)) < 1e-10
     # the cutter point (0, 0) is the pitch point, in contact at roll 0
-    f0 = jax.jit(lambda x: hk._point(s, x))(jnp.zeros(2))
+    f0 = jax.jit(lambda x: hk.point_fields(s, x))(jnp.zeros(2))
     assert abs(float(f0.phi)) < 1e-12
     np.testing.assert_allclose(np.asarray(f0.r), np.asarray(s.P), atol=1e-10)
     # p tangent and normal to the contact line; eigen identities
@@ -76,8 +76,8 @@ def test_meshing_equation_and_convergence(base):
 
 
 def test_euler_bertrand_vs_autodiff(base):
-    """Seed 2.3 closed forms (cone: k_e = cos a/r_u, k_f = 0) vs autodiff curvature,
-    and the seed's p = w12 x n + k_v v + tau_v (n x v) vs p = w12 x n - W v."""
+    """[Eigenfunctions] §2.3 closed forms (cone: k_e = cos a/r_u, k_f = 0) vs autodiff curvature,
+    and the paper's p = w12 x n + k_v v + tau_v (n x v) vs p = w12 x n - W v."""
     _, _, s, f = base
     kv, tv = np.asarray(f.k_v), np.asarray(f.tau_v)
     scale = np.max(np.abs(kv))
@@ -104,7 +104,7 @@ def test_k_II_equals_curvature_difference_of_conjugate_flanks(base):
 
 
 def test_seed_designs_free_of_limits_and_table1(base):
-    """The three seed-000 designs (x_hm1 = 0.5): no meshing limit or curvature
+    """The three [Eigenfunctions] designs (x_hm1 = 0.5): no meshing limit or curvature
     interference on the working convex flank; Table 1 trends and values.  (The
     blank is re-designed from ``StudySettings.cutter_radius``; ``inp.cutter_radius`` is
     not used by the model, so one compiled program serves all three.)"""
@@ -119,11 +119,11 @@ def test_seed_designs_free_of_limits_and_table1(base):
         b = blank_geometry(inp)
         d1 = np.degrees(float(b.delta1))
         aD = np.degrees(float(b.alpha_nD))
-        # agreement where the seed's table is self-consistent (docs/kinematics_study.md)
+        # agreement where the paper's table is self-consistent (docs/kinematics_study.md)
         assert abs(d1 - row[3]) < 0.4
         assert abs(aD - row[1]) < 0.35    # measured: 0.309, 0.133, 0.016 deg
         assert abs(aD + np.degrees(float(b.alpha_nC)) - (row[1] - row[2])) < 1e-9
-        if prev is not None:  # seed trends: larger cutter -> smaller delta1, alpha_D; wider b1
+        if prev is not None:  # trends of [Eigenfunctions]: larger cutter -> smaller delta1, alpha_D; wider b1
             assert d1 < prev[0] and aD < prev[1] and float(b.b1) > prev[2]
         prev = (d1, aD, float(b.b1))
 
@@ -138,7 +138,7 @@ def test_curvature_interference_detected_and_located():
     pts = np.array(lim["zero_curve_uv"])
     assert len(pts) >= SHAPE[1]
     assert np.all(pts[:, 0] < 0)          # tip side of the gear (u < 0)
-    vals = jax.vmap(lambda x: hk._point(s, x).phi_II)(jnp.asarray(pts))
+    vals = jax.vmap(lambda x: hk.point_fields(s, x).phi_II)(jnp.asarray(pts))
     # linear interpolation on a 7x5 grid: within a few % of the field's range
     assert np.max(np.abs(np.asarray(vals))) < 0.05 * np.ptp(np.asarray(f.phi_II))
     assert not hk.limit_report(f)["meshing_limit"]["inside"]
@@ -217,12 +217,12 @@ def test_contact_line_is_level_set_of_the_roll_angle(base):
     _, _, s, _ = base
 
     def check(uv):
-        f = hk._point(s, uv)
-        dphi = jax.grad(lambda x: hk._point(s, x).phi)(uv)
+        f = hk.point_fields(s, uv)
+        dphi = jax.grad(lambda x: hk.point_fields(s, x).phi)(uv)
         duv = jnp.array([-dphi[1], dphi[0]])
         # along duv the roll is constant (dphi . duv = 0), so the contact point moves on
         # the flank at one instant: its tangent is the contact-line direction
-        J = jax.jacfwd(lambda x: hk._point(s, x).r)(uv)
+        J = jax.jacfwd(lambda x: hk.point_fields(s, x).r)(uv)
         t = J @ duv
         t = t / jnp.linalg.norm(t)
         return jnp.linalg.norm(jnp.cross(t, f.contact_dir)), jnp.abs(jnp.dot(t, f.p))

@@ -1,4 +1,4 @@
-"""Straight-blade face-mill cutter (gearjax.gears.hypoid.cutter): seed 004 surface, normals, fillet."""
+"""Straight-blade face-mill cutter (gearjax.gears.hypoid.cutter): [HFT-hypoid] surface, normals, fillet."""
 
 import math
 
@@ -17,7 +17,7 @@ def test_seed_formula_and_normal(flank, alpha):
     sg = 1 if flank == "convex" else -1
     for s, th in [(0.0, 0.3), (5.0, -1.2), (12.0, 2.9)]:
         r = np.asarray(cutter_point(c, s, th))
-        rho = 117.475 - sg * s * math.sin(a)              # seed 004, written out by hand
+        rho = 117.475 - sg * s * math.sin(a)              # [HFT-hypoid], written out by hand
         np.testing.assert_allclose(r, [rho * math.cos(th), rho * math.sin(th), -s * math.cos(a)],
                                    rtol=0, atol=1e-12)
         # normal = sgn * (dr/ds x dr/dtheta)/|.|, a unit vector
@@ -61,7 +61,7 @@ def test_fillet_joins_blade_and_tip_plane(flank):
 
 @pytest.mark.parametrize("flank,sg", [("convex", 1), ("concave", -1)])
 def test_tangents_by_hand(flank, sg):
-    """cutter_tangents against the derivatives of the seed 004 cone differentiated by
+    """cutter_tangents against the derivatives of the [HFT-hypoid] cone differentiated by
     hand: dr/ds = (-sg sin a cos t, -sg sin a sin t, -cos a),
     dr/dt = (-rho sin t, rho cos t, 0), rho = R_p - sg s sin a.  Round-off only
     (measured 0): 1e-14 on the unit tangent, 1e-12 mm on ~114 mm."""

@@ -1,4 +1,4 @@
-"""Friction coefficient: limits and trends required by the issue (seed 001 trend table),
+"""Friction coefficient: limits and trends required by the issue ([VH-CATT] trend table, docs/references.md),
 Stribeck shifts, mesh losses and bad input."""
 
 import math
@@ -147,7 +147,7 @@ def test_stribeck_shifts_as_in_seed():
 def test_stribeck_curve_definitions():
     """Stribeck sweep against its definitions through a second route: the Stribeck
     number η0 u_e/F_n in 1/m (η0 Pa·s, u_e in m/s, F_n N; typed from the docstring), μ
-    and λ_s equal to friction_coefficient at u_s = SRR·u_e (seed 001: SRR = u_s/u_e)."""
+    and λ_s equal to friction_coefficient at u_s = SRR·u_e ([VH-CATT]: SRR = u_s/u_e)."""
     ue = np.array([800.0, 3000.0, 12000.0])
     surf = make_surface(0.8)
     c = stribeck_curve(F, RX, RY, 0.2, ue, OIL, surf)
@@ -314,7 +314,7 @@ def test_mesh_losses_against_pointwise_route():
     outw = mesh_losses(F, us, ue, Rx, Ry, OIL, surf, p_in, weights=w)
     assert float(outw.mean_efficiency) == pytest.approx(1 - (w * P).sum() / (w.sum() * p_in), rel=1e-12)
     # input power varying along the cycle: the cycle efficiency is the ratio of energies
-    # 1 - Σ w P_f / Σ w P_in (seed 001: losses integrated over the path of contact), which
+    # 1 - Σ w P_f / Σ w P_in ([VH-CATT]: losses integrated over the path of contact), which
     # here differs from the (weighted) mean of the instantaneous efficiencies by 1.3e-3
     p_var = p_in * np.array([0.3, 1.0, 1.4, 1.2, 0.5])
     outv = mesh_losses(F, us, ue, Rx, Ry, OIL, surf, p_var, weights=w)

@@ -17,8 +17,8 @@ SAMPLE2 = dict(method="iso23509-method1", z1=13, z2=42, offset_mm=15.0,
                gear_outer_pitch_diameter_mm=170.0, gear_face_width_mm=30.0,
                spiral_angle_deg=50.0, cutter_radius_mm=63.5)
 
-# seed 000 table 1 gear set: 6/39, d = 230 mm, E = 35 mm; cutters 6, 7.5, 9 inch.
-# The seed gives neither spiral angle nor face width: gearjax uses Gleason's
+# [Eigenfunctions] Table 1 gear set (docs/references.md): 6/39, d = 230 mm, E = 35 mm; cutters 6, 7.5, 9 inch.
+# The paper gives neither spiral angle nor face width: gearjax uses Gleason's
 # hypoid rules psi_p = 25 + 5 sqrt(z2/z1) + 90 E/d (deg) and F = 0.155 d.
 SEED000 = dict(z1=6, z2=39, offset_mm=35.0, gear_outer_pitch_diameter_mm=230.0,
                gear_face_width_mm=0.155 * 230.0,
@@ -93,7 +93,7 @@ def test_three_routes_and_table():
         res[m] = out
     # Method 1 = ISO sample 2 (annex F.3): delta_a1 - theta_a1 = delta1 ~ 21.289 deg
     assert abs(res["iso23509-method1"]["delta1"] - 21.2877) < 1e-3
-    # seed route: contact point at mid face (seed eq. (7))
+    # [Tangent-cones] route: contact point at mid face ([Tangent-cones] eq. (7))
     assert abs(res["tangent-cones"]["c_be2"] - 0.5) < 1e-12
     assert abs(res["tangent-cones"]["beta_m1"] - 50.0) < 1e-10
     # Method 0: closed-form bevel pitch angle, apexes at the crossing point
@@ -104,7 +104,7 @@ def test_three_routes_and_table():
 @pytest.mark.parametrize("method", hb.METHODS)
 def test_blank_outputs_by_independent_relations(method):
     """Outputs of blank_geometry that the ISO sample tables do not list, each against
-    a relation typed in from its definition (ISO 23509:2016 clause 7, seed 003):
+    a relation typed in from its definition (ISO 23509:2016 clause 7, [Tangent-cones]):
 
     * m_et2 = d_e2/z2 (126), a_p = R_m2 sin(beta_m1 - beta_m2) (115 with 27);
     * d_e2 and b2 are the inputs; Method 0: common apex at the crossing point
@@ -112,10 +112,10 @@ def test_blank_outputs_by_independent_relations(method):
       theta1 = -90, theta2 = +90 deg), no offset angle;
     * hypoid routes: theta2 = 90 deg - zeta_m (the pitch point seen from the gear
       axis), a1 = t_z1, a2 = t_z2 (same apex in two routes);
-    * seed route: the ratio condition u r1 cos b1 = r2 cos b2 (Gleason's hypoid
+    * [Tangent-cones] route: the ratio condition u r1 cos b1 = r2 cos b2 (Gleason's hypoid
       factor, ISO (14)/(26)) and the pitch point at mid face, d_e2 = 2 (R_m2 + b2/2)
-      sin delta2 (seed 003 eq. (7));
-    * seed 003's machine table: dV = E sin theta2 - a1, dH = E cos theta2 + a2,
+      sin delta2 ([Tangent-cones] eq. (7));
+    * the machine table of [Tangent-cones]: dV = E sin theta2 - a1, dH = E cos theta2 + a2,
       cradle = theta2 + 90 deg (left hand), X_G = a2, tilt NaN (no solution) and
       the reciprocal tilt asin(tan alpha_lim / tan beta_m1).
     Closed forms and converged solves: 1e-10 (measured <= 3e-12, in a1 - t_z1)."""
@@ -145,7 +145,7 @@ def test_blank_outputs_by_independent_relations(method):
                                 b["machine_X_G"]],
                                [E * math.sin(th2) - a1, E * math.cos(th2) + a2, th2 + math.pi / 2,
                                 a2], **tol)
-    # the seed's tilt sin i = tan b1 / tan a_lim has no solution (|ratio| > 1, or
+    # the tilt of [Tangent-cones] sin i = tan b1 / tan a_lim has no solution (|ratio| > 1, or
     # a_lim = 0 for Method 0): NaN; the reciprocal reading asin(tan a_lim / tan b1)
     assert math.isnan(b["machine_tilt"])
     np.testing.assert_allclose(b["machine_tilt_reciprocal"],
@@ -208,9 +208,9 @@ def test_sensitivity_matches_central_differences(method):
 
 @pytest.mark.parametrize("method", ["iso23509-method1", "tangent-cones"])
 def test_seed000_cutter_study_trends(method):
-    """Seed 000 table 1: a larger cutter gives a smaller pinion pitch angle, a smaller
+    """[Eigenfunctions] Table 1: a larger cutter gives a smaller pinion pitch angle, a smaller
     drive-side pressure angle and (slightly) a wider pinion; our numbers beside the
-    seed's are in docs/hypoid_blank.md (no agreement is forced)."""
+    paper's are in docs/hypoid_blank.md (no agreement is forced)."""
     rows = []
     for rc0 in (76.2, 95.25, 114.3):
         b = blank_geometry(BlankInput.from_dict(dict(SEED000, method=method, cutter_radius_mm=rc0)))

@@ -1,4 +1,4 @@
-"""Hypoid flank grids by seed 004's algorithm (gearjax.gears.hypoid.flank) on the 8/43 example.
+"""Hypoid flank grids by the algorithm of [HFT-hypoid] (gearjax.gears.hypoid.flank) on the 8/43 example.
 
 Independent checks: meshing equation from the angular-velocity form (not the autodiff
 velocity the solver uses), generated-surface normal vs cutter normal, blank limits,
@@ -39,7 +39,7 @@ def test_blank_cones_by_hand(design, member):
     """Cone geometry of the member blank in the axial plane (x along the axis from the
     pitch apex, R the radius), typed in from the definitions:
 
-    * A_m = A_o - F/2 against the HFT formate hypoid paper's Table 1 (mean cone
+    * A_m = A_o - F/2 against [HFT-hypoid] Table 1 (mean cone
       distance 128.32 / 130.75 mm, printed to 0.01 mm: 5e-3 mm; measured 0);
     * the pitch generatrix g = (cos gp, sin gp): xi = -1, 0, +1 at A_o - F, A_m, A_o,
       and a step along the pitch-cone normal does not change l_p;
@@ -165,7 +165,7 @@ def _Mmw_ref(ms, phi):
 
 @pytest.mark.parametrize("mf", [("pinion", "convex"), ("pinion", "concave")])
 def test_meshing_equation_independent(design, grids, mf):
-    """n . v = 0 with v from seed 004's (w_c - w_w) x r + w_w x R in the machine frame;
+    """n . v = 0 with v from the (w_c - w_w) x r + w_w x R of [HFT-hypoid] in the machine frame;
     the work placement is typed in (not gearjax.gears.hypoid.machine) and the roll is linear
     (2C = 6D = 0 in the 8/43 settings): phi = R_a psi."""
     fl, g = design.flank(*mf), grids[mf]
@@ -228,7 +228,7 @@ def _mean_spiral_angle(fl):
     (("gear", "concave"), 33.82, 1.0),     # classical formate placement (root mean point)
 ])
 def test_spiral_angle_vs_table1(design, mf, target, tol):
-    """Mean spiral angle of the generated flank vs seed 004's Table 1.  The pinion
+    """Mean spiral angle of the generated flank vs [HFT-hypoid] Table 1.  The pinion
     settings were derived to meet it at (xi = 0, s = s_tip/2) (see docs/hypoid.md), the
     gear's from the classical relation at the mean root point (1 deg: its accuracy)."""
     beta, ok = _mean_spiral_angle(design.flank(*mf))

@@ -1,4 +1,4 @@
-"""Eigenfunction kinematics (seed 000 §1) against independent routes and closed forms.
+"""Eigenfunction kinematics ([Eigenfunctions] §1, docs/references.md) against independent routes and closed forms.
 
 Sigma_1 is an explicit curved patch on member 1; Sigma_2 is generated from it as
 the envelope in member 2's frame (GeneratedSurface), for crossed, parallel and
@@ -137,7 +137,7 @@ def test_eigenfunctions_against_independent_routes(case):
     assert abs(0.5 * (u1 + u2)) > 0.05 * scale      # SRR well conditioned here
     np.testing.assert_allclose(kin.srr, 2 * (u1 - u2) / (u1 + u2), rtol=1e-12)
 
-    # seed's alternative forms
+    # alternative forms of [Eigenfunctions]
     w1, w2 = mesh.omega1, mesh.omega2
     q_alt = jnp.cross(jnp.cross(w1, w2), g1.r) + (w1 @ w2) * mesh.a - (w1 @ mesh.a) * w2
     np.testing.assert_allclose(kin.q, q_alt, atol=1e-11)

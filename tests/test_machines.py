@@ -29,7 +29,7 @@ def test_mct_reproduces_seed_a11(dial):
     eps = D(15.0)
     tau = c + e + s
     a11 = math.cos(tau) * (math.cos(eps) ** 2 * math.cos(t) + math.sin(eps) ** 2) \
-        - math.sin(tau) * math.cos(eps) * math.sin(t)           # seed 004, by hand
+        - math.sin(tau) * math.cos(eps) * math.sin(t)           # [HFT-hypoid], by hand
     M = np.asarray(dial_cutter_to_cradle(_dials(*dial)))
     assert abs(M[0, 0] - a11) < 1e-14
     # a proper rigid transform
@@ -63,7 +63,7 @@ def test_dial_and_geometric_routes_place_the_same_cutter(dial):
     # tilt from the wedge construction: cos i = cos^2 eps + sin^2 eps cos phi_t
     eps, t = WEDGE_ANGLE, D(dial[3])
     assert abs(math.cos(float(i)) - (math.cos(eps) ** 2 + math.sin(eps) ** 2 * math.cos(t))) < 1e-14
-    q0 = D(dial[0]) + D(dial[1]) / 2 - math.pi / 2                      # seed's q0 (mirrored: -q0)
+    q0 = D(dial[0]) + D(dial[1]) / 2 - math.pi / 2                      # q0 of [HFT-hypoid] (mirrored: -q0)
     assert abs(math.sin(float(q) + q0)) < 1e-14 and math.cos(float(q) + q0) > 0
 
 
@@ -145,7 +145,7 @@ def _roll_ref(Ra, c2, d6, psi):
 
 
 def _dial_ref(c, e, s, t, eps=math.radians(15.0), l=222.25 / 2):
-    """Seed 004's No. 116 product typed in with NumPy, mirrored in y (P A P).
+    """The No. 116 product of [HFT-hypoid] typed in with NumPy, mirrored in y (P A P).
     R_k by the vector form of Rodrigues: cos t I + sin t [k]x + (1 - cos t) k k^T."""
     k = np.array([math.sin(eps), 0.0, math.cos(eps)])
     kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
@@ -233,7 +233,7 @@ def test_machine_known_points():
 
 @pytest.mark.parametrize("dial", SEED_DIALS)
 def test_dial_matrix_against_hand_typed_product(dial):
-    """dial_cutter_to_cradle = P A P with seed 004's product A typed in with NumPy
+    """dial_cutter_to_cradle = P A P with the product A of [HFT-hypoid] typed in with NumPy
     (Rodrigues in the vector form, not the code's I + sin K + (1-cos) K^2);
     round-off only (measured 2e-16 in the rotation, 0 mm in the translation):
     1e-14, 1e-12 mm."""
@@ -264,7 +264,7 @@ def test_dial_and_geometric_settings_agree_by_hand(dial):
 
 
 def test_relative_velocity_matches_angular_velocity_formula():
-    """dr_w/dpsi by autodiff equals seed 004's (omega_c - omega_w) x r + omega_w x R form,
+    """dr_w/dpsi by autodiff equals the (omega_c - omega_w) x r + omega_w x R form of [HFT-hypoid],
     written in the machine frame and rotated into the work frame.  The machine
     frame, the work axis and the roll rate come from the hand-typed matrices and
     the hand-differentiated roll (R_a (1 - 2C psi - 6D psi^2 / 2)), not from

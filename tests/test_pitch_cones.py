@@ -1,7 +1,7 @@
-"""Seed-003 pitch cones by tangency: independent checks.
+"""[Tangent-cones] pitch cones by tangency: independent checks.
 
-References: seed 003 (tangency route), ISO 23509:2016 6.2.2 (Method 1, the same
-conditions by a different parametrisation), seed 000 section 1 (limit normal
+References (docs/references.md): [Tangent-cones] (tangency route), [ISO23509] 6.2.2
+(Method 1, the same conditions by a different parametrisation), [Eigenfunctions] §1 (limit normal
 n0 = v12 x q / |v12 x q|, independent of the ISO limit-pressure-angle formula).
 """
 
@@ -16,7 +16,7 @@ from gearjax.gears.hypoid import iso23509 as iso
 from gearjax.gears.hypoid import pitch_cones as pc
 D = np.deg2rad
 
-# (u, Sigma, E, de2, b2, beta1, rc0): ISO 23509 sample 2 data, seed-000 7.5-inch case,
+# (u, Sigma, E, de2, b2, beta1, rc0): ISO 23509 sample 2 data, [Eigenfunctions] 7.5-inch case,
 # and two non-orthogonal shaft angles
 CASES = [
     (42 / 13, D(90.0), 15.0, 170.0, 30.0, D(50.0), 63.5),
@@ -81,7 +81,7 @@ def test_tangency_residuals_vanish_independently(case):
     # generatrix angle (8): beta1 - beta2 = angle between the generatrices
     g1 = (P1 - apply_point(M1, jnp.zeros(3))) / sol.R1
     np.testing.assert_allclose(sol.beta1 - sol.beta2, jnp.arccos(jnp.dot(g1, g2)), atol=1e-13)
-    # limit normal (seed 000 sec. 1.2): n0 = v12 x q, q = w12 x (w1 x r1) - w1 x v12;
+    # limit normal ([Eigenfunctions] §1.2): n0 = v12 x q, q = w12 x (w1 x r1) - w1 x v12;
     # its inclination out of the pitch plane is the limit pressure angle (ISO (117))
     q = jnp.cross(w1 - w2, jnp.cross(w1, P1 - C1)) - jnp.cross(w1, v12)
     n0 = jnp.cross(v12, q)
@@ -121,7 +121,7 @@ def test_same_conditions_as_iso_method1(case):
 
 
 def test_seed_route_vs_iso_route_documented_difference():
-    """Each route with its own rules (seed: contact at mid face, beta1 exactly the
+    """Each route with its own rules ([Tangent-cones]: contact at mid face, beta1 exactly the
     input; ISO: rmpt2 from the approximate pitch angle (11)-(12), beta_m1 after one
     linearised correction) -- ISO 23509 sample 2 data.  The values are quoted in
     docs/hypoid_blank.md."""
@@ -224,7 +224,7 @@ def test_seed_machine_settings_literal_and_tilt_slip():
     u, S, E, de2, b2, beta, rc0 = CASES[0]
     sol = pc.solve_pitch_cones(u, S, E, de2, b2, beta, rc0)
     ms = pc.pinion_machine_settings(sol, E, "left")
-    # the seed's tilt relation sin i = tan(beta1)/tan(alpha_lim) has no solution here
+    # the tilt relation of [Tangent-cones] sin i = tan(beta1)/tan(alpha_lim) has no solution here
     assert abs(float(jnp.tan(sol.beta1) / jnp.tan(sol.alpha_lim))) > 20
     assert not bool(ms["tilt_valid"]) and np.isnan(ms["tilt"])
     # the reciprocal reading asin(tan alpha_lim / tan beta1), typed in
@@ -240,7 +240,7 @@ def test_seed_machine_settings_literal_and_tilt_slip():
     np.testing.assert_allclose(ms["cradle"], np.pi - zeta_m, rtol=0, atol=1e-14)
     np.testing.assert_allclose(pc.pinion_machine_settings(sol, E, "right")["cradle"], -zeta_m,
                                rtol=0, atol=1e-14)
-    # gear machine centre to back X_G = a2 (seed 003), a2 = ISO t_z2 for the same cone
+    # gear machine centre to back X_G = a2 ([Tangent-cones]), a2 = ISO t_z2 for the same cone
     # pair: formulae (129), (131) typed in (measured 1e-14 mm; 1e-10 mm)
     dS = S - np.pi / 2
     tzm2 = (dm1 * np.sin(sol.delta2) / (2 * np.cos(sol.delta1))

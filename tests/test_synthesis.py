@@ -1,8 +1,9 @@
 """Local synthesis of the spiral-bevel pinion (gearjax.gears.hypoid.synthesis).
 
-Two XLA compiles shared through module-scoped fixtures: the jitted (residual,
-Jacobian) function of the drive side (reused by the solve, the gradient check and
-the re-check of the shipped example) and the independent full TCA of the verification.
+Two XLA compiles shared through module-scoped fixtures: the jitted Levenberg-Marquardt
+solve of the drive side (reused by every solve, the gradient check and the re-check of
+the shipped example: ``residuals_and_jacobian`` is the same program stopped after its
+first evaluation) and the independent full TCA of the verification.
 """
 
 import math
@@ -11,6 +12,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from gearjax import optimize
 from gearjax.gears.hypoid import synthesis as sy
 from gearjax.gears.hypoid import tca as th
 from gearjax.errors import ConvergenceError
@@ -30,7 +32,14 @@ def res(st):
 
 def test_synthesis_converges(res):
     assert res.converged
+    assert res.status == optimize.CONVERGED and res.message == "converged"
     assert res.iterations <= 15
+    assert res.evaluations >= res.iterations + 1
+    # history: max scaled residual at the start and after each accepted step, decreasing
+    h = np.asarray(res.history)
+    assert len(h) == res.iterations + 1 and np.all(np.diff(h) < 0)
+    assert h[-1] == pytest.approx(np.max(np.abs(res.residuals / sy.SCALES)))
+    assert h[0] > 1.0 and h[-1] <= 1e-3
     assert np.all(np.abs(res.residuals / sy.SCALES) <= 1e-3)
     assert res.singular_values[-1] > 1e-3 * res.singular_values[0]   # well-posed (scaled)
     a = res.achieved
@@ -94,11 +103,20 @@ def test_bad_free_set_raises(st):
         sy.synthesise(st, free=("d_radius", "modified_roll_2c", "x", "y", "z"))
 
 
-def test_not_converged_raises_unless_strict_false(st):
-    with pytest.raises(ConvergenceError):
+def test_residuals_and_jacobian_needs_all_variables(st, res):
+    with pytest.raises(ValueError, match="7 entries"):
+        sy.residuals_and_jacobian(st, np.zeros(6), res.targets)
+
+
+def test_not_converged_raises_unless_strict_false(st, res):
+    with pytest.raises(ConvergenceError, match="step limit"):
         sy.synthesise(st, max_iter=1)
     r = sy.synthesise(st, max_iter=1, strict=False)
     assert not r.converged
+    assert r.status == optimize.MAX_ITERATIONS and "step limit" in r.message
+    assert r.iterations == 1 and len(r.history) == 2
+    # the first step is the first step of the full solve (same compiled program)
+    assert r.history == pytest.approx(res.history[:2], rel=1e-9)
 
 
 def test_shipped_example_reproduces_the_bearing(res):
@@ -116,6 +134,12 @@ def test_shipped_example_reproduces_the_bearing(res):
     assert abs(float(aux["te_level_arcsec"]) - res.targets[2] / ARCSEC) < 0.01
     assert abs(float(aux["path_angle_deg"]) - math.degrees(res.targets[3])) < 0.01
     assert abs(float(aux["semi_major_mm"]) - res.targets[4]) < 1e-3
+    # the saved pinion is a solution: the solve from it stops at once, converged
+    again = sy.synthesise(st_f, v0=np.zeros(len(sy.VARIABLES)))
+    assert again.status == optimize.CONVERGED and again.message == "converged"
+    assert again.iterations == 0 and again.evaluations == 1
+    # (its own reference guess: the Newton tolerance 1e-11 apart)
+    np.testing.assert_allclose(again.residuals, r * sy.SCALES, rtol=0, atol=1e-9)
     # the saved drive pinion is the synthesised one (file precision)
     fl = d.flank("pinion", "concave")
     assert float(fl.cutter.point_radius) == pytest.approx(float(res.pair.pinion.cutter.point_radius),

@@ -8,6 +8,7 @@ import jax
 import numpy as np
 import pytest
 
+from gearjax import optimize
 from gearjax.gears.hypoid import synthesis as sy
 from gearjax.gears.hypoid import tca as th
 from gearjax.gears.hypoid.design_file import load_design
@@ -43,3 +44,8 @@ def test_shipped_hypoid_example_has_the_synthesised_bearing():
         assert abs(float(aux["te_apex_arcsec"])) < 0.01
         assert abs(float(aux["path_angle_deg"]) - math.degrees(tgt[3])) < 0.01
         assert abs(float(aux["semi_major_mm"]) - tgt[4]) < 1e-3
+        # the saved pinion is a solution: the solve from it (same compiled program)
+        # stops at the start with status converged
+        res = sy.synthesise(st, sy.Targets(path_angle_deg=angle), v0=np.zeros(len(sy.VARIABLES)))
+        assert res.status == optimize.CONVERGED and res.message == "converged"
+        assert res.iterations == 0 and res.evaluations == 1 and res.converged

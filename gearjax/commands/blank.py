@@ -19,8 +19,7 @@ def register(sub):
 
 
 def run(args) -> int:
-    from gearjax.gears.hypoid.blank import blank_geometry
-    from gearjax.gears.hypoid.design_file import load_design
+    from gearjax import blank_geometry, load_design
     design = load_design(args.design)
     data = blank_geometry(design.blank_input())
     if args.json:

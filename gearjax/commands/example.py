@@ -17,8 +17,7 @@ def register(sub):
 
 
 def run_list(args) -> int:
-    from gearjax.io import list_examples
-    from gearjax.gears.hypoid.design_file import load_design
+    from gearjax import list_examples, load_design
     for name in list_examples():
         try:
             desc = load_design(f"example:{name}").data.get("design", {}).get("description", "")
@@ -29,6 +28,6 @@ def run_list(args) -> int:
 
 
 def run_show(args) -> int:
-    from gearjax.io import example_path
+    from gearjax import example_path
     sys.stdout.write(example_path(args.name).read_text(encoding="utf-8"))
     return 0

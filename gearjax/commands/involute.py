@@ -60,7 +60,9 @@ def register(sub):
 
 def run(args) -> int:
     from gearjax.errors import check_int, check_positive
-    from gearjax.gears.involute.geometry import InvolutePair, pair_geometry, path_kinematics, path_table
+    from gearjax import InvolutePair, pair_geometry
+    from gearjax import involute_path_kinematics as path_kinematics
+    from gearjax import involute_path_table as path_table
 
     pair = InvolutePair.create(args.z1, args.z2, args.module, args.pressure_angle, args.helix,
                                args.x1, args.x2)

@@ -1,4 +1,4 @@
-"""``gearjax kinematics DESIGN``: seed-000 eigenfunction kinematics of a hypoid design.
+"""``gearjax kinematics DESIGN``: [Eigenfunctions] eigenfunction kinematics of a hypoid design.
 
 DESIGN is a path or ``example:NAME`` (e.g. ``example:hypoid_6x39_7p5in``).  The
 model needs only the design's ``[blank]`` table (any hypoid route; the cutter radius
@@ -52,7 +52,7 @@ def run(args) -> int:
     from pathlib import Path
 
     from gearjax.studies import cutter_radius as hk
-    from gearjax.gears.hypoid.design_file import load_design
+    from gearjax import load_design
     shape = _grid(args.grid)
     if args.plot is not None:
         pp = Path(args.plot)

@@ -1,5 +1,5 @@
 """``gearjax surface DESIGN``: a flank grid of a hypoid / spiral-bevel member, written
-to CSV, XYZ (points and normals) or STL (seed 004's algorithm, see
+to CSV, XYZ (points and normals) or STL (the algorithm of [HFT-hypoid], docs/references.md; see
 :mod:`gearjax.gears.hypoid.flank`)."""
 
 from __future__ import annotations
@@ -38,9 +38,8 @@ def register(sub):
 def run(args) -> int:
     from pathlib import Path
 
-    from gearjax.gears.hypoid.flank import flank_surface
+    from gearjax import flank_surface, load_design
     from gearjax.io import write_flank, write_stl_tooth
-    from gearjax.gears.hypoid.design_file import load_design
     from gearjax.progress import Progress
     n_xi, n_s = _grid(args.grid)
     out = Path(args.out)

@@ -35,7 +35,13 @@ JSON_KEYS_DOC = """JSON keys:
   ellipses         {semi_major_mm, semi_minor_mm}: contact ellipse (elastic approach
                    0.00632 mm; null = infinite, line contact)
   flags            {converged, on_flank, edge}: per grid point (edge: converged but
-                   outside a flank boundary)"""
+                   outside a flank boundary)
+  quality          {converged, reference_on_flank, edge_contact, low_contact_ratio}:
+                   contact-quality flags of the side (each raised one is also a
+                   warning on stderr)
+  kinematics       with --kinematics: {u1_mm_s, u2_mm_s, u_e_mm_s, u_s_mm_s, srr, r_x_mm,
+                   r_y_mm} per grid point (pinion = 1; per rad/s of pinion speed;
+                   rolling direction across the contact ellipse; null off the flank)"""
 
 
 def register(sub):
@@ -57,6 +63,9 @@ def register(sub):
     p.add_argument("--pitches", type=float, default=1.25,
                    help="half-range of the grid in angular pitches (0.75 ... 4, default 1.25); "
                         "widen it when the contact of one tooth pair spans more than the grid")
+    p.add_argument("--kinematics", action="store_true",
+                   help="also compute rolling/sliding velocities, SRR and effective radii at "
+                        "the contact points (JSON key 'kinematics')")
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.add_argument("--plot", default=None, help="write the TE and contact-pattern figure (PNG)")
     p.set_defaults(func=run)
@@ -81,8 +90,7 @@ def _parse_kv(text, allowed, what):
 
 
 def _design(text):
-    from gearjax.gears.involute.geometry import InvolutePair
-    from gearjax.gears.involute.tca import InvoluteTCA
+    from gearjax import InvolutePair, InvoluteTCA
 
     kv = _parse_kv(text[len("involute:"):], _ALLOWED, "design")
     missing = [k for k in ("z1", "z2", "m", "alpha", "b") if k not in kv]
@@ -99,33 +107,34 @@ def _nan_list(a):
     return [None if not np.isfinite(x) else float(x) for x in a.ravel()]
 
 
-def _involute_side(args, mis, m, side_name, half):
-    from gearjax.gears.involute.tca import involute_limits, involute_tca
+def _involute_side(args, mis, m, side_name, half, kin):
+    import gearjax as gj
     _, des = _design(args.design)
-    side = -1 if side_name == "drive" else 1
-    path, margin, multi = involute_tca(des, mis, side=side, steps_per_pitch=m, half_pitches=half)
-    return path, margin, multi, involute_limits(des, side), {}
+    res = gj.run_tca(des, mis, side=side_name, steps_per_pitch=m, half_pitches=half,
+                     kinematics=kin)
+    return res, gj.involute_limits(des, side_name)
 
 
-def _hypoid_side(design, mis, m, side_name, half):
-    from gearjax.gears.hypoid import tca as th
-    prep = th.prepare(th.pair_flanks(design, side_name))
-    res = th.hypoid_tca(prep, mis, steps_per_pitch=m, half_pitches=half, n_pairs=3)
-    prep_pair = prep.pair
-    extra = {"xi1": res.coords["xi1"], "h1_mm": res.coords["h1"], "xi2": res.coords["xi2"],
-             "h2_mm": res.coords["h2"]}
-    return res.path, res.margin, res.multi, th.pinion_outline(prep_pair), extra
+def _hypoid_side(design, mis, m, side_name, half, kin):
+    import gearjax as gj
+    prep = gj.prepare_hypoid(gj.pair_flanks(design, side_name))
+    res = gj.run_tca(prep, mis, steps_per_pitch=m, half_pitches=half, n_pairs=3,
+                     kinematics=kin)
+    return res, gj.pinion_outline(prep.pair)
 
 
-def _side_json(path, margin, multi, extra):
-    from gearjax.tca import ARCSEC
+def _side_json(res):
+    from gearjax import ARCSEC
+    path, margin, multi = res.path, res.margin, res.multi
     conv = np.asarray(path.converged)
     on = (np.asarray(margin) >= 0.0) & conv
     te = np.where(on, np.asarray(path.te), np.nan) / ARCSEC
     pth = {k: _nan_list(getattr(path, k[:-3])) for k in
            ("axial1_mm", "radial1_mm", "axial2_mm", "radial2_mm")}
-    pth.update({k: _nan_list(v) for k, v in extra.items()})
-    return {
+    if res.family == "hypoid":
+        pth.update({k: _nan_list(res.coords[c]) for k, c in
+                    (("xi1", "xi1"), ("h1_mm", "h1"), ("xi2", "xi2"), ("h2_mm", "h2"))})
+    out = {
         "phi1_rad": _nan_list(path.phi1),
         "te_arcsec": _nan_list(te),
         "te_pairs_arcsec": [_nan_list(r) for r in np.asarray(multi.te_pairs) / ARCSEC],
@@ -138,12 +147,20 @@ def _side_json(path, margin, multi, extra):
                      "semi_minor_mm": _nan_list(path.semi_minor)},
         "flags": {"converged": conv.tolist(), "on_flank": on.tolist(),
                   "edge": (conv & ~on).tolist()},
+        "quality": res.flags(),
     }
+    if res.kinematics is not None:
+        k = res.kinematics
+        mask = lambda a: _nan_list(np.where(on, np.asarray(a), np.nan))
+        out["kinematics"] = {"u1_mm_s": mask(k.u1), "u2_mm_s": mask(k.u2),
+                             "u_e_mm_s": mask(k.u_e), "u_s_mm_s": mask(k.u_s),
+                             "srr": mask(k.srr), "r_x_mm": mask(k.r_x), "r_y_mm": mask(k.r_y)}
+    return out
 
 
 def run(args) -> int:
-    from gearjax.errors import ConvergenceError, check_int, check_range
-    from gearjax.tca import Misalignment, NoContactError
+    from gearjax import ConvergenceError, Misalignment, NoContactError
+    from gearjax.errors import check_int, check_range
 
     mis_kv = _parse_kv(args.misalign, {"dE", "dP", "dG", "dSigma"}, "misalign")
     mis = Misalignment.create(mis_kv.get("dE", 0.0), mis_kv.get("dP", 0.0),
@@ -156,11 +173,11 @@ def run(args) -> int:
     sides = ["drive", "coast"] if args.side == "both" else [args.side]
     if args.design.startswith("involute:"):
         _design(args.design)                       # validate before any tracing
-        solve = lambda side: _involute_side(args, mis, m, side, half)
+        solve = lambda side: _involute_side(args, mis, m, side, half, args.kinematics)
     else:
-        from gearjax.gears.hypoid.design_file import load_design
+        from gearjax import load_design
         design = load_design(args.design)
-        solve = lambda side: _hypoid_side(design, mis, m, side, half)
+        solve = lambda side: _hypoid_side(design, mis, m, side, half, args.kinematics)
     results = {}
     for side in sides:
         try:
@@ -173,9 +190,13 @@ def run(args) -> int:
             return 3
     if args.plot:
         from gearjax.plot.tca import save_tca_plot
-        save_tca_plot(args.plot, [(sd, r[0], r[1], r[2]) for sd, r in results.items()],
-                      [r[3] for r in results.values()], title=f"TCA {args.design}")
-    outs = {sd: _side_json(r[0], r[1], r[2], r[4]) for sd, r in results.items()}
+        save_tca_plot(args.plot, [(sd, r[0].path, r[0].margin, r[0].multi)
+                                  for sd, r in results.items()],
+                      [r[1] for r in results.values()], title=f"TCA {args.design}")
+    for sd, (res, _) in results.items():
+        for w in res.warnings():
+            sys.stderr.write(f"gearjax: warning: {sd} side: {w}\n")
+    outs = {sd: _side_json(r[0]) for sd, r in results.items()}
     inp = {"design": args.design, "side": args.side, "misalign": mis_kv, "positions": n,
            "pitches": half}
     if args.json:
@@ -184,7 +205,8 @@ def run(args) -> int:
         else:
             print(json.dumps({"input": inp, **outs}, indent=1))
         return 0
-    for sd, (path, margin, multi, _, extra) in results.items():
+    for sd, (res, _) in results.items():
+        path = res.path
         out = outs[sd]
         conv = np.asarray(out["flags"]["converged"])
         on = np.asarray(out["flags"]["on_flank"])

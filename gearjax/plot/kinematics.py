@@ -1,4 +1,4 @@
-"""Figures of the seed-000 flank fields (matplotlib, Agg; no ``plt.show``).
+"""Figures of the [Eigenfunctions] flank fields (matplotlib, Agg; no ``plt.show``).
 
 * :func:`field_maps` -- fields (u_e, SRR, R_eff, ...) over the gear flank in the
   axial projection (coordinate along the gear axis, radius from it; mm), with the
@@ -87,7 +87,7 @@ def field_maps(fields_by_case: dict, names=("u_e", "abs_srr", "r_eff")):
 
 def trend_plot(r0, values: dict, derivatives: dict, marks=None):
     """Statistics (top row) and their derivatives d/dr0 (bottom row) against the
-    cutter radius ``r0`` (mm); ``marks``: radii to mark (the seed's cutters)."""
+    cutter radius ``r0`` (mm); ``marks``: radii to mark (the cutters of [Eigenfunctions])."""
     names = list(values)
     fig, axes = plt.subplots(2, len(names), figsize=(2.6 * len(names), 4.4), squeeze=False)
     for j, nm in enumerate(names):

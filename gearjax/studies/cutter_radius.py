@@ -1,6 +1,6 @@
-"""Meshing characteristics of a hypoid pair by eigenfunctions (seed 000, sections 2-3).
+"""Meshing characteristics of a hypoid pair by eigenfunctions ([Eigenfunctions] §2-§3).
 
-The model of seed 000 (the eigenfunction paper on conjugate surfaces): the gear flank is the surface
+The model of [Eigenfunctions] (see docs/references.md): the gear flank is the surface
 of a face-mill cutter placed at the pitch point and carried about the gear axis;
 the eigenfunctions of section 1 (:mod:`gearjax.kinematics`) then give the local
 kinematics of the gear and its conjugate pinion at every point of the flank.
@@ -8,7 +8,7 @@ kinematics of the gear and its conjugate pinion at every point of the flank.
 Construction (all in the fixed frame ``S_f`` of :mod:`gearjax.gears.hypoid.pitch_cones`:
 gear axis ``u2 = (0, 0, 1)`` through the origin, pinion axis ``u1`` through
 ``C1 = (E, 0, 0)``; mm, rad; pinion speed 1 rad/s so velocities are mm per radian
-of pinion roll, as the seed's non-dimensional "pinion speed 1"):
+of pinion roll, as the paper's non-dimensional "pinion speed 1"):
 
 1. Blank: :func:`gearjax.gears.hypoid.blank.blank_geometry`'s core with the cutter
    radius ``r0`` as input (route ``tangent-cones`` by default: the ratio holds
@@ -16,12 +16,12 @@ of pinion roll, as the seed's non-dimensional "pinion speed 1"):
    outward, into the gear) from :func:`gearjax.gears.hypoid.pitch_cones.cone_tangency`.
 2. Motion: ``omega_p = u1`` (|omega_p| = 1), ``omega_g = s (z1/z2) u2`` with the sign
    ``s`` for which the pitch-point velocities of the two members point the same way
-   (rolling cones).  In the seed's pitch-point frame these are its
+   (rolling cones).  In the paper's pitch-point frame these are its
    ``omega^(1), omega^(2)`` (tested component by component).
 3. Pitch-point frame ``i-j-k``: ``j = v21(P)/|v21(P)|`` (v21 = v_gear - v_pinion,
    tangent to the tooth trace because the ratio condition holds), ``k`` the pitch
    plane normal, ``i = j x k``.
-4. Cutter (seed 2.2): ``r_c = (r_u cos th, r_u sin th, u cos a)``, ``r_u = r0 -+ u sin a``
+4. Cutter ([Eigenfunctions] §2.2): ``r_c = (r_u cos th, r_u sin th, u cos a)``, ``r_u = r0 -+ u sin a``
    (outside blade ``-``: concave gear flank; inside blade ``+``: convex flank), ``u``
    the slant length along the blade from the pitch plane (``u > 0`` towards the gear
    root), ``a`` the blade angle.  Cutter axis ``z_c = k``; centre ``C = P + r0 e``
@@ -39,19 +39,19 @@ of pinion roll, as the seed's non-dimensional "pinion speed 1"):
    on the gear flank, ``Phi_II = 0`` curvature interference on the pinion.  The
    normal points into the gear tooth (outward normal of the pinion flank), so
    ``R_eff > 0`` for a contact without interference.  Curvatures: autodiff
-   (:func:`gearjax.surfaces.local_geometry`); the seed's Euler/Bertrand route
+   (:func:`gearjax.surfaces.local_geometry`); the paper's Euler/Bertrand route
    ``k_v = H + Q cos 2 phi_v``, ``tau_v = -Q sin 2 phi_v`` with ``k_e = cos a / r_u``,
    ``k_f = 0`` is :func:`euler_bertrand` (tested equal).
 
-Seed slips (see docs/kinematics_study.md): the seed's cutter normal
+Slips of [Eigenfunctions] (see docs/kinematics_study.md): the paper's cutter normal
 ``(-cos a cos th, cos a sin th, sin a)`` is not normal to its own ``r_c`` (the
 normal is ``+-(cos a cos th, cos a sin th, sin a)``); gearjax takes the normal from
-autodiff.  The seed's "generating angle" is the gear roll angle at which a flank
+autodiff.  The paper's "generating angle" is the gear roll angle at which a flank
 point is in contact (the gear is cutter-formed, its flank *is* the cutter cone,
-as the seed's curvatures ``k_e = cos a / r_u, k_f = 0`` require).
+as its curvatures ``k_e = cos a / r_u, k_f = 0`` require).
 
-Reference: seed 000 sections 1-3; Litvin & Fuentes, *Gear Geometry and Applied
-Theory* ch. 8-9 (Euler, Bertrand); ISO 23509:2016 (blank).
+References (docs/references.md): [Eigenfunctions] §1-§3; [Litvin2004] ch. 8-9
+(Euler, Bertrand); [ISO23509] (blank).
 """
 
 from __future__ import annotations
@@ -69,21 +69,21 @@ import numpy as np
 from gearjax.frames import rotate_about
 from gearjax.errors import check_range, require_converged
 from gearjax.gears.hypoid import pitch_cones
-from gearjax.gears.hypoid.blank import BlankInput, _core
+from gearjax.gears.hypoid.blank import BlankInput, blank_core
 from gearjax.kinematics import Mesh, eigen_kinematics
 from gearjax.newton import newton_solve
 from gearjax.surfaces import curvature_in_direction, local_geometry
 
 __all__ = ["STUDY_BLANK", "STUDY_CUTTERS", "study_blank_input", "StudySettings",
-           "PitchSetup", "pitch_setup", "FlankFields", "flank_fields", "field_stats",
+           "PitchSetup", "pitch_setup", "FlankFields", "point_fields", "flank_fields", "field_stats",
            "euler_bertrand", "limit_report", "FIELDS", "conjugate_check", "grid_uv", "STAT_NAMES",
            "flank_statistics", "statistics_gradient", "cutter_radius_sweep",
            "OPT_BOUNDS", "design_objective", "optimise_design"]
 
 _DEG = math.pi / 180.0
 
-#: Seed 000 gear set (ratio 6/39, gear pitch diameter 230 mm, offset 35 mm) with the
-#: assumptions of docs/hypoid_blank.md (the seed gives neither face width, spiral
+#: Gear set of [Eigenfunctions] (ratio 6/39, gear pitch diameter 230 mm, offset 35 mm) with the
+#: assumptions of docs/hypoid_blank.md (the paper gives neither face width, spiral
 #: angle nor nominal pressure angle): Gleason face width 0.155 d, pinion spiral
 #: angle 25 + 5 sqrt(z2/z1) + 90 E/d degrees, nominal pressure angle 19 deg; and
 #: profile shift x_hm1 = 0.5 (a 6-tooth pinion needs a long addendum: Gleason's
@@ -96,7 +96,7 @@ STUDY_BLANK = {
     "cutter_radius_mm": 95.25, "pressure_angle_drive_deg": 19.0,
     "pressure_angle_coast_deg": 19.0, "profile_shift": 0.5,
 }
-#: The seed's three cutters (nominal diameter in inches -> radius in mm).
+#: The three cutters of [Eigenfunctions] (nominal diameter in inches -> radius in mm).
 STUDY_CUTTERS = {"6in": 76.2, "7.5in": 95.25, "9in": 114.3}
 
 #: names of the scalar fields of :class:`FlankFields` that :func:`field_stats` reports
@@ -106,7 +106,7 @@ _FLANKS = ("convex", "concave")
 
 
 def study_blank_input(cutter_radius_mm=95.25, **overrides) -> BlankInput:
-    """Validated :class:`BlankInput` of the seed-000 set with cutter radius ``r0`` (mm)."""
+    """Validated :class:`BlankInput` of the [Eigenfunctions] set with cutter radius ``r0`` (mm)."""
     d = dict(STUDY_BLANK)
     d["cutter_radius_mm"] = float(cutter_radius_mm)
     d.update(overrides)
@@ -178,7 +178,7 @@ def pitch_setup(inp: BlankInput, settings: StudySettings, flank: str = "convex")
         raise ValueError(f"flank = {flank!r} must be one of {_FLANKS}")
     r0 = jnp.asarray(settings.cutter_radius, float)
     inp_r = dataclasses.replace(inp, cutter_radius=r0)
-    bd = _core(inp_r, inp.z2 / inp.z1)
+    bd = blank_core(inp_r, inp.z2 / inp.z1)
     Sigma, E = inp.shaft_angle, inp.offset
     geo = pitch_cones.cone_tangency(bd["delta1"], bd["delta2"], Sigma, E, bd["Rm2"])
     u1, u2, C1, _, _ = pitch_cones.axes(jnp.asarray(Sigma, float), jnp.asarray(E, float))
@@ -228,8 +228,8 @@ class FlankFields(NamedTuple):
     (rad); r, n contact point and normal (fixed frame, at roll phi); axial (2,)
     axial projection (coordinate along the gear axis, radius; mm); eigen
     quantities as :class:`gearjax.kinematics.Kinematics` (mm/rad, 1/mm, mm);
-    v_dir unit relative velocity v21; k_v_eb, tau_v_eb the seed's Euler/Bertrand
-    values; residual / converged of the meshing equation.
+    v_dir unit relative velocity v21; k_v_eb, tau_v_eb the Euler/Bertrand
+    values of [Eigenfunctions] §2.3; residual / converged of the meshing equation.
     """
 
     uv: jnp.ndarray
@@ -261,13 +261,13 @@ class FlankFields(NamedTuple):
 
 
 def euler_bertrand(k_e, k_f, e, n, t):
-    """Seed 2.3: ``k_t = H + Q cos 2 phi_t``, ``tau_t = -Q sin 2 phi_t``.
+    """[Eigenfunctions] §2.3: ``k_t = H + Q cos 2 phi_t``, ``tau_t = -Q sin 2 phi_t``.
 
     ``H = (k_e + k_f)/2``, ``Q = (k_e - k_f)/2``, ``phi_t`` the angle from the
     principal direction ``e`` (curvature ``k_e``) to the tangent ``t``, measured
     towards ``f = n x e``.  Sign convention of :func:`gearjax.surfaces.curvature_in_direction`
     (``kappa = -dn.t``, ``tau = -dn.(n x t)``), with which Bertrand's formula
-    carries the minus sign as the seed writes it.
+    carries the minus sign as [Eigenfunctions] writes it.
     """
     f = jnp.cross(n, e)
     ph = jnp.arctan2(jnp.dot(t, f), jnp.dot(t, e))
@@ -275,7 +275,7 @@ def euler_bertrand(k_e, k_f, e, n, t):
     return H + Q * jnp.cos(2 * ph), -Q * jnp.sin(2 * ph)
 
 
-def _point(s: PitchSetup, uv, tol=1e-11):
+def point_fields(s: PitchSetup, uv, tol=1e-11):
     """All fields at cutter parameters ``uv`` (see :class:`FlankFields`)."""
     mesh = s.mesh
     wg = mesh.omega1
@@ -305,7 +305,7 @@ def _point(s: PitchSetup, uv, tol=1e-11):
     n = sn * g.n
     W = sn * g.W
     kin = eigen_kinematics(mesh, g.r, n, W)
-    # Euler/Bertrand route (seed 2.3): cone, k_e = cos a / r_u along the circle
+    # Euler/Bertrand route ([Eigenfunctions] §2.3): cone, k_e = cos a / r_u along the circle
     # direction, k_f = 0 along the blade; sign + when n points towards the cutter axis
     rr = jnp.linalg.norm(r0 - s.centre - jnp.dot(r0 - s.centre, s.zc) * s.zc)
     e_dir = rotate_about(ax, phi, jnp.cross(s.zc, radial))
@@ -339,10 +339,10 @@ def conjugate_check(s: PitchSetup, uv):
     wp = jnp.linalg.norm(mesh.omega2)
     ax_p = mesh.omega2 / wp
     ratio = wp / jnp.linalg.norm(mesh.omega1)
-    f0 = _point(s, uv)
+    f0 = point_fields(s, uv)
 
     def pinion_body(uv_):
-        f = _point(s, uv_)
+        f = point_fields(s, uv_)
         return rotate_about(ax_p, -ratio * f.phi, f.r - mesh.a)
 
     psi0 = ratio * f0.phi
@@ -380,7 +380,7 @@ def grid_uv(s: PitchSetup, shape, extend=1.0):
 def _fields(inp, settings, flank, shape, extend):
     s = pitch_setup(inp, settings, flank)
     uv = grid_uv(s, shape, extend)
-    f = jax.vmap(jax.vmap(partial(_point, s)))(uv)
+    f = jax.vmap(jax.vmap(partial(point_fields, s)))(uv)
     return s, f
 
 
@@ -389,7 +389,7 @@ _fields_jit = jax.jit(_fields, static_argnums=(0, 2, 3, 4))
 
 def flank_fields(inp: BlankInput, settings: StudySettings, flank: str = "convex",
                  shape=(31, 15), extend: float = 1.0, *, strict: bool = True):
-    """Seed-000 fields over a ``shape = (n_depth, n_face)`` grid of the gear flank.
+    """[Eigenfunctions] fields over a ``shape = (n_depth, n_face)`` grid of the gear flank.
 
     Returns ``(setup, fields)``: :class:`PitchSetup` and :class:`FlankFields` with
     leading grid axes.  jitted (static: ``inp``, ``flank``, ``shape``, ``extend``);

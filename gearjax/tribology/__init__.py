@@ -1,4 +1,4 @@
-"""Lubrication and friction of Hertzian gear contacts (seed 001).
+"""Lubrication and friction of Hertzian gear contacts ([VH-CATT], see docs/references.md).
 
 Modules (imports flow downwards):
 

@@ -1,6 +1,6 @@
-"""Mixed-lubrication friction coefficient of a Hertzian contact (seed 001).
+"""Mixed-lubrication friction coefficient of a Hertzian contact ([VH-CATT], see docs/references.md).
 
-    μ = F_f / F_n = [ f_c F_a r(u_s) + ∫_A τ dA ] / F_n,                      (seed 001)
+    μ = F_f / F_n = [ f_c F_a r(u_s) + ∫_A τ dA ] / F_n,                      [VH-CATT]
     τ = τ0 asinh( η(p_f) u_s / (h_c τ0) )                                     (Ree–Eyring)
 
 Ingredients, per contact point:
@@ -18,7 +18,7 @@ Ingredients, per contact point:
        ∫_A τ dA = 2π a b ∫_0^1 τ((1-φ) p_max s) s ds,
 
    evaluated by 48-point Gauss–Legendre quadrature (the integrand is analytic).
-4. Boundary friction f_c F_a at the asperities.  The seed's ``F_c = f_c F_a`` is a
+4. Boundary friction f_c F_a at the asperities.  The ``F_c = f_c F_a`` of [VH-CATT] is a
    Coulomb law: it does not vanish in pure rolling and jumps at u_s = 0.  gearjax
    multiplies it by ``r(u_s) = tanh(u_s / v_slip)`` (a regularised Coulomb law,
    v_slip = 1 mm/s by default, i.e. r = 1 to machine precision for u_s > 40 mm/s),
@@ -48,7 +48,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax.contact import MAX_LOG_RATIO, _hertz_exact
+from gearjax.contact import MAX_LOG_RATIO, hertz_exact
 from gearjax.errors import check_positive, check_range, require_converged
 from gearjax.tribology.asperity import load_sharing_traced
 from gearjax.tribology.lubricant import Oil, eyring_shear, viscosity
@@ -145,7 +145,7 @@ def friction_point_traced(F, u_e, u_s, Rx, Ry, oil: Oil, surface: Surface, E_pri
 
     F N, u_e and u_s (≥ 0) mm/s, Rx, Ry mm, E' MPa.
     """
-    hz = _hertz_exact(F, Rx, Ry, E_prime)
+    hz = hertz_exact(F, Rx, Ry, E_prime)
     ls = load_sharing_traced(F, Rx, hz.k, hz.a, hz.b, u_e, oil.eta0, oil.alpha, E_prime,
                              surface.sigma, surface.density, surface.beta, film_method)
     p_f = (1.0 - ls.phi) * hz.p_max * jnp.asarray(_S)
@@ -194,7 +194,7 @@ def friction_traced(F, u_e, u_s, Rx, Ry, oil: Oil, surface: Surface, E_prime=STE
 _friction_jit = jax.jit(friction_traced, static_argnames=("viscosity_model", "film_method"))
 
 
-def _friction_padded(F, u_e, u_s, Rx, Ry, oil, surface, E_prime, viscosity_model, film_method):
+def friction_padded(F, u_e, u_s, Rx, Ry, oil, surface, E_prime, viscosity_model, film_method):
     """Run the jitted kernel on flat arrays padded to a power-of-two length (≥ 64).
 
     Padding (with copies of the first point) lets calls of different sizes share a
@@ -240,7 +240,7 @@ def validate_contact_inputs(F, u_e, u_s, Rx, Ry, E_prime, allow_signed_us=False)
                          "[1e-15, 1e15]")
 
 
-def _warn_validity(out: FrictionResult, film_method: str, viscosity_model: str):
+def warn_validity(out: FrictionResult, film_method: str, viscosity_model: str):
     """Warn (naming formula and range) where a correlation is used outside its fit.
 
     Film: Hamrock–Dowson is fitted for 1 <= k <= 8 ("point"; with "auto" it is used
@@ -297,8 +297,8 @@ def friction_coefficient(F, u_e, u_s, Rx, Ry, oil: Oil, surface: Surface, E_prim
         raise ValueError(f"viscosity_model = {viscosity_model!r} must be 'roelands' or 'barus'")
     if film_method not in ("auto", "point", "line"):
         raise ValueError(f"film_method = {film_method!r} must be 'auto', 'point' or 'line'")
-    out = _friction_padded(F, u_e, u_s, Rx, Ry, oil, surface, E_prime, viscosity_model, film_method)
+    out = friction_padded(F, u_e, u_s, Rx, Ry, oil, surface, E_prime, viscosity_model, film_method)
     if strict:
         require_converged(out.converged, "friction (Hertz / load-sharing solves)")
-    _warn_validity(out, film_method, viscosity_model)
+    warn_validity(out, film_method, viscosity_model)
     return out

@@ -1,17 +1,17 @@
-"""Sliding power loss, mesh efficiency and Stribeck curves (seed 001).
+"""Sliding power loss, mesh efficiency and Stribeck curves ([VH-CATT], see docs/references.md).
 
 Mesh cycle input: arrays of shape (n_positions, n_points) — contact points j at
 mesh positions i (points of all tooth pairs in contact at position i; a later
 issue feeds them from TCA).  Units: load N, speeds mm/s, radii mm, power W.
 
-    P_f(φ_i)  = Σ_j μ_ij F_n,ij |u_s,ij|                      (seed 001; N·mm/s → W ×1e-3)
+    P_f(φ_i)  = Σ_j μ_ij F_n,ij |u_s,ij|                      ([VH-CATT]; N·mm/s → W ×1e-3)
     η_m(φ_i)  = 1 - P_f(φ_i) / P_in(φ_i)
     η̄_m       = 1 - Σ_i w_i P_f(φ_i) / Σ_i w_i P_in(φ_i)
 
 with weights ``w_i`` (default: equal, i.e. positions equally spaced in time; pass
 trapezoid weights for uneven spacing).  ``η̄_m`` is the ratio of energies over
 the cycle, which is what "integrating the instantaneous losses over the path of
-contact" (seed 001) means; it differs from the plain mean of η_m(φ_i) when P_in
+contact" ([VH-CATT]) means; it differs from the plain mean of η_m(φ_i) when P_in
 varies.  Points with zero load are inactive (masked out; they contribute
 nothing and produce no NaN in gradients).  u_s may be signed (direction of
 sliding); only |u_s| enters.
@@ -28,8 +28,8 @@ import jax.numpy as jnp
 import numpy as np
 
 from gearjax.errors import check_positive, require_converged
-from gearjax.tribology.friction import (STEEL_E_PRIME, FrictionResult, Surface, _friction_padded,
-                                        _warn_validity, friction_traced, validate_contact_inputs)
+from gearjax.tribology.friction import (STEEL_E_PRIME, FrictionResult, Surface, friction_padded,
+                                        warn_validity, friction_traced, validate_contact_inputs)
 from gearjax.tribology.lubricant import Oil
 
 __all__ = ["MeshLoss", "mesh_losses_traced", "mesh_losses", "input_power",
@@ -123,12 +123,12 @@ def mesh_losses(F, u_s, u_e, Rx, Ry, oil: Oil, surface: Surface, power_in_W,
     if wt.shape != (F_arr.shape[0],) or np.any(wt < 0) or not np.any(wt > 0):
         raise ValueError(f"weights must be {F_arr.shape[0]} non-negative numbers, not all 0")
     F_safe, us, ue_safe = _safe_inputs(F_arr, u_s, u_e)
-    fr = _friction_padded(F_safe, ue_safe, us, Rx, Ry, oil, surface, E_prime, viscosity_model,
+    fr = friction_padded(F_safe, ue_safe, us, Rx, Ry, oil, surface, E_prime, viscosity_model,
                           film_method)
     out = _assemble(fr, F_arr, u_s, power_in_W, wt)
     if strict:
         require_converged(out.friction.converged, "mesh friction (Hertz / load-sharing solves)")
-    _warn_validity(out.friction, film_method, viscosity_model)
+    warn_validity(out.friction, film_method, viscosity_model)
     return out
 
 
@@ -161,10 +161,10 @@ def stribeck_curve(F, Rx, Ry, srr, u_e, oil, surface, E_prime=STEEL_E_PRIME, *,
     check_range("srr", srr, 0.0, 2.0)
     ue = np.asarray(u_e, float)
     validate_contact_inputs(F, ue, srr * ue, Rx, Ry, E_prime)
-    fr = _friction_padded(F, ue, srr * ue, Rx, Ry, oil, surface, E_prime, viscosity_model,
+    fr = friction_padded(F, ue, srr * ue, Rx, Ry, oil, surface, E_prime, viscosity_model,
                           film_method)
     out = StribeckCurve(jnp.asarray(ue), oil.eta0 * (ue * 1e-3) / F, fr.lam_smooth, fr.mu, fr)
     if strict:
         require_converged(out.friction.converged, "Stribeck sweep")
-    _warn_validity(out.friction, film_method, viscosity_model)
+    warn_validity(out.friction, film_method, viscosity_model)
     return out

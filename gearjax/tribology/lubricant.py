@@ -5,12 +5,12 @@ converts to MPa·s = N·s/mm² internally, 1 Pa·s = 1e-6 MPa·s); pressure–vi
 coefficient α in 1/MPa (1 GPa⁻¹ = 1e-3 MPa⁻¹); Eyring stress τ0 in MPa; density in
 kg/m³.
 
-Roelands (seed 001; Roelands 1966):
+Roelands ([VH-CATT]; [Roelands1966], see docs/references.md):
 
     η(p) = η0 exp{ (ln η0 + 9.67) [ (1 + p/p_R)^z - 1 ] },   p_R = 1/5.1e-9 Pa = 196.08 MPa,
 
 with η0 in **Pa·s** (the constant 9.67 = -ln(6.31e-5 Pa·s) belongs to that unit;
-in mPa·s it would be 2.76).  The seed fixes ``z = 0.68``.  gearjax takes z from
+in mPa·s it would be 2.76).  [VH-CATT] fixes ``z = 0.68``.  gearjax takes z from
 the oil's pressure–viscosity coefficient α at η0 so that both laws share the
 initial slope d(ln η)/dp at p = 0:
 
@@ -20,12 +20,12 @@ An :class:`Oil` stores ``z`` (a property of the oil family, nearly independent o
 temperature in Roelands' correlation) and derives ``α = z (ln η0 + 9.67)/p_R`` from
 it.  So a change of η0 (e.g. a temperature change, or a derivative dμ/dη0) moves α
 with it, as Roelands' correlation says.  Holding α fixed instead while raising η0
-would *lower* z and hence the high-pressure viscosity — that reverses the seed's
-"μ rises with viscosity" trend and is not what a more viscous oil does.
-``make_oil(..., z=0.68)`` or ``roelands_viscosity(..., z=0.68)`` reproduce the seed.
+would *lower* z and hence the high-pressure viscosity — that reverses the
+"μ rises with viscosity" trend of [VH-CATT] and is not what a more viscous oil does.
+``make_oil(..., z=0.68)`` or ``roelands_viscosity(..., z=0.68)`` reproduce [VH-CATT].
 Barus: ``η = η0 exp(α p)``.
 Dowson–Higginson density: ``ρ = ρ0 [1 + 0.6e-3 p / (1 + 1.7e-3 p)]`` (p in MPa).
-Ree–Eyring: ``τ = τ0 asinh(η u_s / (h τ0))`` (seed 001).
+Ree–Eyring: ``τ = τ0 asinh(η u_s / (h τ0))`` ([VH-CATT]; [ReeEyring1955]).
 """
 
 from __future__ import annotations
@@ -146,7 +146,7 @@ def roelands_z(eta0, alpha):
 def roelands_viscosity(p, eta0, z=0.68):
     """Roelands viscosity η(p), Pa·s.  p in MPa (> -196 MPa), η0 in Pa·s, z dimensionless.
 
-    ``η = η0 exp{(ln η0 + 9.67)[(1 + p/196.08)^z - 1]}`` (seed 001 with p in MPa).
+    ``η = η0 exp{(ln η0 + 9.67)[(1 + p/196.08)^z - 1]}`` ([VH-CATT] with p in MPa).
     """
     p = jnp.asarray(p, float)
     ln_ratio = (jnp.log(eta0) + _LN_ETA_INF) * ((1.0 + p / P_ROELANDS_MPA) ** z - 1.0)

@@ -6,9 +6,9 @@ Three routes to the same blank, chosen by ``BlankInput.method``:
 ``"iso23509-method1"``  hypoid, the Gleason method, ISO 23509:2016 6.2.2 + clause 7
                         (face milling: limit curvature radius = cutter radius);
 ``"tangent-cones"``  hypoid pitch cones by the tangency of two skew cones
-                        (seed 003, :mod:`gearjax.gears.hypoid.pitch_cones`): two-variable
+                        ([Tangent-cones], :mod:`gearjax.gears.hypoid.pitch_cones`): two-variable
                         Newton in the pitch angles with the ratio and cutter-radius
-                        conditions, contact point at mid face (seed eq. (7)); the
+                        conditions, contact point at mid face ([Tangent-cones] eq. (7)); the
                         remaining dimensions by ISO 23509 clause 7.
 
 :func:`blank_geometry` is the jit/jacfwd-friendly core (no validation in the traced
@@ -19,9 +19,9 @@ spiral angle.
 
 Units inside: mm and rad.  Degrees appear only in ``from_dict``/``to_dict``/
 ``to_table``.  The geometry does not depend on the hand of spiral (mirror image);
-``hand`` only selects the sign of the seed-003 cradle angle.
+``hand`` only selects the sign of the [Tangent-cones] cradle angle.
 
-Reference: ISO 23509:2016; seed 003 (the hypoid pitch-cone tangency paper); docs in
+References (docs/references.md): [ISO23509]; [Tangent-cones]; docs in
 ``docs/hypoid_blank.md``.
 """
 
@@ -343,7 +343,7 @@ OUTPUTS = [
     ("converged", "-", "1 if converged on the physical branch, else 0"),
 ]
 _UNITS = {"deg": "deg", "mm": "mm", "-": ""}
-# outputs that are legitimately non-finite: the seed's tilt relation without a
+# outputs that are legitimately non-finite: the tilt relation of [Tangent-cones] without a
 # solution (NaN) and the limit curvature of a spiral-bevel pair (0/0, reported inf)
 _MAY_BE_NONFINITE = ("machine_tilt", "rho_lim")
 # outputs excluded from sensitivities (not smooth or not geometry)
@@ -385,7 +385,7 @@ jax.tree_util.register_dataclass(BlankData, data_fields=[n for n, _, _ in OUTPUT
                                  meta_fields=["method"])
 
 
-def _core(inp: BlankInput, ratio):
+def blank_core(inp: BlankInput, ratio):
     """All outputs (dict, mm/rad) for ``inp`` with the ratio ``u`` given separately
     (a float, so it can be differentiated; ``z2 = u z1`` where the module enters)."""
     u = ratio
@@ -437,7 +437,7 @@ def _core(inp: BlankInput, ratio):
     return {name: jnp.asarray(out[name], dtype=float) for name, _, _ in OUTPUTS}
 
 
-_core_jit = jax.jit(_core)
+_core_jit = jax.jit(blank_core)
 
 
 def blank_geometry(inp: BlankInput, *, strict: bool = True):
@@ -478,7 +478,7 @@ def _sens_values(inp: BlankInput, x, names):
     spiral_angle)``; the other fields of ``inp`` are held."""
     new = dataclasses.replace(inp, offset=x[0], gear_outer_pitch_diameter=x[2],
                               gear_face_width=x[3], cutter_radius=x[4], spiral_angle=x[5])
-    out = _core(new, x[1])
+    out = blank_core(new, x[1])
     return jnp.stack([out[n] for n in names])
 
 

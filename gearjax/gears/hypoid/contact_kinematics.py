@@ -1,12 +1,12 @@
 """Rolling, sliding and curvature at the contact points of a hypoid/spiral-bevel TCA.
 
 For every point of a :class:`~gearjax.tca.ContactPath` of a
-:class:`~gearjax.gears.hypoid.tca.HypoidPair` this module computes the quantities of seed
-000 §1 twice:
+:class:`~gearjax.gears.hypoid.tca.HypoidPair` this module computes the quantities of
+[Eigenfunctions] §1 (see docs/references.md) twice:
 
-* **model** -- the eigenfunction kinematics of seed 000 (:func:`gearjax.kinematics.
+* **model** -- the eigenfunction kinematics of [Eigenfunctions] (:func:`gearjax.kinematics.
   eigen_kinematics`) with the gear as member 1 (its flank's Weingarten map), the
-  pinion as its *conjugate* member 2 and the nominal ratio: what seed 000's study
+  pinion as its *conjugate* member 2 and the nominal ratio: what the study of [Eigenfunctions]
   computes at that gear-flank point;
 * **pair** -- the same quantities from the actual pair: the surface velocities
   relative to the *moving contact point* of the TCA, ``u_i = (omega_i x r_i - v_c) . t``
@@ -23,12 +23,12 @@ independent check of the TCA, of the generated pinion and of the eigenfunction
 formulas); for a localised pair the difference is the effect of the mismatch on
 the rolling/sliding velocities and on the effective radius seen by the
 lubricant film.  Common normal ``n``: out of the pinion material, into the gear
-tooth (seed 000's orientation: ``R_eff > 0`` for a convex contact).  Definitions
+tooth (the orientation of [Eigenfunctions]: ``R_eff > 0`` for a convex contact).  Definitions
 (gear = member 1): ``u_e = (u1 + u2)/2``, ``u_s = u1 - u2``, ``SRR = u_s/u_e``.
 Velocities in mm per radian of pinion roll (pinion speed 1 rad/s).
 
-Reference: seed 000 (the eigenfunction paper on conjugate surfaces) §1-§2; Litvin & Fuentes, *Gear Geometry
-and Applied Theory*, 2nd ed., ch. 8-9 (relative velocity of the contact point).
+References (docs/references.md): [Eigenfunctions] §1-§2; [Litvin2004] ch. 8-9
+(relative velocity of the contact point).
 """
 
 from __future__ import annotations
@@ -43,9 +43,9 @@ from gearjax.gears.hypoid import tca as th
 from gearjax.gears.hypoid.flank import work_point
 from gearjax.frames import matrix_z
 from gearjax.kinematics import Kinematics, Mesh, eigen_kinematics
-from gearjax.surfaces import GeneratedSurface, curvature_in_direction, local_geometry
-from gearjax.tca import (ContactPath, Misalignment, contact_equations, gear_mount,
-                         relative_curvature)
+from gearjax.surfaces import GeneratedSurface, curvature_in_direction
+from gearjax.tca import ContactPath, Misalignment, relative_curvature
+from gearjax.tca_result import contact_motion
 
 __all__ = ["PathKinematics", "path_kinematics"]
 
@@ -103,28 +103,14 @@ def path_kinematics(pair: th.HypoidPair, path: ContactPath, mis: Misalignment | 
     r1 = th.flank_function(pair.pinion, pair.pinion_crossing)
     r2 = th.flank_function(pair.gear, pair.gear_crossing)
     asm = th.hypoid_assembly(pair)
-    R, c = gear_mount(asm, mis)
+    mid = path.phi1.shape[0] // 2
+    motion, (R, c) = contact_motion(r1, r2, asm, mis, line_contact, path.uv1[mid, 1])
     k2 = R[:, 2]
     ez = jnp.array([0.0, 0.0, 1.0])
-    mid = path.phi1.shape[0] // 2
-    F, unpack, pack = contact_equations(r1, r2, asm, mis, line_contact, path.uv1[mid, 1])
-
-    def point(x, ph1):
-        uv1, _, _ = unpack(x)
-        return matrix_z(ph1) @ r1(uv1) + mis.dP * ez
 
     def one(uv1, uv2, ph2, ph1):
-        x = pack(jnp.concatenate([uv1, uv2, jnp.stack([ph2])]))
-        Fx = jax.jacfwd(F, 0)(x, ph1)
-        Fp = jax.jacfwd(F, 1)(x, ph1)
-        dx = -jnp.linalg.solve(Fx, Fp)
-        r, v_c = jax.jvp(point, (x, ph1), (dx, jnp.ones_like(ph1)))
-        dph2 = dx[-1]
-        R1, R2 = matrix_z(ph1), R @ matrix_z(ph2)
-        n = R1 @ _outward_normal(pair.pinion, r1, uv1)
-        g1, g2 = local_geometry(r1, uv1), local_geometry(r2, uv2)
-        W1 = jnp.sign(jnp.dot(R1 @ g1.n, n)) * (R1 @ g1.W @ R1.T)
-        W2 = jnp.sign(jnp.dot(R2 @ g2.n, n)) * (R2 @ g2.W @ R2.T)
+        n = matrix_z(ph1) @ _outward_normal(pair.pinion, r1, uv1)
+        r, v_c, dph2, W1, W2 = motion(uv1, uv2, ph2, ph1, n)
         # model: gear = member 1 with its axis through the origin (frame shifted by c),
         # pinion = member 2 about the z axis (through -c), nominal ratio
         w_gear = asm.ratio_sign * (asm.z1 / asm.z2) * k2

@@ -3,20 +3,20 @@
 A face-mill cutter head carries blades whose straight cutting edges sweep cones
 about the cutter axis ``z_t``.  In the cutter frame S_t (origin on the cutter axis in
 the plane of the blade tips, ``z_t`` pointing from the cutter head towards the
-workpiece) the generating cone of seed 004 is
+workpiece) the generating cone of [HFT-hypoid] (see docs/references.md) is
 
     r_t(s, theta) = [ (R_p - sgn * s * sin(alpha)) cos(theta),
                       (R_p - sgn * s * sin(alpha)) sin(theta),
-                      -s * cos(alpha) ]                                   (seed 004)
+                      -s * cos(alpha) ]                                   [HFT-hypoid]
 
 with ``s`` the distance along the blade from its tip (mm, arc length), ``theta``
 the angular position about the cutter axis (rad), ``R_p`` the point radius (mm,
 radius of the blade tip corner), ``alpha`` the blade (pressure) angle, and
 ``sgn = +1`` for the blade that cuts a *convex* flank (inside blade: its radius
 shrinks towards the tooth tip) and ``sgn = -1`` for the blade that cuts a
-*concave* flank (outside blade).  This is seed 004's sign convention.
+*concave* flank (outside blade).  This is the sign convention of [HFT-hypoid].
 
-Unit normal (gearjax's orientation, not stated in the seed): the normal points from
+Unit normal (gearjax's orientation, not stated in [HFT-hypoid]): the normal points from
 the workpiece material into the tooth space, i.e. into the blade,
 
     n_t(theta) = [ sgn cos(alpha) cos(theta), sgn cos(alpha) sin(theta), -sin(alpha) ],
@@ -24,15 +24,15 @@ the workpiece material into the tooth space, i.e. into the blade,
 which is ``sgn * (dr/ds x dr/dtheta)/|.|`` (checked in tests).
 
 Edge radius (root fillet): the blade tip corner is rounded with radius ``rho_f``.
-The straight part starts at ``s_min = rho_f (1 - sin(alpha)) / cos(alpha)`` (seed 004,
+The straight part starts at ``s_min = rho_f (1 - sin(alpha)) / cos(alpha)`` ([HFT-hypoid],
 "fillet start"); the fillet is a torus segment whose normal turns from the blade
 normal (angle ``alpha``) to ``-z_t`` (angle ``pi/2``):
 
     centre (radial, axial) = (R_p + sgn*s_min, -rho_f),
     point  = centre - rho_f * (sgn cos(phi), -sin(phi)),  phi in [alpha, pi/2].
 
-Units: mm, rad.  References: seed 004 (the HFT formate hypoid paper from Gleason No. 116 settings); Litvin & Fuentes,
-*Gear Geometry and Applied Theory*, 2nd ed., ch. 21 (head-cutters for spiral bevel
+Units: mm, rad.  References (docs/references.md): [HFT-hypoid];
+[Litvin2004] ch. 21 (head-cutters for spiral bevel
 gears).
 """
 
@@ -45,7 +45,7 @@ from dataclasses import dataclass
 import jax
 import jax.numpy as jnp
 
-from gearjax.errors import check_positive, check_range
+from gearjax.errors import check_positive, check_range, is_traced
 
 __all__ = ["FaceMillCutter", "make_cutter", "cutter_point", "cutter_normal",
            "cutter_tangents", "fillet_start", "fillet_point", "fillet_normal",
@@ -89,11 +89,12 @@ def make_cutter(point_radius, blade_angle_deg, edge_radius, flank: str) -> FaceM
     a = check_range("blade_angle", blade_angle_deg, 0.0, 45.0, lo_open=True, hi_open=True,
                     unit="deg")
     rho = check_range("edge_radius", edge_radius, 0.0, None, unit="mm")
-    a_rad = math.radians(a)
-    s_min = rho * (1.0 - math.sin(a_rad)) / math.cos(a_rad)
-    if s_min * math.sin(a_rad) + rho >= R:
-        raise ValueError(f"edge_radius = {rho:g} mm is too large for point_radius = {R:g} mm")
-    return FaceMillCutter(jnp.asarray(R), jnp.asarray(a_rad), jnp.asarray(rho),
+    a_rad = a * (math.pi / 180.0)
+    if not any(is_traced(v) for v in (R, a, rho)):      # traced values pass unchecked
+        s_min = rho * (1.0 - math.sin(a_rad)) / math.cos(a_rad)
+        if s_min * math.sin(a_rad) + rho >= R:
+            raise ValueError(f"edge_radius = {rho:g} mm is too large for point_radius = {R:g} mm")
+    return FaceMillCutter(jnp.asarray(R, float), jnp.asarray(a_rad, float), jnp.asarray(rho, float),
                           1 if flank == "convex" else -1)
 
 
@@ -103,7 +104,7 @@ def blade_radius(c: FaceMillCutter, s):
 
 
 def cutter_point(c: FaceMillCutter, s, theta):
-    """Point r_t(s, theta) of the straight-blade cone in the cutter frame (mm), seed 004."""
+    """Point r_t(s, theta) of the straight-blade cone in the cutter frame (mm), [HFT-hypoid]."""
     rho = blade_radius(c, s)
     return jnp.stack([rho * jnp.cos(theta), rho * jnp.sin(theta), -s * jnp.cos(c.blade_angle)])
 

@@ -7,7 +7,7 @@ hypoid/spiral-bevel design file has the tables
 * ``[blank]``   the blank-design input, passed verbatim to
   :meth:`gearjax.gears.hypoid.blank.BlankInput.from_dict` (optional)
 * ``[blank_summary.pinion]``, ``[blank_summary.gear]``  cone data of each member
-  (seed 004's Table 1 layout): hand, teeth, outer_cone_distance,
+  (the layout of [HFT-hypoid] Table 1, docs/references.md): hand, teeth, outer_cone_distance,
   mean_cone_distance (optional, checked against A_o - F/2), face_width,
   outer_addendum, outer_dedendum, pitch_angle, face_angle, root_angle,
   mean_spiral_angle
@@ -17,7 +17,7 @@ hypoid/spiral-bevel design file has the tables
   machine_root_angle, sliding_base, center_to_back, ratio_of_roll,
   modified_roll_2c, modified_roll_6d, and either the geometric radial_distance,
   cradle_angle, tilt, swivel or a sub-table ``no116`` with the Gleason No. 116
-  dials cradle, eccentric, swivel, tilt (seed 004)
+  dials cradle, eccentric, swivel, tilt ([HFT-hypoid])
 * ``[machine_summary]`` free-form copy of published settings, kept for comparison.
 
 Unknown keys raise ``ValueError`` naming the key.  :func:`save_design` writes the

@@ -1,4 +1,4 @@
-"""Face-milled hypoid and spiral-bevel tooth flanks by seed 004's algorithm.
+"""Face-milled hypoid and spiral-bevel tooth flanks by the algorithm of [HFT-hypoid].
 
 A flank is the envelope of a straight-blade face-mill cutter cone
 (:mod:`gearjax.gears.hypoid.cutter`) carried by a cradle-type generator
@@ -8,28 +8,28 @@ the work frame and ``n_w`` its unit normal:
 
 * meshing equation (generated members)      f1 = n_w . dr_w/dpsi = 0   (mm/rad)
   The relative velocity is the autodiff derivative ``dr_w/dpsi`` of the carried
-  cutter point (the project's design rule), not a hand-derived velocity formula; it equals seed
-  004's ``(omega_c - omega_w) x r + omega_w x R`` per unit cradle roll.
+  cutter point (the project's design rule), not a hand-derived velocity formula; it equals
+  the ``(omega_c - omega_w) x r + omega_w x R`` of [HFT-hypoid] per unit cradle roll.
 * face-width condition                      f2 = l_p(r_w) - l_p(xi0) = 0   (mm)
   with the distance along the pitch generatrix ``l_p = cos(gp) x_A + sin(gp) R_A``
-  (seed 004) and ``xi = 1 - 2 (A_o - l_p)/F`` so that ``xi = -1`` at the toe, 0 at
-  mid face and +1 at the heel.  (Seed 004 prints ``xi = 1 - A_o/F + l_p/F``, which
+  ([HFT-hypoid]) and ``xi = 1 - 2 (A_o - l_p)/F`` so that ``xi = -1`` at the toe, 0 at
+  mid face and +1 at the heel.  ([HFT-hypoid] prints ``xi = 1 - A_o/F + l_p/F``, which
   runs from 0 to 1 and contradicts its own "-1 at the toe, +1 at the heel"; gearjax
   uses the form that matches the stated range.)
 * face-cone (tip) condition                 f3 = sin(gF)(x_A + x_pf) - cos(gF) R_A = 0  (mm)
-  (seed 004's ``tan(gF)(x_A + x_pf) - R_A`` times ``cos(gF)``: the signed normal
+  (the ``tan(gF)(x_A + x_pf) - R_A`` of [HFT-hypoid] times ``cos(gF)``: the signed normal
   distance to the face cone, better scaled near gF = 90 deg).
 
 For a formate member ``psi`` is fixed at 0 and the first equation reads
 ``f1 = psi``, so both kinds share one code path.
 
-Algorithm (seed 004): (1) start values at mid face from the cutter/blank geometry
+Algorithm ([HFT-hypoid]): (1) start values at mid face from the cutter/blank geometry
 at ``psi = 0`` -- gearjax takes the blank's mean pitch point on the side facing the
 cutter and reads ``theta*`` and ``s*`` off it in the cutter frame (the geometric
-content of seed 004's closed-form ``theta* = pi/2 - beta + q0``,
-``s* = A_m sin(Delta)/cos(alpha)``, ``psi* = 0``, whose signs depend on the paper's
+content of the closed-form ``theta* = pi/2 - beta + q0``,
+``s* = A_m sin(Delta)/cos(alpha)``, ``psi* = 0`` of [HFT-hypoid], whose signs depend on the paper's
 frame conventions); (2) Newton on (f1, f2, f3) at ``xi = 0`` gives the tip point
-(seed 004 uses simulated annealing here; Newton from the geometric estimate
+([HFT-hypoid] uses simulated annealing here; Newton from the geometric estimate
 converges and nothing random is used); (3) continuation of the tip point along the
 face width (``lax.scan`` from mid face to heel and to toe, previous solution as
 the start); (4) for every face-width position a scan down the blade from
@@ -42,8 +42,8 @@ Work frame: origin at the pitch-cone apex, ``z_w`` the work axis pointing from t
 apex towards the heel; ``x_A = z_w``, ``R_A = sqrt(x_w^2 + y_w^2)``.
 Normals point out of the tooth material into the tooth space.
 
-Units: mm, rad.  References: seed 004 (the HFT formate hypoid paper from Gleason No. 116 settings); Litvin & Fuentes,
-*Gear Geometry and Applied Theory*, 2nd ed., ch. 6 (envelopes) and ch. 21-22.
+Units: mm, rad.  References (docs/references.md): [HFT-hypoid];
+[Litvin2004] ch. 6 (envelopes) and ch. 21-22.
 """
 
 from __future__ import annotations
@@ -78,7 +78,7 @@ BLANK_FIELDS = ["outer_cone_distance", "face_width", "pitch_angle", "face_angle"
                    meta_fields=["teeth", "hand"])
 @dataclass(frozen=True)
 class MemberBlank:
-    """Cone data of one member's blank (mm, rad), as in seed 004's Table 1.
+    """Cone data of one member's blank (mm, rad), as in [HFT-hypoid] Table 1.
 
     outer_cone_distance A_o, face_width F (mm), pitch/face/root cone angles,
     outer addendum and dedendum (mm, at the heel, Gleason convention), mean spiral
@@ -111,8 +111,8 @@ def make_member_blank(*, outer_cone_distance, face_width, pitch_angle, face_angl
     z = check_int("teeth", teeth, 1)
     if hand not in ("left", "right"):
         raise ValueError(f"hand = {hand!r} must be 'left' or 'right'")
-    r = np.radians
-    f = lambda v: jnp.asarray(float(v))
+    r = lambda x: x * (np.pi / 180.0)             # traced values pass (inside jax.grad)
+    f = lambda v: jnp.asarray(v, float)
     return MemberBlank(f(Ao), f(F), f(r(gp)), f(r(gf)), f(r(gr)), f(a), f(d), f(r(b)), z, hand)
 
 
@@ -149,7 +149,7 @@ def axial_coords(r):
 
 
 def pitch_distance(b: MemberBlank, r):
-    """l_p = cos(gp) x_A + sin(gp) R_A (mm), seed 004."""
+    """l_p = cos(gp) x_A + sin(gp) R_A (mm), [HFT-hypoid]."""
     x, R = axial_coords(r)
     return jnp.cos(b.pitch_angle) * x + jnp.sin(b.pitch_angle) * R
 
@@ -192,12 +192,34 @@ def work_point(fl: FlankSpec, s, theta, psi=0.0):
     return r, n
 
 
+def body_family(fl: FlankSpec, shift, uv, psi):
+    """Tool family of a flank in the member's body frame: the cutter point at
+    ``uv = (theta, s)`` carried to cradle roll ``psi``, minus ``shift`` (3,) (the
+    crossing point).  Module-level so that ``jax.tree_util.Partial(body_family, fl,
+    shift)`` is a pytree whose jit caches are shared by every flank function built
+    from it (:func:`gearjax.gears.hypoid.pair.flank_function`)."""
+    return work_point(fl, uv[1], uv[0], psi)[0] - shift
+
+
+def body_point(fl: FlankSpec, shift, uv):
+    """Formate flank (the cutter cone placed by the settings) in the body frame."""
+    return work_point(fl, uv[1], uv[0], 0.0)[0] - shift
+
+
+def _carried(fl: FlankSpec, s, theta, psi):
+    """``(r_w, n_w, dr_w/dpsi)`` from one forward-mode pass through the machine chain
+    (the point, the normal and the relative velocity share one trace)."""
+    psi = jnp.asarray(psi, float)
+    (r, n), (v, _) = jax.jvp(lambda p: work_point(fl, s, theta, p), (psi,),
+                             (jnp.ones_like(psi),))
+    return r, n, v
+
+
 def meshing_function(fl: FlankSpec, s, theta, psi):
     """f1 = n_w . dr_w/dpsi (mm/rad): zero on the generated flank (0 for formate)."""
     if not fl.machine.generated:
         return jnp.zeros_like(jnp.asarray(psi, float))
-    v = jax.jacfwd(lambda p: work_point(fl, s, theta, p)[0])(psi)
-    _, n = work_point(fl, s, theta, psi)
+    _, n, v = _carried(fl, s, theta, psi)
     return jnp.dot(n, v)
 
 
@@ -205,23 +227,27 @@ def _target(b: MemberBlank, xi0):
     return b.outer_cone_distance - 0.5 * b.face_width * (1.0 - xi0)
 
 
-def _first_eq(fl, s, th, psi):
-    return meshing_function(fl, s, th, psi) if fl.machine.generated else psi
+def _point_and_first_eq(fl, s, th, psi):
+    """Work point and the first equation (meshing, or ``psi`` for formate): one pass."""
+    if fl.machine.generated:
+        r, n, v = _carried(fl, s, th, psi)
+        return r, jnp.dot(n, v)
+    return work_point(fl, s, th, psi)[0], psi
 
 
 def _F_tip(x, p):
     fl, xi0 = p
     s, th, psi = x[0], x[1], x[2]
-    r, _ = work_point(fl, s, th, psi)
-    return jnp.stack([_first_eq(fl, s, th, psi), pitch_distance(fl.blank, r) - _target(fl.blank, xi0),
+    r, f1 = _point_and_first_eq(fl, s, th, psi)
+    return jnp.stack([f1, pitch_distance(fl.blank, r) - _target(fl.blank, xi0),
                       face_cone_gap(fl.blank, r)])
 
 
 def _F_point(x, p):
     fl, s, xi0 = p
     th, psi = x[0], x[1]
-    r, _ = work_point(fl, s, th, psi)
-    return jnp.stack([_first_eq(fl, s, th, psi), pitch_distance(fl.blank, r) - _target(fl.blank, xi0)])
+    r, f1 = _point_and_first_eq(fl, s, th, psi)
+    return jnp.stack([f1, pitch_distance(fl.blank, r) - _target(fl.blank, xi0)])
 
 
 def mid_estimate(fl: FlankSpec):
@@ -280,7 +306,7 @@ def _tip_scan(fl, xs, x_start):
 
 
 def flank_points(fl: FlankSpec, n_xi: int = 21, n_s: int = 11) -> FlankGrid:
-    """Flank grid by seed 004's algorithm (pure and jit-friendly; no validation).
+    """Flank grid by the algorithm of [HFT-hypoid] (pure and jit-friendly; no validation).
 
     ``n_xi`` face-width positions ``xi`` in [-1, 1] (toe to heel), ``n_s`` blade
     positions from the fillet start ``s_min`` to the tip ``s_max(xi)``, uniformly

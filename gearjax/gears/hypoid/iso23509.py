@@ -113,7 +113,7 @@ def method0_pitch_cones(u, Sigma, de2, b2, beta_m):
 def _method1_start(u, Sigma, a, de2, b2, beta_d1, rmpt2=None):
     """ISO 23509 formulae (10)-(16): approximate quantities and the start value of eta.
 
-    ``rmpt2`` overrides formula (12) (used by the seed-003 route to start from a
+    ``rmpt2`` overrides formula (12) (used by the [Tangent-cones] route to start from a
     Method 1 solution with its own wheel mean radius).
     """
     dS = Sigma - 0.5 * jnp.pi

@@ -30,14 +30,14 @@ Generating roll with modified roll (Gleason 2C, 6D):
 
     phi(psi) = R_a * (psi - (2C/2) psi^2 - (6D/6) psi^3)
 
-with ``R_a`` the ratio of roll (work turns per cradle turn, seed 004's ``m_wc``).
+with ``R_a`` the ratio of roll (work turns per cradle turn, ``m_wc`` of [HFT-hypoid], see docs/references.md).
 The cutter surface in the work frame is
 
     r_w(s, theta, psi) = M_mw(phi(psi))^-1 . Rz(psi) . M_ct . r_t(s, theta).
 
 A *formate* member (non-generated gear) has no roll: ``r_w = M_mw(0)^-1 . M_ct . r_t``.
 
-Gleason No. 116 dials (seed 004): cradle dial ``phi_c``, eccentric ``phi_e``,
+Gleason No. 116 dials ([HFT-hypoid]): cradle dial ``phi_c``, eccentric ``phi_e``,
 swivel ``phi_s``, tilt ``phi_t``, wedge angle ``eps = 15 deg`` and machine length
 ``l = 222.25/2 mm``.  The cutter centre is carried by two arms of length ``l``
 (cradle -> eccentric -> cutter spindle) and the cutter spindle by the tilt drum,
@@ -48,17 +48,17 @@ whose axis is inclined by ``eps`` to the spindle:
                 k = (sin eps, 0, cos eps),
 
 read in a cradle frame mirrored in y (``P M P``, P = diag(1, -1, 1); the mirror
-leaves ``a11`` unchanged and is the reading under which the seed's pinion dials
-cut the left-hand pinion of its Table 1), whose first element is seed 004's
+leaves ``a11`` unchanged and is the reading under which the pinion dials of [HFT-hypoid]
+cut the left-hand pinion of its Table 1), whose first element is the paper's
 ``a11 = cos(tau)(cos^2 eps cos phi_t + sin^2 eps) - sin(tau) cos(eps) sin(phi_t)``.
-Hence ``S_r = 2 l sin(phi_e/2)``, ``q = -(phi_c + phi_e/2 - pi/2)`` (minus the seed's ``q_0``),
+Hence ``S_r = 2 l sin(phi_e/2)``, ``q = -(phi_c + phi_e/2 - pi/2)`` (minus the paper's ``q_0``),
 ``cos i = cos^2 eps + sin^2 eps cos phi_t`` and the swivel from the azimuth of the
-tilted cutter axis.  The seed gives only ``a11``; the remaining elements follow from
+tilted cutter axis.  [HFT-hypoid] gives only ``a11``; the remaining elements follow from
 this product and are tested by an independent route (both transforms place every
 cutter point on the same cone).
 
-Units: mm, rad.  References: seed 004 (the HFT formate hypoid paper from Gleason No. 116 settings), seed 003;
-Litvin & Fuentes, *Gear Geometry and Applied Theory*, 2nd ed., ch. 21-22.
+Units: mm, rad.  References (docs/references.md): [HFT-hypoid], [Tangent-cones];
+[Litvin2004] ch. 21-22.
 """
 
 from __future__ import annotations
@@ -78,8 +78,8 @@ __all__ = ["MachineSettings", "No116Dials", "WEDGE_ANGLE", "MACHINE_LENGTH",
            "dial_cutter_to_cradle", "dials_to_geometric", "geometric_to_dials",
            "SETTING_FIELDS"]
 
-WEDGE_ANGLE = math.radians(15.0)      # eps, Gleason No. 116 (seed 004)
-MACHINE_LENGTH = 222.25 / 2.0         # l (mm), Gleason No. 116 (seed 004)
+WEDGE_ANGLE = math.radians(15.0)      # eps, Gleason No. 116 ([HFT-hypoid])
+MACHINE_LENGTH = 222.25 / 2.0         # l (mm), Gleason No. 116 ([HFT-hypoid])
 
 SETTING_FIELDS = ["radial_distance", "cradle_angle", "tilt", "swivel", "blank_offset",
                   "machine_root_angle", "sliding_base", "center_to_back", "ratio_of_roll",
@@ -117,7 +117,8 @@ class MachineSettings:
     def create(*, radial_distance, cradle_angle, machine_root_angle, tilt=0.0, swivel=0.0,
                blank_offset=0.0, sliding_base=0.0, center_to_back=0.0, ratio_of_roll=0.0,
                modified_roll_2c=0.0, modified_roll_6d=0.0, generated=True) -> "MachineSettings":
-        """Validated constructor from internal units (mm, rad)."""
+        """Validated constructor from internal units (mm, rad); traced values (inside
+        ``jax.grad``) pass through unchecked."""
         check_positive("radial_distance", radial_distance, "mm")
         check_range("tilt", tilt, 0.0, math.pi / 2, hi_open=True, unit="rad")
         for name, v in [("cradle_angle", cradle_angle), ("swivel", swivel),
@@ -128,7 +129,7 @@ class MachineSettings:
             check_range(name, v)
         if generated:
             check_positive("ratio_of_roll", ratio_of_roll)
-        f = lambda v: jnp.asarray(float(v))
+        f = lambda v: jnp.asarray(v, float)
         return MachineSettings(f(radial_distance), f(cradle_angle), f(tilt), f(swivel),
                                f(blank_offset), f(machine_root_angle), f(sliding_base),
                                f(center_to_back), f(ratio_of_roll), f(modified_roll_2c),
@@ -166,7 +167,7 @@ def cutter_to_work(ms: MachineSettings, psi=0.0):
 
 
 # --------------------------------------------------------------------------------------
-# Gleason No. 116 dial settings (seed 004)
+# Gleason No. 116 dial settings ([HFT-hypoid])
 
 
 @functools.partial(jax.tree_util.register_dataclass,
@@ -190,13 +191,13 @@ _MIRROR_Y = jnp.diag(jnp.array([1.0, -1.0, 1.0, 1.0]))
 
 
 def dial_cutter_to_cradle(d: No116Dials, eps=WEDGE_ANGLE, length=MACHINE_LENGTH):
-    """Seed 004's M_ct from the No. 116 dials (cutter frame -> cradle frame), 4x4.
+    """M_ct of [HFT-hypoid] from the No. 116 dials (cutter frame -> cradle frame), 4x4.
 
-    Seed 004's product, A = T(l(cos phi_c - cos(phi_c+phi_e)), l(sin phi_c -
+    The paper's product, A = T(l(cos phi_c - cos(phi_c+phi_e)), l(sin phi_c -
     sin(phi_c+phi_e)), 0) Rz(phi_c + phi_e + phi_s) R_k(phi_t), k = (sin eps, 0, cos eps),
     is read in a cradle frame mirrored in y: ``M_ct = P A P`` with P = diag(1, -1, 1).
-    ``a11`` is unchanged by the mirror (so the seed's a11 holds for both readings);
-    only the mirrored reading gives the seed's 8/43 pinion the left hand of Table 1
+    ``a11`` is unchanged by the mirror (so the paper's a11 holds for both readings);
+    only the mirrored reading gives its 8/43 pinion the left hand of Table 1
     (the unmirrored one cuts a right-hand pinion) -- see docs/hypoid.md.
     """
     c, e = d.cradle, d.eccentric
@@ -213,8 +214,8 @@ def _wrap(a):
 def dials_to_geometric(d: No116Dials, eps=WEDGE_ANGLE, length=MACHINE_LENGTH):
     """(S_r, q, i, j) from the No. 116 dials (mm, rad), differentiable.
 
-    In seed 004's (unmirrored) frame: S_r = 2 l sin(phi_e/2), q0 = phi_c + phi_e/2 - pi/2
-    (the seed's q0), cos i = cos^2 eps + sin^2 eps cos phi_t, azimuth of the tilted
+    In the (unmirrored) frame of [HFT-hypoid]: S_r = 2 l sin(phi_e/2), q0 = phi_c + phi_e/2 - pi/2
+    (the paper's q0), cos i = cos^2 eps + sin^2 eps cos phi_t, azimuth of the tilted
     cutter axis lam = tau + atan2(-sin phi_t, cos eps (1 - cos phi_t)), and from the
     axis (sin i sin(q-j), -sin i cos(q-j), cos i) of :func:`cutter_to_cradle`
     j0 = q0 - pi/2 - lam.  The mirror in y (see :func:`dial_cutter_to_cradle`) gives

@@ -66,7 +66,7 @@ from gearjax.gears.hypoid.cutter import FaceMillCutter
 from gearjax.gears.hypoid.flank import (FlankSpec, face_cone_gap, mid_estimate, pitch_distance,
                                         root_cone_gap, solve_tip, work_point)
 from gearjax.gears.hypoid.machine import MachineSettings, cutter_to_cradle
-from gearjax.surfaces import GeneratedSurface, solve_envelope
+from gearjax.surfaces import GeneratedSurface
 from gearjax.tca import Assembly, ContactPath
 
 __all__ = ["SIDES", "HypoidPair", "pair_flanks", "mean_dedendum", "complementary_pinion",
@@ -202,15 +202,14 @@ def with_point_radius(fl: FlankSpec, d_radius, theta_m) -> FlankSpec:
 def flank_function(fl: FlankSpec, crossing):
     """Flank ``uv = (theta, s) -> (3,)`` in the member's body frame (origin at the
     crossing point): a GeneratedSurface for a generated member, else the placed cone."""
+    from gearjax.gears.hypoid.flank import body_family, body_point
     shift = jnp.stack([0.0, 0.0, jnp.asarray(crossing, float)])
+    # Partials of module-level functions (pytrees): every flank function built here
+    # shares one set of jit caches (gearjax.surfaces, "trace once")
     if fl.machine.generated:
-        def family(uv, psi):
-            return work_point(fl, uv[1], uv[0], psi)[0] - shift
-        return GeneratedSurface(family, 0.0, tol=1e-12, max_steps=30)
-
-    def r(uv):
-        return work_point(fl, uv[1], uv[0], 0.0)[0] - shift
-    return r
+        return GeneratedSurface(jax.tree_util.Partial(body_family, fl, shift), 0.0,
+                                tol=1e-12, max_steps=30)
+    return jax.tree_util.Partial(body_point, fl, shift)
 
 
 def hypoid_assembly(pair: HypoidPair) -> Assembly:
@@ -228,7 +227,9 @@ def mean_point(fl: FlankSpec, crossing):
     uv = jnp.array([float(tip.x[1]), 0.5 * float(tip.x[0])])
     psi = 0.0
     if fl.machine.generated:
-        psi = solve_envelope(lambda q, p: work_point(fl, q[1], q[0], p)[0], uv, 0.0).x
+        # the cached envelope solve of the flank function (a constant shift of the
+        # family does not change the meshing equation): no recompilation per call
+        psi = flank_function(fl, crossing).solve(uv).x
     r, n = work_point(fl, uv[1], uv[0], psi)
     q = np.asarray(r) - np.array([0.0, 0.0, float(crossing)])
     return np.asarray(uv), q, np.asarray(n)

@@ -1,6 +1,6 @@
-"""Hypoid pitch cones by the tangency-contact condition (seed 003).
+"""Hypoid pitch cones by the tangency-contact condition ([Tangent-cones]).
 
-Seed 003 (the hypoid pitch-cone tangency paper) states the pitch-cone problem of a hypoid
+[Tangent-cones] (see docs/references.md) states the pitch-cone problem of a hypoid
 pair as the tangency of two skew cones: at the pitch point P the two cones have
 a common point (3 equations) and parallel normals (2 equations), equations (1)-(5);
 the wheel mean point is at mid face, ``r2 = (D - b sin delta2)/2`` (7); the pinion
@@ -10,13 +10,13 @@ P, ``beta1 = beta2 + zeta`` (8); and a cutter-radius (limit curvature) condition
 else is explicit, so the eight unknowns reduce to a two-variable root finding in
 ``(delta1, delta2)``.
 
-What gearjax does (and where it differs from the seed's text):
+What gearjax does (and where it differs from the text of [Tangent-cones]):
 
 * **Frames.**  S_f has its origin at the crossing point C2 of the wheel axis and
   the common perpendicular; x_f runs along the common perpendicular towards the
   pinion axis, the wheel axis is ``u2 = (0, 0, 1)`` through C2 = 0, the pinion axis
   is ``u1 = (0, sin Sigma, cos Sigma)`` through ``C1 = (E, 0, 0)``.  ``u_i`` points
-  from the apex of member i into its pitch cone.  The seed's cone parametrisation
+  from the apex of member i into its pitch cone.  The paper's cone parametrisation
   ``(r cos t, r sin t sin d, r sin t cos d)`` is a plane, not a cone, and its
   eq. (3) has the offset on the wrong side of its own translation; its normals
   (1)-(2) are those of cones about y_1 and z_2.  gearjax writes the cones as
@@ -34,15 +34,15 @@ What gearjax does (and where it differs from the seed's text):
 * **Spiral angles (8).**  ``zeta`` is the signed angle between the generatrices
   in the common tangent plane (= ISO's offset angle in the pitch plane
   ``zeta_mp``), ``beta1 = beta2 + zeta``; either spiral angle may be the input.
-* **The missing equation: the ratio.**  The seed never uses the tooth numbers.
+* **The missing equation: the ratio.**  [Tangent-cones] never uses the tooth numbers.
   The pitch point must transmit the ratio: the velocity components normal to the
   tooth trace are equal, ``omega1 r1 cos beta1 = omega2 r2 cos beta2`` (Gleason's
   hypoid dimension factor ``r1 = r2 cos beta2 / (u cos beta1)``, ISO 23509 (14),
   (26)).  This is the first residual.
-* **Cutter radius (6).**  The seed's eq. (6) mixes undefined radii ``rho_1, rho_2``
+* **Cutter radius (6).**  The paper's eq. (6) mixes undefined radii ``rho_1, rho_2``
   and its limit-angle formula is not dimensionally consistent.  gearjax uses the
-  classical limit pressure angle and limit radius of curvature (Wildhaber; ISO
-  23509 formulae (32)-(33)) with the tangency-route cone distances ``R1, R2``:
+  classical limit pressure angle and limit radius of curvature ([Wildhaber1946];
+  [ISO23509] formulae (32)-(33)) with the tangency-route cone distances ``R1, R2``:
   second residual ``rho_lim / r_c0 - 1``.
 
 * **Unknowns.**  Newton runs in ``(delta1, gamma)`` with ``gamma = n . x_f``
@@ -55,7 +55,7 @@ At ``E = 0`` the limit curvature is 0/0 (any cutter works for a spiral bevel
 pair), so this route needs ``E > 0``; the zero-offset limit is checked in the
 tests by letting ``E -> 0``.
 
-The pinion machine settings of the seed's last table are in
+The pinion machine settings of the last table of [Tangent-cones] are in
 :func:`pinion_machine_settings`.
 """
 
@@ -88,7 +88,7 @@ def axes(Sigma, E):
 
 
 def cone_tangency(delta1, delta2, Sigma, E, R2):
-    """Closed-form steps 2-3 of seed 003: tangency of the cones for trial pitch angles.
+    """Closed-form steps 2-3 of [Tangent-cones]: tangency of the cones for trial pitch angles.
 
     Given pitch angles ``delta1, delta2`` (rad), shaft angle ``Sigma``, offset ``E``
     (mm) and the wheel cone distance ``R2`` (mm) of the pitch point, returns a dict
@@ -97,7 +97,7 @@ def cone_tangency(delta1, delta2, Sigma, E, R2):
     ``R1``, apex positions ``a1, a2`` (ISO t_z1, t_z2: apex beyond the crossing
     point along the axis, mm), position angles ``theta1, theta2`` and the signed
     angle ``zeta`` from ``g2`` to ``g1`` in the tangent plane.  Equations (1)-(5)
-    of seed 003 in the frames described in the module docstring.
+    of [Tangent-cones] in the frames described in the module docstring.
     """
     gamma = normal_offset_component(delta1, delta2, Sigma)
     return _tangency(jnp.sin(delta1), jnp.cos(delta1), jnp.sin(delta2), jnp.cos(delta2),
@@ -164,7 +164,7 @@ def delta2_from_normal(delta1, gamma, Sigma):
 
 @dataclass(frozen=True)
 class PitchConeSolution:
-    """Solution of the seed-003 tangency route (mm, rad).
+    """Solution of the [Tangent-cones] tangency route (mm, rad).
 
     ``delta1, delta2`` pitch angles; ``R1, R2`` mean cone distances of the pitch
     point; ``r1, r2`` its radii; ``theta1, theta2`` position angles; ``a1, a2`` apex
@@ -224,7 +224,7 @@ def _state(x, th, spiral_member, wheel_radius):
     if spiral_member == "pinion":
         beta1, beta2 = beta + 0.0 * zeta, beta - zeta
     else:
-        beta1, beta2 = beta + zeta, beta + 0.0 * zeta       # seed 003 eq. (8)
+        beta1, beta2 = beta + zeta, beta + 0.0 * zeta       # [Tangent-cones] eq. (8)
     R1, R2 = geo["R1"], geo["R2"]
     r1 = R1 * jnp.sin(delta1)
     alim = iso23509.limit_pressure_angle(delta1, delta2, R1, R2, beta1, beta2, zeta)
@@ -236,7 +236,7 @@ def _state(x, th, spiral_member, wheel_radius):
 
 def solve_pitch_cones(u, Sigma, E, de2, b2, beta, rc0, *, spiral_member="pinion",
                       wheel_radius="mid-face", r2=None, strict=True):
-    """Seed-003 pitch cones: two-variable Newton in the pitch angles.
+    """[Tangent-cones] pitch cones: two-variable Newton in the pitch angles.
 
     The Newton unknowns are ``(delta1, gamma)``, ``gamma = n . x_f``, a smooth
     one-to-one change of coordinates of ``(delta1, delta2)`` (see :func:`_state`);
@@ -245,7 +245,7 @@ def solve_pitch_cones(u, Sigma, E, de2, b2, beta, rc0, *, spiral_member="pinion"
     Parameters (mm, rad): ``u = z2/z1`` ratio (float), ``Sigma`` shaft angle, ``E``
     hypoid offset (> 0), ``de2`` wheel outer pitch diameter, ``b2`` wheel face width,
     ``beta`` mean spiral angle of ``spiral_member`` ("pinion" or "gear"), ``rc0``
-    cutter radius.  ``wheel_radius`` is ``"mid-face"`` (seed eq. (7),
+    cutter radius.  ``wheel_radius`` is ``"mid-face"`` ([Tangent-cones] eq. (7),
     ``r2 = (de2 - b2 sin delta2)/2``) or ``"given"`` (use ``r2``, e.g. ISO 23509's
     ``rmpt2`` for a like-for-like comparison with Method 1).
 
@@ -322,22 +322,22 @@ def _start(u, Sigma, E, de2, b2, beta, rc0, r2_fixed, spiral_member, wheel_radiu
 
 
 def pinion_machine_settings(sol: PitchConeSolution, E, hand="left"):
-    """Pinion machine settings of seed 003's last table, evaluated literally.
+    """Pinion machine settings of the last table of [Tangent-cones], evaluated literally.
 
     * vertical wheel base   ``dV = E sin theta2 - a1``
     * horizontal wheel base ``dH = E cos theta2 + a2``
     * cradle angle          ``q = theta2 + 90 deg`` (left-hand pinion) or
-      ``theta2 - 90 deg`` (right-hand); the seed writes ``theta2 +- 90 deg``
-    * cutter tilt           ``sin i = tan beta1 / tan alpha_lim`` (seed) -- for every
+      ``theta2 - 90 deg`` (right-hand); the paper writes ``theta2 +- 90 deg``
+    * cutter tilt           ``sin i = tan beta1 / tan alpha_lim`` (paper) -- for every
       practical hypoid ``|tan beta1 / tan alpha_lim| >> 1`` (e.g. ~30 for ISO 23509
-      sample 2), so the seed's relation has no solution; ``tilt`` is NaN then
+      sample 2), so the paper's relation has no solution; ``tilt`` is NaN then
       and ``tilt_valid`` False.  ``tilt_reciprocal = asin(tan alpha_lim / tan beta1)``
       is the reciprocal reading (zero for spiral bevels, where no tilt is needed);
       it is gearjax's interpretation, not a published formula.
     * gear machine centre to back ``X_G = a2``.
 
     ``theta2, a1, a2`` are those of :func:`cone_tangency` (position angle from the
-    common perpendicular; ISO t_z1, t_z2).  The seed gives these relations as
+    common perpendicular; ISO t_z1, t_z2).  [Tangent-cones] gives these relations as
     approximations ("primary analytical relation"); the exact settings come from
     the machine model.  Returns a dict (mm, rad).
     """

@@ -28,11 +28,13 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from gearjax.gears.hypoid.design_file import HypoidDesign
 from gearjax.gears.hypoid.flank import face_apex_offset, root_apex_offset
 from gearjax.gears.hypoid.pair import (SIDES, HypoidPair, complementary_pinion, flank_coordinates,
                                        flank_function, hypoid_assembly, hypoid_margin,
                                        mean_dedendum, mean_point, pair_flanks, with_point_radius)
 from gearjax.newton import newton_solve
+from gearjax.tca_result import TCAResult, check_side, contact_kinematics, register_family
 from gearjax.tca import (DEFAULT_APPROACH, ContactPath, Misalignment, MultiPair,
                          NoContactError, check_on_flank_converged, check_tca_options,
                          contact_equations, contact_path, multi_pair)
@@ -41,7 +43,8 @@ __all__ = ["mean_dedendum", "HypoidPair", "pair_flanks", "complementary_pinion",
            "hypoid_assembly", "flank_function", "reference_guess", "hypoid_margin",
            "flank_coordinates", "hypoid_tca_traced", "hypoid_tca", "SIDES", "HypoidTCA",
            "Prepared", "prepare", "with_point_radius", "pinion_outline",
-           "misalignment_sensitivity", "reference_contact", "tca_summary", "SUMMARY_KEYS"]
+           "misalignment_sensitivity", "reference_contact", "tca_summary", "SUMMARY_KEYS",
+           "hypoid_result_traced"]
 
 
 
@@ -209,17 +212,31 @@ def hypoid_tca_traced(pair: HypoidPair, mis: Misalignment, x_ref, phi1_ref, *,
     contact (conjugate pairs): the grid is centred on ``phi1_ref`` and the pinion
     blade position ``s`` stays at ``x_ref[1]``.
     """
+    r1 = flank_function(pair.pinion, pair.pinion_crossing)
+    r2 = flank_function(pair.gear, pair.gear_crossing)
     if not line_contact:
-        # where step 1 fails the reference stays at the guessed pinion angle; the
-        # path's own solves carry the convergence flags
-        x_new, phi1_new, ok = reference_contact(pair, mis, x_ref, phi1_ref)
-        x_ref = jnp.where(ok, x_new, jax.lax.stop_gradient(jnp.asarray(x_ref, float)))
-        phi1_ref = jnp.where(ok, phi1_new, jax.lax.stop_gradient(jnp.asarray(phi1_ref, float)))
+        # step 1 of reference_contact: where the pinion's mean point meets the gear
+        # flank.  Its step 2 (the 5x5 point contact at that pinion angle, from step
+        # 1's solution) is exactly the path's first solve (the middle grid point is
+        # that angle): solving it here too would put a third contact Newton into the
+        # program.  Where step 1 fails the reference stays at the guess; the path's
+        # own solves carry the convergence flags.
+        F, _, _ = contact_equations(r1, r2, hypoid_assembly(pair), mis, False)
+        x_guess = jax.lax.stop_gradient(jnp.asarray(x_ref, float))
+        uv1 = x_guess[:2]
+
+        def G(y, _):
+            return F(jnp.concatenate([uv1, y[1:]]), y[0])[:4]
+
+        y0 = jnp.concatenate([jnp.stack([jnp.asarray(phi1_ref, float)]), x_guess[2:]])
+        s1 = newton_solve(G, y0, (), tol=1e-11, max_steps=40)
+        x1 = jax.lax.stop_gradient(jnp.concatenate([uv1, s1.x[1:]]))
+        x_ref = jnp.where(s1.converged, x1, x_guess)
+        phi1_ref = jnp.where(s1.converged, s1.x[0],
+                             jax.lax.stop_gradient(jnp.asarray(phi1_ref, float)))
     h = 2.0 * np.pi / (pair.z1 * steps_per_pitch)
     k = int(round(half_pitches * steps_per_pitch))
     grid = phi1_ref + h * jnp.arange(-k, k + 1, dtype=float)
-    r1 = flank_function(pair.pinion, pair.pinion_crossing)
-    r2 = flank_function(pair.gear, pair.gear_crossing)
     path = contact_path(r1, r2, hypoid_assembly(pair), mis, grid, x_ref,
                         line_contact=line_contact, approach=approach)
     margin, coords = hypoid_margin(pair, path)
@@ -349,3 +366,106 @@ def pinion_outline(pair: HypoidPair) -> dict:
     pts = [corner(Ao - F, cones[0]), corner(Ao, cones[0]), corner(Ao, cones[1]),
            corner(Ao - F, cones[1])]
     return {"outline": np.array(pts + [pts[0]])}
+
+
+# -- the common TCA interface (gearjax.tca_result) --------------------------------------
+
+def hypoid_result_traced(pair: HypoidPair, mis: Misalignment, x_ref, phi1_ref, *,
+                         side: str, drive: bool, steps_per_pitch: int = 16, half_pitches: float = 2.0,
+                         line_contact: bool = False, n_pairs: int = 5,
+                         approach=DEFAULT_APPROACH, kinematics: bool = True) -> TCAResult:
+    """:func:`hypoid_tca_traced` as a :class:`~gearjax.tca_result.TCAResult` with the
+    kinematics at the contact points (traceable).  ``side`` "drive"/"coast" labels the
+    flank pair (drive = pinion concave on gear convex); ``drive`` is the sense of
+    rotation found by :func:`prepare` (True: the pinion flank pushes the gear for
+    increasing ``phi1``), which picks the max or min TE envelope."""
+    res = hypoid_tca_traced(pair, mis, x_ref, phi1_ref, steps_per_pitch=steps_per_pitch,
+                            half_pitches=half_pitches, line_contact=line_contact,
+                            n_pairs=n_pairs, drive=drive, approach=approach)
+    kin = None
+    if kinematics:
+        kin = contact_kinematics(flank_function(pair.pinion, pair.pinion_crossing),
+                                 flank_function(pair.gear, pair.gear_crossing),
+                                 hypoid_assembly(pair), mis, res.path, line_contact=line_contact)
+    return TCAResult(res.path, res.margin, res.multi, res.coords, kin, side, "hypoid")
+
+
+_RSTATIC = ("side", "drive", "steps_per_pitch", "half_pitches", "line_contact", "n_pairs", "kinematics")
+
+
+@functools.partial(jax.jit, static_argnames=_RSTATIC)
+def _result_jit(pair, mis, x_ref, phi1_ref, approach, *, side, drive, steps_per_pitch,
+                half_pitches, line_contact, n_pairs, kinematics):
+    return hypoid_result_traced(pair, mis, x_ref, phi1_ref, side=side, drive=drive,
+                                steps_per_pitch=steps_per_pitch, half_pitches=half_pitches,
+                                line_contact=line_contact, n_pairs=n_pairs, approach=approach,
+                                kinematics=kinematics)
+
+
+class _Adapter:
+    """The spiral-bevel/hypoid family behind :func:`gearjax.run_tca`.  Designs: a
+    loaded design file (``side`` picks the flanks: drive = pinion concave on gear
+    convex), a :class:`HypoidPair` or a :class:`Prepared` pair (its flanks fix the
+    side; a ``side`` that contradicts them raises ValueError)."""
+
+    family = "hypoid"
+    defaults = dict(steps_per_pitch=16, half_pitches=2.0, n_pairs=5)
+
+    @staticmethod
+    def _prepared(design, side):
+        side = check_side(side) if side is not None else None
+        if isinstance(design, (Prepared, HypoidPair)):
+            pair = design.pair if isinstance(design, Prepared) else design
+            # drive = pinion concave (outside blade, sign -1) on gear convex (SIDES)
+            found = "drive" if pair.pinion.cutter.sign == -1 else "coast"
+            if side is not None and side != found:
+                raise ValueError(f"side = {side!r}: the pinion flank of this pair is "
+                                 f"{SIDES[found][0]}, i.e. the {found} side (build the pair "
+                                 "of the other side from the design)")
+            prep = design if isinstance(design, Prepared) else prepare(design)
+            return prep, found
+        side = side or "drive"                  # a design file: side picks the flanks
+        return prepare(pair_flanks(design, side)), side
+
+    def run(self, design, mis=None, *, side=None, steps_per_pitch=16, half_pitches=2.0,
+            n_pairs=5, line_contact=False, approach=DEFAULT_APPROACH, kinematics=True,
+            strict=True):
+        check_tca_options(steps_per_pitch, half_pitches, n_pairs, approach)
+        prep, side = self._prepared(design, side)
+        mis = Misalignment.zero() if mis is None else mis
+        res = _result_jit(prep.pair, mis, jnp.asarray(prep.x_ref), jnp.asarray(prep.phi1_ref),
+                          float(approach), side=side, drive=bool(prep.drive),
+                          steps_per_pitch=int(steps_per_pitch),
+                          half_pitches=float(half_pitches), line_contact=bool(line_contact),
+                          n_pairs=int(n_pairs), kinematics=bool(kinematics))
+        if strict:
+            check_on_flank_converged(res.path, res.margin)
+        return res
+
+    def traced(self, design, *, side=None, steps_per_pitch=16, half_pitches=2.0, n_pairs=5,
+               line_contact=False, approach=DEFAULT_APPROACH, kinematics=True):
+        check_tca_options(steps_per_pitch, half_pitches, n_pairs, approach)
+        prep, side = self._prepared(design, side)
+        x_ref, phi1_ref = jnp.asarray(prep.x_ref), jnp.asarray(prep.phi1_ref)
+        hand, drive = prep.pair.hand, bool(prep.drive)
+
+        def f(pair: HypoidPair, mis=None):
+            mis = Misalignment.zero() if mis is None else mis
+            return hypoid_result_traced(replace(pair, hand=hand), mis, x_ref, phi1_ref,
+                                        side=side, drive=drive, steps_per_pitch=int(steps_per_pitch),
+                                        half_pitches=float(half_pitches),
+                                        line_contact=bool(line_contact), n_pairs=int(n_pairs),
+                                        approach=approach, kinematics=kinematics)
+        f.pair = prep.pair
+        return f
+
+    def sensitivity(self, design, mis=None, *, side=None, steps_per_pitch=16, half_pitches=2.0,
+                    n_pairs=5, approach=DEFAULT_APPROACH, **_):
+        prep, _ = self._prepared(design, side)
+        return misalignment_sensitivity(prep, mis, steps_per_pitch=steps_per_pitch,
+                                        half_pitches=half_pitches, n_pairs=n_pairs,
+                                        approach=approach)
+
+
+for _t in (HypoidDesign, HypoidPair, Prepared):
+    register_family(_t, _Adapter())

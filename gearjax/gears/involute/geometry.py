@@ -48,7 +48,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from gearjax.frames import matrix_z
-from gearjax.errors import check_int, check_range, require_converged
+from gearjax.errors import check_int, check_range, is_traced, require_converged
 from gearjax.kinematics import Kinematics, Mesh, eigen_kinematics, parallel_axes
 from gearjax.newton import newton_solve
 from gearjax.surfaces import GeneratedSurface, local_geometry, unit_normal
@@ -94,9 +94,11 @@ class InvolutePair:
         b = check_range("helix", helix_deg, 0.0, 60.0, unit="deg")
         x1 = check_range("x1", x1, -3.0, 3.0)
         x2 = check_range("x2", x2, -3.0, 3.0)
-        pair = cls(jnp.asarray(m), jnp.asarray(math.radians(a)), jnp.asarray(math.radians(b)),
+        deg = math.pi / 180.0
+        pair = cls(jnp.asarray(m), jnp.asarray(a * deg), jnp.asarray(b * deg),
                    jnp.asarray(x1), jnp.asarray(x2), z1, z2)
-        _check_tooth_form(pair)
+        if not any(is_traced(v) for v in (m, a, b, x1, x2)):
+            _check_tooth_form(pair)      # concrete values only (traced ones pass through)
         return pair
 
 

@@ -49,12 +49,14 @@ import numpy as np
 from gearjax.errors import check_range
 from gearjax.gears.involute.geometry import InvolutePair, generated_flank, pair_geometry
 from gearjax.surfaces import GeneratedSurface
+from gearjax.tca_result import TCAResult, check_side, contact_kinematics, register_family
 from gearjax.tca import (DEFAULT_APPROACH, Assembly, ContactPath, Misalignment, MultiPair,
                   contact_path, multi_pair, check_on_flank_converged, check_tca_options)
 
 __all__ = ["InvoluteTCA", "crowned_pinion_flank", "involute_assembly", "involute_tca_traced",
-           "involute_tca", "involute_margin", "tca_summary", "SUMMARY_KEYS",
-           "misalignment_sensitivity", "check_on_flank_converged", "involute_limits"]
+           "involute_tca", "involute_margin", "tca_summary", "SUMMARY_KEYS", "reference_guess",
+           "misalignment_sensitivity", "check_on_flank_converged", "involute_limits",
+           "involute_result_traced"]
 
 
 @jax.tree_util.register_dataclass
@@ -77,13 +79,13 @@ class InvoluteTCA:
     @classmethod
     def create(cls, pair: InvolutePair, face_width, dalpha_deg=0.0, profile_crown=0.0,
                lead_crown=0.0):
-        """Validated constructor (degrees for ``dalpha_deg``)."""
-        import math
+        """Validated constructor (degrees for ``dalpha_deg``); traced values (inside
+        ``jax.grad``) pass through unchecked."""
         b = check_range("face_width", face_width, 0.0, None, lo_open=True, unit="mm")
         da = check_range("dalpha", dalpha_deg, -5.0, 5.0, unit="deg")
         a = check_range("profile_crown", profile_crown, 0.0, 0.1, unit="1/mm")
         c = check_range("lead_crown", lead_crown, 0.0, 0.1, unit="1/mm")
-        return cls(pair, jnp.asarray(math.radians(da)), jnp.asarray(a), jnp.asarray(c),
+        return cls(pair, jnp.asarray(da * (np.pi / 180.0)), jnp.asarray(a), jnp.asarray(c),
                    jnp.asarray(b))
 
 
@@ -142,7 +144,7 @@ def involute_margin(des: InvoluteTCA, path: ContactPath):
     return jnp.min(parts, axis=0), parts
 
 
-def _reference_guess(des: InvoluteTCA, side: int):
+def reference_guess(des: InvoluteTCA, side: int):
     """Initial guess (u1, v1, u2, v2, phi2) and phi1 near the pitch-point contact.
 
     From the rack geometry: a rack point at profile coordinate u is at height
@@ -174,7 +176,10 @@ def _reference_guess(des: InvoluteTCA, side: int):
     phi1 = jnp.arctan2(C[1], C[0]) - jnp.arctan2(q1[1], q1[0])
     phi2 = jnp.arctan2(C[1] - geo["a_w"], C[0]) - jnp.arctan2(q2[1], q2[0])
     x = jnp.stack([u1, v1, u2, v2, phi2])
-    return jax.lax.stop_gradient(x), jax.lax.stop_gradient(phi1), geo["alpha_wt_converged"]
+    # the guess x only starts Newton (no derivative needed); phi1 centres the grid of
+    # pinion angles, so it carries its derivative: the TCA is then a differentiable
+    # function of the design on a grid that moves with it (as finite differences see it)
+    return jax.lax.stop_gradient(x), phi1, geo["alpha_wt_converged"]
 
 
 def involute_tca_traced(des: InvoluteTCA, mis: Misalignment, *, side: int = -1,
@@ -188,7 +193,7 @@ def involute_tca_traced(des: InvoluteTCA, mis: Misalignment, *, side: int = -1,
     (``2 round(half_pitches steps_per_pitch) + 1`` positions).
     """
     p = des.pair
-    x_ref, phi1_ref, ok = _reference_guess(des, side)
+    x_ref, phi1_ref, ok = reference_guess(des, side)
     h = 2.0 * np.pi / (p.z1 * steps_per_pitch)
     k = int(round(half_pitches * steps_per_pitch))
     grid = phi1_ref + h * jnp.arange(-k, k + 1, dtype=float)
@@ -222,8 +227,7 @@ def involute_tca(des: InvoluteTCA, mis: Misalignment | None = None, *, side: int
     contact solve failed at a grid point between the first and last on-flank points
     of the pair (or at the reference); ``strict=False`` returns the masks.
     """
-    if side not in (-1, 1):
-        raise ValueError(f"side = {side!r} must be -1 (drive) or +1 (coast)")
+    side = _side_code(check_side(side))      # "drive"/"coast" (or the former -1/+1)
     check_tca_options(steps_per_pitch, half_pitches, n_pairs, approach)
     if mis is None:
         mis = Misalignment.zero()
@@ -279,6 +283,7 @@ def misalignment_sensitivity(des: InvoluteTCA, mis: Misalignment | None = None, 
     dalpha, profile_crown, lead_crown; and the pair's fields).
     Exact (implicit-function-theorem) derivatives through every contact solve.
     """
+    side = _side_code(check_side(side))
     if mis is None:
         mis = Misalignment.zero()
     if line_contact is None:
@@ -299,3 +304,89 @@ def involute_limits(des: InvoluteTCA, side: int = -1) -> dict:
     rf1 = _form_radius(p.module, p.pressure_angle + des.dalpha, p.helix, p.x1, p.z1)
     return dict(face_half=0.5 * float(des.face_width), root_radius=float(rf1),
                 tip_radius=float(geo["ra1"]))
+
+
+# -- the common TCA interface (gearjax.tca_result) --------------------------------------
+
+def _side_code(side: str) -> int:
+    return -1 if side == "drive" else 1
+
+
+def involute_result_traced(des: InvoluteTCA, mis: Misalignment, *, side: str = "drive",
+                           steps_per_pitch: int = 24, half_pitches: float = 1.25,
+                           line_contact: bool = True, n_pairs: int = 3,
+                           approach=DEFAULT_APPROACH, kinematics: bool = True) -> TCAResult:
+    """:func:`involute_tca_traced` as a :class:`~gearjax.tca_result.TCAResult` with the
+    kinematics at the contact points (traceable; ``side`` "drive"/"coast")."""
+    code = _side_code(side)
+    path, margin, multi = involute_tca_traced(des, mis, side=code, steps_per_pitch=steps_per_pitch,
+                                              half_pitches=half_pitches, line_contact=line_contact,
+                                              n_pairs=n_pairs, approach=approach)
+    _, parts = involute_margin(des, path)
+    kin = None
+    if kinematics:
+        p = des.pair
+        r1 = crowned_pinion_flank(des, code)
+        r2 = generated_flank(p.module, p.pressure_angle, -p.helix, p.x2, p.z2, code)
+        kin = contact_kinematics(r1, r2, involute_assembly(p), mis, path,
+                                 line_contact=line_contact)
+    return TCAResult(path, margin, multi, {"margin_parts": parts}, kin, side, "involute")
+
+
+@partial(jax.jit, static_argnames=("side", "steps_per_pitch", "half_pitches", "line_contact",
+                                   "n_pairs", "kinematics"))
+def _result_jit(des, mis, approach, *, side, steps_per_pitch, half_pitches, line_contact,
+                n_pairs, kinematics):
+    return involute_result_traced(des, mis, side=side, steps_per_pitch=steps_per_pitch,
+                                  half_pitches=half_pitches, line_contact=line_contact,
+                                  n_pairs=n_pairs, approach=approach, kinematics=kinematics)
+
+
+class _Adapter:
+    """The involute family behind :func:`gearjax.run_tca` (see
+    :func:`gearjax.tca_result.register_family`)."""
+
+    family = "involute"
+    defaults = dict(steps_per_pitch=24, half_pitches=1.25, n_pairs=3)
+
+    @staticmethod
+    def _options(des, line_contact):
+        return float(des.lead_crown) == 0.0 if line_contact is None else bool(line_contact)
+
+    def run(self, des, mis=None, *, side="drive", steps_per_pitch=24, half_pitches=1.25,
+            n_pairs=3, line_contact=None, approach=DEFAULT_APPROACH, kinematics=True,
+            strict=True):
+        side = check_side(side)
+        check_tca_options(steps_per_pitch, half_pitches, n_pairs, approach)
+        mis = Misalignment.zero() if mis is None else mis
+        res = _result_jit(des, mis, float(approach), side=side,
+                          steps_per_pitch=int(steps_per_pitch), half_pitches=float(half_pitches),
+                          line_contact=self._options(des, line_contact), n_pairs=int(n_pairs),
+                          kinematics=bool(kinematics))
+        if strict:
+            check_on_flank_converged(res.path, res.margin)
+        return res
+
+    def traced(self, des, *, side="drive", steps_per_pitch=24, half_pitches=1.25, n_pairs=3,
+               line_contact=None, approach=DEFAULT_APPROACH, kinematics=True):
+        side = check_side(side)
+        check_tca_options(steps_per_pitch, half_pitches, n_pairs, approach)
+        lc = self._options(des, line_contact)
+
+        def f(d, mis=None):
+            mis = Misalignment.zero() if mis is None else mis
+            return involute_result_traced(d, mis, side=side, steps_per_pitch=int(steps_per_pitch),
+                                          half_pitches=float(half_pitches), line_contact=lc,
+                                          n_pairs=int(n_pairs), approach=approach,
+                                          kinematics=kinematics)
+        return f
+
+    def sensitivity(self, des, mis=None, *, side="drive", steps_per_pitch=24,
+                    half_pitches=1.25, line_contact=None, **_):
+        values, table, _ = misalignment_sensitivity(
+            des, mis, side=_side_code(check_side(side)), steps_per_pitch=steps_per_pitch,
+            half_pitches=half_pitches, line_contact=line_contact)
+        return values, table
+
+
+register_family(InvoluteTCA, _Adapter())

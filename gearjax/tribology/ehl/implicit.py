@@ -51,7 +51,7 @@ def _fwd(x_star, case, grid, angle_deg, mixed):
 
 
 def _bwd(grid, angle_deg, mixed, res, g):
-    from gearjax.tribology.ehl.solver import _precond   # circular import guard
+    from gearjax.tribology.ehl.solver import precondition_operator   # circular import guard
 
     x, case = res
     sc = scales(case)
@@ -59,7 +59,7 @@ def _bwd(grid, angle_deg, mixed, res, g):
     f_x = lambda v: residual_core(v, case, sc, khat, grid, angle_deg, mixed)
     R, vjp_x = jax.vjp(f_x, x)
     JT = lambda v: vjp_x(v)[0]
-    _, M_T = _precond(x, case, grid, angle_deg, mixed, R, sc)
+    _, M_T = precondition_operator(x, case, grid, angle_deg, mixed, R, sc)
     lam, _ = gmres(JT, g, M=M_T, tol=ADJOINT_TOL, restart=60, maxiter=20)
     _, vjp_c = jax.vjp(lambda c: residual(x, c, grid, angle_deg, mixed), case)
     (case_bar,) = vjp_c(-lam)

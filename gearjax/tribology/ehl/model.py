@@ -41,7 +41,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax.contact import _hertz_exact
+from gearjax.contact import hertz_exact
 from gearjax.errors import check_positive, check_range
 from gearjax.tribology.asperity import gt_coefficient, log_F_n
 from gearjax.tribology.ehl.grid import EHLGrid, deformation, influence_kernel
@@ -133,7 +133,7 @@ class Scales(NamedTuple):
 
 def scales(case: EHLCase) -> Scales:
     """Hertz solution and dimensionless groups of ``case``."""
-    hz = _hertz_exact(case.F, case.Rx, case.Ry, case.E_prime)
+    hz = hertz_exact(case.F, case.Rx, case.Ry, case.E_prime)
     a, b, p_h = hz.a, hz.b, hz.p_max
     lam = 12.0 * case.eta0 * PA_S_TO_MPA_S * case.u_e * case.Rx ** 2 / (b ** 3 * p_h)
     c_w = 2.0 * p_h * case.Rx / (jnp.pi * case.E_prime * b)
@@ -156,7 +156,7 @@ class Fields(NamedTuple):
     eps: jax.Array
 
 
-_H_FLOOR = 1e-9
+H_FLOOR = 1e-9
 
 
 def fluid_props(P, sc: Scales):
@@ -182,7 +182,7 @@ def fields(P, H0, P_a, case: EHLCase, sc: Scales, grid: EHLGrid, khat) -> Fields
     X, Y = (jnp.asarray(v) for v in grid.nodes())
     H = H0 + 0.5 * X * X + 0.5 * sc.g_y * Y * Y + sc.c_w * deformation(P + P_a, khat, grid)
     eta, rho = fluid_props(P, sc)
-    Hf = jnp.maximum(H, _H_FLOOR)
+    Hf = jnp.maximum(H, H_FLOOR)
     eps = rho * Hf ** 3 / (eta * sc.lam)
     return Fields(H, P_a, eta, rho, eps)
 
@@ -199,7 +199,7 @@ def reynolds_operator(P, fl: Fields, sc: Scales, grid: EHLGrid, angle_deg: float
     c, s = np.cos(np.radians(angle_deg)), np.sin(np.radians(angle_deg))
     Pp = _pad(P, "zero")
     ep = _pad(fl.eps, "edge")
-    q = _pad(fl.rho * jnp.maximum(fl.H, _H_FLOOR), "edge")
+    q = _pad(fl.rho * jnp.maximum(fl.H, H_FLOOR), "edge")
     Pc, ec = Pp[1:-1, 1:-1], ep[1:-1, 1:-1]
     e_e = 0.5 * (ec + ep[1:-1, 2:])
     e_w = 0.5 * (ec + ep[1:-1, :-2])

@@ -29,7 +29,7 @@ import numpy as np
 from gearjax.tribology.ehl.grid import EHLGrid, deformation, influence_kernel
 from gearjax.tribology.ehl.model import (EHLCase, asperity_P, fields, fluid_props,
                                          kernel_hat, reynolds_operator, residual_core,
-                                         row_scale, scales, unpack, _H_FLOOR)
+                                         row_scale, scales, unpack, H_FLOOR)
 from gearjax.tribology.ehl.krylov import gmres
 from gearjax.tribology.ehl.precondition import build_preconditioner
 from gearjax.tribology.film import hamrock_dowson
@@ -68,7 +68,7 @@ def initial_guess(case: EHLCase, grid: EHLGrid, mixed: bool):
     return jnp.concatenate(parts)
 
 
-def _precond(x, case, grid, angle_deg, mixed, R, sc=None):
+def precondition_operator(x, case, grid, angle_deg, mixed, R, sc=None):
     sc = scales(case) if sc is None else sc
     kernel = influence_kernel(grid, sc.k)
     khat = jnp.fft.rfft2(kernel)
@@ -108,7 +108,7 @@ def newton_krylov(x0, case: EHLCase, grid: EHLGrid, angle_deg: float = 0.0, mixe
 
     def body(st):
         x, R, k, _ = st
-        M, _ = _precond(x, case, grid, angle_deg, mixed, R, sc)
+        M, _ = precondition_operator(x, case, grid, angle_deg, mixed, R, sc)
         Jv = lambda v: jax.jvp(f, (x,), (v,))[1]
         dx, _ = gmres(Jv, -R, M=M, tol=lin_tol, restart=restart, maxiter=maxiter)
         m0 = merit(R)
@@ -139,7 +139,7 @@ def newton_krylov(x0, case: EHLCase, grid: EHLGrid, angle_deg: float = 0.0, mixe
     # continuation) is not a solution
     P, P_a, H0 = unpack(x, grid, mixed)
     H = fields(P, H0, P_a, case, sc, grid, khat).H
-    film_ok = jnp.min(H) > 10.0 * _H_FLOOR
+    film_ok = jnp.min(H) > 10.0 * H_FLOOR
     conv = jnp.isfinite(res) & (res <= tol) & film_ok
     return SolverState(x, res, jnp.abs(R[-1]), k, conv)
 

@@ -1,0 +1,56 @@
+"""Continuous fields of a design pytree by dotted name.
+
+A design (for example a :class:`~gearjax.gears.hypoid.pair.HypoidPair`, an
+:class:`~gearjax.gears.involute.tca.InvoluteTCA` or a
+:class:`~gearjax.tca.Misalignment`) is a pytree whose array leaves are its continuous
+fields.  These helpers name them by their path (``"pinion.machine.modified_roll_2c"``,
+``"pair.x1"``) so that a sensitivity study, a finite-difference check or an
+optimiser can pick the fields it varies and put new values back, without writing a
+``dataclasses.replace`` chain per field.  Pure and traceable: values may be tracers.
+"""
+
+from __future__ import annotations
+
+import jax
+
+__all__ = ["field_names", "get_fields", "with_fields"]
+
+
+def _name(path) -> str:
+    parts = []
+    for k in path:
+        for attr in ("name", "key", "idx"):
+            if hasattr(k, attr):
+                parts.append(str(getattr(k, attr)))
+                break
+        else:
+            parts.append(str(k))
+    return ".".join(parts)
+
+
+def field_names(tree) -> list[str]:
+    """Dotted names of the array leaves of ``tree``, in leaf order."""
+    return [_name(p) for p, _ in jax.tree_util.tree_flatten_with_path(tree)[0]]
+
+
+def get_fields(tree, names=None) -> dict:
+    """``{name: leaf}`` for ``names`` (default: every leaf); KeyError naming unknown ones."""
+    flat = {_name(p): leaf for p, leaf in jax.tree_util.tree_flatten_with_path(tree)[0]}
+    if names is None:
+        return flat
+    unknown = [n for n in names if n not in flat]
+    if unknown:
+        raise KeyError(f"unknown field(s) {unknown} (known: {', '.join(flat)})")
+    return {n: flat[n] for n in names}
+
+
+def with_fields(tree, values: dict):
+    """``tree`` with the leaves named in ``values`` replaced (same structure and static
+    fields); KeyError naming an unknown field."""
+    flat, treedef = jax.tree_util.tree_flatten_with_path(tree)
+    names = [_name(p) for p, _ in flat]
+    unknown = set(values) - set(names)
+    if unknown:
+        raise KeyError(f"unknown field(s) {sorted(unknown)} (known: {', '.join(names)})")
+    return jax.tree_util.tree_unflatten(treedef, [values.get(n, leaf)
+                                                  for n, (_, leaf) in zip(names, flat)])

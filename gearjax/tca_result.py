@@ -1,0 +1,322 @@
+"""The one result type of tooth contact analysis, shared by every gear family, and
+the kinematics at its contact points.
+
+:class:`TCAResult` is a pytree (``jax.grad`` and ``jit`` pass through it) holding
+
+* ``path`` -- :class:`~gearjax.tca.ContactPath` of tooth pair 0 on the grid of
+  pinion angles: TE (rad), the contact point on both flanks (body frames and
+  fixed frame), the contact ellipses, residuals and converged flags;
+* ``margin`` -- (N,) distance of the contact from the nearest flank boundary of
+  either member (mm, >= 0 on both working flanks);
+* ``multi`` -- :class:`~gearjax.tca.MultiPair`: TE of the neighbouring pairs, the
+  unloaded TE envelope, its peak-to-peak, the transfer points, the contact ratio;
+* ``coords`` -- family-specific coordinates of the contact on the flanks (hypoid:
+  ``xi1, h1, xi2, h2``; involute: roll distance and axial position), a dict;
+* ``kinematics`` -- :class:`ContactKinematics` at every point of the path, or
+  ``None`` when not requested;
+* ``side`` (static) -- ``"drive"`` or ``"coast"``, the one side convention of
+  every family; ``family`` (static) -- ``"involute"`` or ``"hypoid"``.
+
+:meth:`TCAResult.flags` gives the contact-quality flags on concrete results
+(converged, reference on the flank, edge contact, contact ratio below 1).
+
+**Kinematics at the contact points** (:func:`contact_kinematics`).  Pinion =
+member 1 turning at 1 rad/s about its body z axis, gear = member 2 turning at the
+*actual* speed ``dphi2/dphi1`` (implicit derivative of the contact equations,
+``dx/dphi1 = -F_x^-1 F_phi1``) about its mounted axis.  The contact point moves
+with ``v_c = dr/dphi1``.  Surface velocities relative to the moving contact point,
+projected on the tangent plane: ``w_i = P (omega_i x (r - a_i) - v_c)``.  The
+*rolling direction* ``t`` is across the contact ellipse (``t = +-n x e_major``; for
+line contact: across the contact line), the direction of the line-contact EHL
+theory, oriented along the entrainment (``u_e >= 0``); along ``t``::
+
+    u1 = w1 . t,   u2 = w2 . t,   u_e = (u1 + u2)/2,   u_s = u1 - u2,   SRR = u_s/u_e
+
+(mm/s per rad/s of pinion speed) plus the side-slip ``u_s_side = (w1 - w2) . e_major``
+and the angle of the entrainment vector ``(w1 + w2)/2`` from ``t``.  Curvature:
+the relative curvature tensor ``B`` of the two flanks (:func:`~gearjax.tca.
+relative_curvature`, oriented so that its trace is >= 0), ``R_x = 1/(t.B.t)``
+across the ellipse (the effective radius of the EHL theory) and
+``R_y = 1/(e_major.B.e_major)`` along it (``inf`` for line contact).  For a line
+contact the velocity of the contact point along the contact line is arbitrary; the
+components along ``t`` do not depend on it.
+
+References (docs/references.md): [Litvin2004] ch. 8-9 (relative velocity, contact
+point velocity, induced curvature); [Eigenfunctions] section 1 (u1, u2, u_e, u_s,
+SRR, K_II, R_eff); [HamrockDowson1977] (R_x, R_y of the elliptic EHL contact).
+Units: mm, rad, mm/s per rad/s.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+from typing import Callable, NamedTuple
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from gearjax.frames import matrix_z
+from gearjax.surfaces import local_geometry
+from gearjax.tca import (Assembly, ContactPath, Misalignment, MultiPair, contact_equations,
+                         gear_mount, relative_curvature)
+
+__all__ = ["SIDES", "check_side", "TCAResult", "ContactKinematics", "contact_kinematics",
+           "contact_motion",
+           "register_family", "family_of"]
+
+#: the side convention of every family: the flank pair that transmits the load in
+#: the normal sense of rotation ("drive") or in reverse ("coast")
+SIDES = ("drive", "coast")
+_SIDE_ALIASES = {-1: "drive", 1: "coast"}   # former involute convention (side = -1/+1)
+
+
+def check_side(side) -> str:
+    """``"drive"``/``"coast"``; the former involute codes -1 (drive) and +1 (coast) are
+    accepted.  ValueError naming the allowed values otherwise."""
+    if isinstance(side, str) and side in SIDES:
+        return side
+    if not isinstance(side, (bool, str)) and side in _SIDE_ALIASES:
+        return _SIDE_ALIASES[side]
+    raise ValueError(f"side = {side!r} must be 'drive' or 'coast'")
+
+
+_SAME_TE = 1e-9   # rad (2e-4 arc-seconds): TE curves that coincide
+
+
+class ContactKinematics(NamedTuple):
+    """Rolling, sliding and curvature at every point of a TCA path (module docstring).
+
+    u1, u2 : surface velocities of pinion and gear relative to the contact point
+        along the rolling direction ``t`` (mm/s per rad/s of pinion speed).
+    u_e, u_s, srr : entrainment ``(u1 + u2)/2``, sliding ``u1 - u2``, slide-to-roll
+        ratio ``u_s/u_e`` (pinion = member 1).
+    u_s_side : sliding along the major axis of the ellipse (mm/s per rad/s).
+    entrainment_angle : angle of the entrainment vector from ``t`` (rad).
+    r_x, r_y : effective radii across and along the contact ellipse (mm; ``r_y`` is
+        ``inf`` for line contact); ``r_eff = r_x``.
+    rolling_dir : (N, 3) unit ``t`` (fixed frame).  v_contact : (N, 3) ``dr/dphi1``.
+    gear_ratio : actual ``dphi2/dphi1``.
+    """
+
+    u1: jax.Array
+    u2: jax.Array
+    u_e: jax.Array
+    u_s: jax.Array
+    srr: jax.Array
+    u_s_side: jax.Array
+    entrainment_angle: jax.Array
+    r_x: jax.Array
+    r_y: jax.Array
+    rolling_dir: jax.Array
+    v_contact: jax.Array
+    gear_ratio: jax.Array
+
+    @property
+    def r_eff(self):
+        return self.r_x
+
+
+def contact_motion(r1: Callable, r2: Callable, asm: Assembly, mis: Misalignment,
+                   line_contact: bool, v1_fixed):
+    """``motion(uv1, uv2, phi2, phi1, n) -> (r, v_c, dphi2, W1, W2)`` at one contact
+    point (traceable): the contact point ``r`` (fixed frame), its velocity
+    ``v_c = dr/dphi1`` and the gear speed ``dphi2/dphi1`` from the implicit derivative
+    of the contact equations (``dx/dphi1 = -F_x^-1 F_phi1``), and both flanks'
+    Weingarten maps in the fixed frame for the common normal ``n``.  Also returns the
+    gear mount ``(R, c)``."""
+    R, c = gear_mount(asm, mis)
+    ez = jnp.array([0.0, 0.0, 1.0])
+    F, unpack, pack = contact_equations(r1, r2, asm, mis, line_contact, v1_fixed)
+
+    def point(x, ph1):
+        uv1, _, _ = unpack(x)
+        return matrix_z(ph1) @ r1(uv1) + mis.dP * ez
+
+    def motion(uv1, uv2, ph2, ph1, n):
+        x = pack(jnp.concatenate([uv1, uv2, jnp.stack([ph2])]))
+        Fx = jax.jacfwd(F, 0)(x, ph1)
+        Fp = jax.jacfwd(F, 1)(x, ph1)
+        dx = -jnp.linalg.solve(Fx, Fp)
+        r, v_c = jax.jvp(point, (x, ph1), (dx, jnp.ones_like(ph1)))
+        R1, R2 = matrix_z(ph1), R @ matrix_z(ph2)
+        g1, g2 = local_geometry(r1, uv1), local_geometry(r2, uv2)
+        W1 = jnp.sign(jnp.dot(R1 @ g1.n, n)) * (R1 @ g1.W @ R1.T)
+        W2 = jnp.sign(jnp.dot(R2 @ g2.n, n)) * (R2 @ g2.W @ R2.T)
+        return r, v_c, dx[-1], W1, W2
+
+    return motion, (R, c)
+
+
+def contact_kinematics(r1: Callable, r2: Callable, asm: Assembly, mis: Misalignment,
+                       path: ContactPath, *, line_contact: bool) -> ContactKinematics:
+    """:class:`ContactKinematics` at every point of ``path`` (traceable; module docstring).
+
+    ``r1, r2, asm, mis, line_contact`` must be those the path was solved with.  Points
+    where the path did not converge give meaningless values: mask them with
+    ``path.converged``.
+    """
+    mid = path.phi1.shape[0] // 2
+    motion, (R, c) = contact_motion(r1, r2, asm, mis, line_contact,
+                                    jax.lax.stop_gradient(path.uv1[mid, 1]))
+    k2 = R[:, 2]
+    ez = jnp.array([0.0, 0.0, 1.0])
+
+    def one(uv1, uv2, ph2, ph1, n, major):
+        r, v_c, dph2, W1, W2 = motion(uv1, uv2, ph2, ph1, n)
+        e = major - jnp.dot(major, n) * n
+        e = e / jnp.linalg.norm(e)
+        t = jnp.cross(n, e)
+
+        def tangential(v):
+            return v - jnp.dot(v, n) * n
+
+        w1 = tangential(jnp.cross(ez, r) - v_c)
+        w2 = tangential(jnp.cross(dph2 * k2, r - c) - v_c)
+        # orient t along the entrainment (u_e >= 0): the rolling direction
+        t = jnp.where(jnp.dot(w1 + w2, t) < 0.0, -t, t)
+        u1, u2 = jnp.dot(w1, t), jnp.dot(w2, t)
+        we = 0.5 * (w1 + w2)
+        B, A = relative_curvature(n, W1, W2, t)     # A[:, 0] = t, A[:, 1] = n x t
+        B = jnp.where(B[0, 0] + B[1, 1] < 0.0, -B, B)
+        kx, ky = B[0, 0], B[1, 1]
+        r_y = jnp.where(ky > 1e-12, 1.0 / jnp.where(ky > 1e-12, ky, 1.0), jnp.inf)
+        u_e = 0.5 * (u1 + u2)
+        return (u1, u2, u_e, u1 - u2, (u1 - u2) / u_e, jnp.dot(w1 - w2, A[:, 1]),
+                jnp.arctan2(jnp.dot(we, A[:, 1]), jnp.dot(we, t)), 1.0 / kx, r_y, t, v_c,
+                dph2)
+
+    out = jax.vmap(one)(path.uv1, path.uv2, path.phi2, path.phi1, path.normal, path.major_dir)
+    return ContactKinematics(*out)
+
+
+@functools.partial(jax.tree_util.register_dataclass,
+                   data_fields=["path", "margin", "multi", "coords", "kinematics"],
+                   meta_fields=["side", "family"])
+@dataclass(frozen=True)
+class TCAResult:
+    """Result of tooth contact analysis of any family (module docstring; a pytree)."""
+
+    path: ContactPath
+    margin: jax.Array
+    multi: MultiPair
+    coords: dict
+    kinematics: ContactKinematics | None = None
+    side: str = "drive"
+    family: str = ""
+
+    # -- the quantities users ask for first ------------------------------------------
+    @property
+    def te(self):
+        """TE of tooth pair 0 on the grid (rad)."""
+        return self.path.te
+
+    @property
+    def phi1(self):
+        return self.path.phi1
+
+    @property
+    def envelope(self):
+        return self.multi.envelope
+
+    @property
+    def ptp(self):
+        """Peak-to-peak of the unloaded TE envelope over one pitch (rad)."""
+        return self.multi.ptp
+
+    @property
+    def transfer_phi1(self):
+        return self.multi.transfer_phi1
+
+    @property
+    def contact_ratio(self):
+        return self.multi.contact_ratio
+
+    @property
+    def on_flank(self):
+        """(N,) pair 0 converged and inside both flank boundaries."""
+        return (self.margin >= 0.0) & self.path.converged
+
+    def flags(self) -> dict:
+        """Contact-quality flags of a concrete result (Python bools).
+
+        converged : every contact solve between the first and last on-flank grid
+            points converged (and the reference did).
+        reference_on_flank : the reference (middle) contact lies inside both flanks.
+        edge_contact : the unloaded TE envelope hands over from one tooth pair to the
+            next where a pair runs off its flank (its contact reaches a flank boundary
+            while it still carries the load) instead of where the TE curves of the
+            two pairs cross -- the load is then carried at the edge of a tooth.  Pairs
+            whose TE curves coincide (conjugate pairs) touch simultaneously and are
+            not flagged.
+        low_contact_ratio : contact ratio below 1 (or not found): gaps in the
+            envelope, the motion is not transmitted continuously.
+        """
+        conv = np.asarray(self.path.converged)
+        on = np.asarray(self.on_flank)
+        idx = np.nonzero(on)[0]
+        ok = bool(conv[conv.shape[0] // 2]) and (
+            idx.size > 0 and bool(np.all(conv[idx[0]:idx[-1] + 1])))
+        inside = np.asarray(self.multi.inside)
+        te = np.asarray(self.multi.te_pairs)
+        k0 = inside.shape[0] // 2
+        phi = np.asarray(self.path.phi1)
+        edge = False
+        for t_phi, (a, b) in zip(np.asarray(self.multi.transfer_phi1), ((k0 - 1, k0), (k0, k0 + 1))):
+            if not np.isfinite(t_phi):
+                edge = True
+                continue
+            i = int(np.clip(np.searchsorted(phi, t_phi) - 1, 0, phi.shape[0] - 2))
+            sl = slice(i, i + 2)
+            both = inside[a, sl] & inside[b, sl]
+            crossing = bool(both.all())
+            # coincident TE curves (a conjugate pair): both pairs touch at once, the
+            # hand-over point is arbitrary and no pair carries the load alone
+            with np.errstate(invalid="ignore"):
+                same = both & (np.abs(te[a, sl] - te[b, sl]) < _SAME_TE)
+            edge = edge or not (crossing or bool(same.any()))
+        cr = float(self.multi.contact_ratio)
+        return dict(converged=ok, reference_on_flank=bool(on[on.shape[0] // 2]),
+                    edge_contact=bool(edge), low_contact_ratio=not (np.isfinite(cr) and cr >= 1.0))
+
+    def warnings(self) -> list[str]:
+        """Human-readable warnings for the flags that are raised (empty if none)."""
+        f = self.flags()
+        out = []
+        if not f["converged"]:
+            out.append("a contact solve did not converge on the working flank")
+        if not f["reference_on_flank"]:
+            out.append("the reference contact lies outside a flank boundary (off-flank)")
+        if f["edge_contact"]:
+            out.append("edge contact: a tooth pair carries the load up to a flank boundary")
+        if f["low_contact_ratio"]:
+            out.append(f"contact ratio {float(self.multi.contact_ratio):.3f} below 1")
+        return out
+
+
+# -- the family registry behind the one TCA entry point ---------------------------------
+
+_FAMILIES: dict[type, object] = {}
+
+
+def register_family(design_type: type, adapter) -> None:
+    """Register the TCA adapter of a gear family for designs of ``design_type``.
+
+    ``adapter`` provides ``family`` (str), ``run(design, mis, *, side, **options) ->
+    TCAResult`` (validated, jitted, concrete), ``traced(design, *, side, **options)
+    -> f(design, mis) -> TCAResult`` (a pure function for ``jax.grad``/``jit``, the
+    concrete set-up -- reference guess, hand, sense of rotation -- done once here)
+    and ``sensitivity(design, mis, *, side, **options) -> (values, table)``.
+    """
+    _FAMILIES[design_type] = adapter
+
+
+def family_of(design):
+    """The registered adapter for ``design`` (TypeError naming the known types)."""
+    for typ, ad in _FAMILIES.items():
+        if isinstance(design, typ):
+            return ad
+    known = ", ".join(t.__name__ for t in _FAMILIES) or "none registered"
+    raise TypeError(f"no tooth contact analysis for a {type(design).__name__} "
+                    f"(known designs: {known}; import gearjax to register the families)")

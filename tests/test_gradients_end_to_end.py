@@ -1,0 +1,155 @@
+"""Gradients through the whole chain -- design field -> flanks -> TCA -> kinematics at
+the contact points -> objective -- by autodiff against fourth-order central
+differences, on the involute, spiral-bevel and hypoid examples, through the public
+API only (``gj.tca_function``, ``gj.with_fields``).
+
+Objectives: TE peak-to-peak (arcsec), mean and max |SRR| and min R_x over the
+on-flank points of the nominal design (a fixed mask), and the contact position at
+the reference (hypoid: face-width position xi1; involute: radius on the pinion).
+Steps ``h = 1e-4 |x|`` (1e-6 |x| on the bevel and hypoid examples; 1e-5 for a field at 0); tolerance 1e-6 relative plus the
+round-off of the difference quotient (the
+measured errors are listed in the closing note of the change and in
+``experiments/end_to_end_gradients.py``'s output).  A planted slip anywhere on the
+chain -- a derivative dropped by a ``stop_gradient`` or a ``float()``, a wrong sign
+in the implicit derivative of a solve, a grid that moves with the design without
+its derivative -- shows as an O(1) or O(h) relative error.
+"""
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+import gearjax as gj
+
+TOL = 1e-6
+
+
+def _objectives(f, design, mis, position):
+    nominal = f(design, mis)
+    on = np.asarray(nominal.on_flank)
+    assert on.sum() >= 3
+    mid = on.shape[0] // 2
+
+    def g(values):
+        des = gj.with_fields(design, {k: v for k, v in values.items() if not k.startswith("mis.")})
+        m = gj.with_fields(mis, {k[4:]: v for k, v in values.items() if k.startswith("mis.")})
+        res = f(des, m)
+        k = res.kinematics
+        srr = jnp.abs(jnp.where(on, k.srr, 0.0))
+        return jnp.stack([res.multi.ptp / gj.ARCSEC, jnp.sum(srr) / on.sum(), jnp.max(srr),
+                          jnp.min(jnp.where(on, k.r_x, jnp.inf)), position(res, mid)])
+    return g
+
+
+def _check(f, design, fields, position, mis=None, rel_step=1e-4):
+    mis = gj.Misalignment.zero() if mis is None else mis
+    g = jax.jit(_objectives(f, design, mis, position))
+    allf = {**gj.get_fields(design), **{"mis." + k: v for k, v in gj.get_fields(mis).items()}}
+    x0 = {k: jnp.asarray(allf[k], float) for k in fields}
+    base = np.asarray(g(x0))
+    assert np.all(np.isfinite(base))
+    jac = jax.jit(jax.jacfwd(g))(x0)
+    errs = {}
+    for k in fields:
+        x = abs(float(x0[k]))
+        h = rel_step * x if x > 0.0 else 1e-5
+        ev = {j: np.asarray(g({**x0, k: x0[k] + j * h})) for j in (-2, -1, 1, 2)}
+        fd = (8.0 * (ev[1] - ev[-1]) - (ev[2] - ev[-2])) / (12.0 * h)
+        ad = np.asarray(jac[k])
+        assert np.all(np.isfinite(ad)), k
+        # 1e-6 relative plus the round-off of the difference quotient: the solve noise
+        # of each objective (TE from gear angles of O(1) rad: ~1e-10 arcsec; the others
+        # ~1e-12 relative) x 10, x the weight sum 18/12 of the formula, over h
+        noise = 1e-12 * (np.abs(base) + 1.0)
+        noise[0] = 1e-9
+        excess = np.abs(ad - fd) - (TOL * np.abs(fd) + 1.5 * noise / h)
+        errs[k] = float(excess.max())
+    assert max(errs.values()) <= 0.0, errs
+    return jac
+
+
+def test_involute_chain():
+    pair = gj.InvolutePair.create(25, 41, 2.0, 20.0, helix_deg=15.0)
+    des = gj.InvoluteTCA.create(pair, 20.0, dalpha_deg=0.02, profile_crown=2e-4, lead_crown=1e-3)
+    f = gj.tca_function(des, side="drive", steps_per_pitch=8)
+    jac = _check(f, des, ["dalpha", "profile_crown", "lead_crown", "pair.x1", "pair.helix",
+                          "mis.dE", "mis.dSigma"],
+                 lambda res, mid: res.path.radial1[mid])
+    # the derivatives are not trivially zero: the crowns move the bearing and the TE
+    assert abs(float(jac["lead_crown"][4])) > 1e-3 and abs(float(jac["profile_crown"][0])) > 1.0
+
+
+@pytest.mark.parametrize("example", ["spiral_bevel_10x30_synthesised",
+                                     "hypoid_iso_10x41_synthesised"])
+def test_bevel_and_hypoid_chain(example):
+    d = gj.load_design(f"example:{example}")
+    f = gj.tca_function(d, side="drive", steps_per_pitch=6, half_pitches=1.5, n_pairs=3)
+    fields = ["pinion.cutter.point_radius", "pinion.cutter.blade_angle",
+              "pinion.machine.modified_roll_2c", "pinion.machine.ratio_of_roll",
+              "gear.machine.radial_distance", "pinion.blank.face_width", "mis.dE"]
+    # the synthesised designs have the same TE at both transfer points: TE peak-to-peak
+    # (a max over two branches) has a kink there and no derivative.  Check at a design
+    # whose ratio of roll is 0.1 % higher: the TE parabola tilts, one branch is the max
+    rr = f.pair.pinion.machine.ratio_of_roll
+    pair = gj.with_fields(f.pair, {"pinion.machine.ratio_of_roll": rr * (1.0 + 1e-3)})
+    # sampled objectives have kinks where the argmax/argmin over the grid switches: on
+    # the hypoid example the TE minimum sits at two samples 0.02 arcsec apart and R_x
+    # passes through its orientation flip ~0.01 mm of point radius away (the path runs
+    # close to the limit line, R_x -> 0).  A stencil that straddles a kink measures
+    # neither branch: steps of 1e-6 relative keep it on one branch (the per-point TE and
+    # R_x derivatives agree to round-off with 1e-4 steps too)
+    jac = _check(f, pair, fields, lambda res, mid: res.coords["xi1"][mid], rel_step=1e-6)
+    assert abs(float(jac["pinion.machine.modified_roll_2c"][0])) > 1.0   # TE p-t-p moves
+
+
+def test_field_helpers_name_and_replace_leaves():
+    mis = gj.Misalignment.create(dE=0.1, dSigma_deg=0.01)
+    assert gj.field_names(mis) == ["dE", "dP", "dG", "dSigma"]
+    m2 = gj.with_fields(mis, {"dP": jnp.asarray(0.3)})
+    assert float(m2.dP) == 0.3 and float(m2.dE) == 0.1
+    assert gj.get_fields(m2, ["dE"]) == {"dE": m2.dE}
+    with pytest.raises(KeyError, match="dX"):
+        gj.with_fields(mis, {"dX": 1.0})
+    with pytest.raises(KeyError, match="dX"):
+        gj.get_fields(mis, ["dX"])
+    pair = gj.InvoluteTCA.create(gj.InvolutePair.create(20, 40, 4.0, 20.0), 30.0)
+    assert "pair.x1" in gj.field_names(pair) and "lead_crown" in gj.field_names(pair)
+
+
+def test_validated_constructors_pass_traced_values_and_check_concrete_ones():
+    """A user's differentiated function may call the validated constructors: traced
+    values pass through (with their derivatives, degrees converted), concrete ones are
+    still checked."""
+    d = jax.grad(lambda e: gj.Misalignment.create(dE=e, dSigma_deg=2.0 * e).dSigma)(0.1)
+    assert abs(float(d) - 2.0 * np.pi / 180.0) < 1e-15
+    g = jax.grad(lambda a: gj.InvolutePair.create(20, 40, 4.0, a, helix_deg=a).helix)(20.0)
+    assert abs(float(g) - np.pi / 180.0) < 1e-15
+    pair = gj.InvolutePair.create(20, 40, 4.0, 20.0)
+    g = jax.grad(lambda c: gj.InvoluteTCA.create(pair, 30.0, lead_crown=c).lead_crown)(1e-3)
+    assert float(g) == 1.0
+    with pytest.raises(ValueError, match="dE = 60"):
+        gj.Misalignment.create(dE=60.0)
+    with pytest.raises(ValueError, match="lead_crown"):
+        gj.InvoluteTCA.create(pair, 30.0, lead_crown=-1.0)
+    with pytest.raises(ValueError, match="x1"):
+        gj.InvolutePair.create(8, 40, 4.0, 20.0, x1=-1.0)      # undercut
+
+
+def test_hypoid_constructors_pass_traced_values():
+    """The design-file constructors of the hypoid family under ``jax.grad``: cutter
+    (degrees -> rad), machine settings, member blank."""
+    g = jax.grad(lambda a: gj.make_cutter(75.0, a, 1.0, "convex").blade_angle)(20.0)
+    assert abs(float(g) - np.pi / 180.0) < 1e-15
+    g = jax.grad(lambda r: gj.MachineSettings.create(radial_distance=r, cradle_angle=0.1,
+                                                     machine_root_angle=0.3,
+                                                     ratio_of_roll=3.0).radial_distance)(70.0)
+    assert float(g) == 1.0
+    from gearjax.gears.hypoid.flank import make_member_blank
+    g = jax.grad(lambda d: make_member_blank(
+        outer_cone_distance=100.0, face_width=30.0, pitch_angle=d, face_angle=d + 2.0,
+        root_angle=d - 3.0, outer_addendum=3.0, outer_dedendum=4.0, mean_spiral_angle=35.0,
+        teeth=30, hand="right").face_angle)(70.0)
+    assert abs(float(g) - np.pi / 180.0) < 1e-15
+    with pytest.raises(ValueError, match="edge_radius"):
+        gj.make_cutter(1.0, 20.0, 2.0, "convex")

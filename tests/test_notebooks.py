@@ -1,0 +1,40 @@
+"""The notebooks run top to bottom without error (executed in a fresh kernel), and the
+quick start's gradient agrees with its central difference."""
+
+import re
+from pathlib import Path
+
+import pytest
+
+nbformat = pytest.importorskip("nbformat", reason="notebook tooling is in the test extra")
+nbclient = pytest.importorskip("nbclient", reason="notebook tooling is in the test extra")
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _run(path, tmp_path):
+    nb = nbformat.read(path, as_version=4)
+    client = nbclient.NotebookClient(nb, timeout=900, kernel_name="python3",
+                                     resources={"metadata": {"path": str(tmp_path)}})
+    client.execute()
+    return nb
+
+
+def _text(nb):
+    out = []
+    for c in nb.cells:
+        for o in c.get("outputs", []):
+            out.append(o.get("text", "") if o.get("output_type") == "stream"
+                       else "".join(o.get("data", {}).get("text/plain", "")))
+    return "\n".join(out)
+
+
+def test_quickstart_runs_and_its_gradient_matches(tmp_path):
+    nb = _run(ROOT / "notebooks" / "01_quickstart.ipynb", tmp_path)
+    text = _text(nb)
+    assert "float64: True" in text
+    m = re.search(r"rel\. error ([0-9.e+-]+)", text)
+    assert m, text[-2000:]
+    assert float(m.group(1)) < 1e-6
+    flags = re.search(r"flags\s+(\{.*\})", text).group(1)
+    assert "'converged': True" in flags

@@ -1,0 +1,151 @@
+"""The common TCA result: side convention, contact-quality flags, kinematics at the
+contact points against the closed form of an involute spur pair, the one entry point."""
+
+import math
+
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+import gearjax as gj
+from gearjax.tca import ContactPath, MultiPair
+from gearjax.tca_result import TCAResult, check_side
+
+Z1, Z2, M, ALPHA, B = 25, 41, 2.0, 20.0, 20.0
+
+
+# -- side convention ----------------------------------------------------------------
+
+def test_side_names_and_former_codes():
+    assert check_side("drive") == "drive" and check_side("coast") == "coast"
+    assert check_side(-1) == "drive" and check_side(1) == "coast"   # former involute codes
+    for bad in ("Drive", 0, 2, True, None, "both"):
+        with pytest.raises(ValueError, match="side"):
+            check_side(bad)
+
+
+def test_unknown_design_type_is_a_type_error():
+    with pytest.raises(TypeError, match="no tooth contact analysis for a dict"):
+        gj.run_tca({"z1": 25})
+
+
+# -- contact-quality flags on hand-made results (each flag raised alone) ----------------
+
+N = 11
+
+
+def _result(margin, te_pairs, inside, transfer, cr, converged=None):
+    z = jnp.zeros(N)
+    z3 = jnp.zeros((N, 3))
+    conv = jnp.ones(N, bool) if converged is None else jnp.asarray(converged)
+    path = ContactPath(jnp.linspace(-1.0, 1.0, N), z, z, jnp.zeros((N, 2)), jnp.zeros((N, 2)),
+                       z3, z3, z3, z3, z, z, z, z, z + 1.0, z + 0.5, z3, z, conv)
+    multi = MultiPair(jnp.asarray(te_pairs), jnp.asarray(inside), z, jnp.zeros(N, int),
+                      jnp.asarray(0.0), jnp.asarray(transfer), jnp.asarray(cr))
+    return TCAResult(path, jnp.asarray(margin), multi, {}, None, "drive", "test")
+
+
+def _crossing_case():
+    # pair 0 on the flank everywhere, pairs -1/+1 as well; TE curves cross at
+    # phi = -0.5 and +0.5 (grid step 0.2): a hand-over inside the flanks
+    phi = np.linspace(-1.0, 1.0, N)
+    te = np.stack([-(phi + 1.0) ** 2, -phi ** 2, -(phi - 1.0) ** 2])
+    inside = np.ones((3, N), bool)
+    return np.ones(N), te, inside, np.array([-0.5, 0.5]), 1.6
+
+
+def test_flags_all_clear_for_a_hand_over_where_the_te_curves_cross():
+    f = _result(*_crossing_case()).flags()
+    assert f == dict(converged=True, reference_on_flank=True, edge_contact=False,
+                     low_contact_ratio=False)
+    assert _result(*_crossing_case()).warnings() == []
+
+
+def test_edge_contact_when_a_pair_leaves_its_flank_at_the_hand_over():
+    margin, te, inside, transfer, cr = _crossing_case()
+    inside[0, 2:] = False        # pair -1 runs off its flank before the crossing
+    te[0, 2:] = np.nan
+    transfer = np.array([-0.7, 0.5])
+    assert _result(margin, te, inside, transfer, cr).flags()["edge_contact"]
+
+
+def test_no_edge_contact_where_the_te_curves_coincide():
+    margin, te, inside, transfer, cr = _crossing_case()
+    te[:] = 0.0
+    inside[0, 6:] = False          # pair -1 leaves; the transfer lands on its last point
+    te[0, 6:] = np.nan
+    assert not _result(margin, te, inside, np.array([0.15, 0.5]), cr).flags()["edge_contact"]
+    te[1] = 1e-6                   # no longer coincident: an edge hand-over
+    assert _result(margin, te, inside, np.array([0.15, 0.5]), cr).flags()["edge_contact"]
+
+
+def test_edge_contact_when_no_transfer_point_is_found():
+    margin, te, inside, _, cr = _crossing_case()
+    assert _result(margin, te, inside, np.array([np.nan, 0.5]), cr).flags()["edge_contact"]
+
+
+def test_low_contact_ratio_and_off_flank_reference_and_failed_solve():
+    margin, te, inside, transfer, _ = _crossing_case()
+    r = _result(margin, te, inside, transfer, 0.93)
+    assert r.flags()["low_contact_ratio"] and "below 1" in r.warnings()[0]
+    assert _result(margin, te, inside, transfer, np.nan).flags()["low_contact_ratio"]
+    m = margin.copy()
+    m[N // 2] = -0.1
+    assert not _result(m, te, inside, transfer, 1.6).flags()["reference_on_flank"]
+    conv = np.ones(N, bool)
+    conv[3] = False                      # a failed solve between on-flank points
+    f = _result(margin, te, inside, transfer, 1.6, converged=conv).flags()
+    assert not f["converged"]
+
+
+# -- kinematics at the contact points: involute spur pair, closed form -------------------
+
+@pytest.fixture(scope="module")
+def spur():
+    pair = gj.InvolutePair.create(Z1, Z2, M, ALPHA)
+    des = gj.InvoluteTCA.create(pair, B)
+    return pair, {side: gj.run_tca(des, side=side, steps_per_pitch=12) for side in gj.SIDES}
+
+
+@pytest.mark.parametrize("side", ["drive", "coast"])
+def test_spur_kinematics_equal_the_line_of_action_closed_form(spur, side):
+    """Spur pair, pinion at 1 rad/s: the contact point runs along the line of action;
+    the flanks' velocities across the contact line are ``omega_i rho_i`` (rho_i the
+    roll distances from the base-circle tangency points, rho1 + rho2 = a_w sin
+    alpha_wt), the effective radius ``rho1 rho2/(rho1 + rho2)``.  Pinion = member 1."""
+    pair, res = spur
+    r = res[side]
+    geo = gj.pair_geometry(pair)
+    on = np.asarray(r.on_flank)
+    assert on.sum() >= 8
+    rho1 = np.sqrt(np.asarray(r.path.radial1) ** 2 - float(geo["rb1"]) ** 2)
+    rho2 = float(geo["a_w"]) * math.sin(float(geo["alpha_wt"])) - rho1
+    u1, u2 = rho1, (Z1 / Z2) * rho2
+    k = r.kinematics
+    np.testing.assert_allclose(np.asarray(k.u1)[on], u1[on], rtol=1e-8)
+    np.testing.assert_allclose(np.asarray(k.u2)[on], u2[on], rtol=1e-8)
+    np.testing.assert_allclose(np.asarray(k.u_e)[on], 0.5 * (u1 + u2)[on], rtol=1e-8)
+    np.testing.assert_allclose(np.asarray(k.srr)[on], ((u1 - u2) / (0.5 * (u1 + u2)))[on],
+                               rtol=1e-7, atol=1e-9)
+    np.testing.assert_allclose(np.asarray(k.r_x)[on], (rho1 * rho2 / (rho1 + rho2))[on],
+                               rtol=1e-8)
+    assert np.all(np.isinf(np.asarray(k.r_y)[on]))          # line contact
+    np.testing.assert_allclose(np.asarray(k.gear_ratio)[on], -Z1 / Z2, rtol=1e-10)
+    np.testing.assert_allclose(np.asarray(k.u_s_side)[on], 0.0, atol=1e-9)
+    # the pitch point: pure rolling
+    i = int(np.argmin(np.abs(rho1 - float(geo["rho_P"]))))
+    assert abs(float(k.srr[i])) < 0.05
+
+
+def test_spur_result_quantities_and_flags(spur):
+    _, res = spur
+    for side, r in res.items():
+        assert r.side == side and r.family == "involute"
+        assert float(r.ptp) < 1e-3 * gj.ARCSEC                # conjugate: no TE
+        geo = gj.pair_geometry(gj.InvolutePair.create(Z1, Z2, M, ALPHA))
+        assert abs(float(r.contact_ratio) - float(geo["contact_ratio"])) < 0.02
+        f = r.flags()
+        assert f["converged"] and f["reference_on_flank"] and not f["low_contact_ratio"]
+        # conjugate: the TE curves of consecutive pairs coincide, both pairs touch at
+        # the hand-over, no pair carries the load alone at a flank edge
+        assert not f["edge_contact"]
