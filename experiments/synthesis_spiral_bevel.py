@@ -74,8 +74,8 @@ def run_side(design, side, v0, targets=None):
                              te_arcsec=res.targets[2] / sy.ARCSEC,
                              path_angle_deg=math.degrees(res.targets[3]),
                              semi_major_mm=res.targets[4]),
-                before=sy._flank_table(st.pair.pinion), after=sy._flank_table(res.pair.pinion),
-                gear=sy._flank_table(res.pair.gear))
+                before=sy.flank_settings_table(st.pair.pinion), after=sy.flank_settings_table(res.pair.pinion),
+                gear=sy.flank_settings_table(res.pair.gear))
     assert res_again.converged
     return res, info
 

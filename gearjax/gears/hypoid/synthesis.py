@@ -121,7 +121,8 @@ from gearjax.tca import ARCSEC, Misalignment, contact_equations, contact_path
 
 __all__ = ["VARIABLES", "DEFAULT_FREE", "SCALES", "RESIDUAL_NAMES", "Targets", "Start",
            "SynthesisResult", "conjugate_start", "start", "apply_variables", "mean_working_height",
-           "residuals_and_jacobian", "synthesise", "verify", "synthesised_design"]
+           "residuals_and_jacobian", "synthesise", "verify", "synthesised_design",
+           "flank_settings_table"]
 
 VARIABLES = ("d_radius", "modified_roll_2c", "d_ratio_of_roll", "d_cradle_angle",
              "d_sliding_base", "d_blade_angle", "modified_roll_6d")
@@ -552,7 +553,7 @@ def pitch_of(pair) -> float:
     return 2.0 * np.pi / pair.z1
 
 
-def _flank_table(fl) -> dict:
+def flank_settings_table(fl) -> dict:
     c, m = fl.cutter, fl.machine
     f = lambda a: float(np.asarray(a))
     dg = lambda a: math.degrees(f(a))
@@ -579,6 +580,6 @@ def synthesised_design(design, pairs: dict, *, name: str, description: str, sour
                           source=source)
     for side, pair in pairs.items():
         f1, f2 = th.SIDES[side]
-        data["pinion"][f1] = _flank_table(pair.pinion)
-        data["gear"][f2] = _flank_table(pair.gear)
+        data["pinion"][f1] = flank_settings_table(pair.pinion)
+        data["gear"][f2] = flank_settings_table(pair.gear)
     return design_from_dict(data)
