@@ -13,7 +13,8 @@ The on-flank mask is taken from the nominal design (fixed), so every objective i
 a smooth function of the fields near it.
 
 Central differences of fourth order, ``(8 (f(x+h) - f(x-h)) - (f(x+2h) - f(x-2h)))/(12 h)``,
-with ``h = 1e-4 |x|`` (``1e-5`` for a field at 0): a step relative to the field, since a
+with ``h = 1e-4 |x|`` (``1e-5`` for a field at 0; 1e-6 |x| and 1e-7 on the bevel and
+hypoid examples): a step relative to the field, since a
 contact position varies like ``1/b`` with a crown coefficient ``b`` (a step fixed in
 absolute size would be 5 % of a profile crown of 2e-4/mm); truncation ~h^4 f^(5) and
 solve noise ~1e-12 f/h are then both far below 1e-6 relative.
@@ -79,7 +80,9 @@ def check(name, f, design, mis, fields, family, step=1e-4):
     rows = []
     for k in fields:
         x = abs(float(x0[k]))
-        h = step * x if x > 0.0 else 1e-5
+        # relative step; a field at 0 (or at round-off from 0, e.g. -6e-17) gets an
+        # absolute step of the same order as 0.1 of a unit field's
+        h = step * x if x > 1e-12 else 0.1 * step
         ev = {j: np.asarray(g({**x0, k: x0[k] + j * h})) for j in (-2, -1, 1, 2)}
         fd = (8.0 * (ev[1] - ev[-1]) - (ev[2] - ev[-2])) / (12.0 * h)
         allow = fd_noise(base, h)
@@ -154,6 +157,11 @@ def main(argv=None):
               f"{x['autodiff']:14.6e} {x['central_difference']:14.6e} {x['rel_error']:9.1e} "
               f"{x['fd_noise']:9.1e}{'' if x['ok'] else '  FAIL'}")
     out = Path(__file__).parent / "results" / "end_to_end_gradients.json"
+    if args.only and out.exists():           # keep the other examples' rows
+        old = json.loads(out.read_text())
+        done = {t["example"] for t in timing}
+        rows = [r for r in old["rows"] if r["example"] not in done] + rows
+        timing = [t for t in old["timing"] if t["example"] not in done] + timing
     gj.atomic_write(out, json.dumps(dict(rows=rows, timing=timing), indent=1))
     return 0
 
