@@ -36,24 +36,18 @@ import numpy as np
 
 import gearjax as gj
 
-OBJECTIVES = ("ptp_arcsec", "mean_abs_srr", "max_abs_srr", "min_r_x_mm", "path_position")
+OBJECTIVES = gj.TCAResult.OBJECTIVES
 
 
 def objectives_fn(f, design, mis, family):
     """``g(x) -> (5,)`` objectives as a function of the chosen fields ``x`` (dict)."""
     nominal = f(design, mis)
     on = np.asarray(nominal.on_flank)
-    mid = on.shape[0] // 2
 
     def g(values):
         des = gj.with_fields(design, {k: v for k, v in values.items() if not k.startswith("mis.")})
         m = gj.with_fields(mis, {k[4:]: v for k, v in values.items() if k.startswith("mis.")})
-        res = f(des, m)
-        k = res.kinematics
-        srr = jnp.abs(jnp.where(on, k.srr, 0.0))
-        pos = res.coords["xi1"][mid] if family == "hypoid" else res.path.radial1[mid]
-        return jnp.stack([res.multi.ptp / gj.ARCSEC, jnp.sum(srr) / on.sum(), jnp.max(srr),
-                          jnp.min(jnp.where(on, k.r_x, jnp.inf)), pos])
+        return f(des, m).objectives(on)
     return g
 
 

@@ -59,7 +59,7 @@ import numpy as np
 
 from gearjax.frames import matrix_z
 from gearjax.surfaces import local_geometry
-from gearjax.tca import (Assembly, ContactPath, Misalignment, MultiPair, contact_equations,
+from gearjax.tca import (ARCSEC, Assembly, ContactPath, Misalignment, MultiPair, contact_equations,
                          gear_mount, relative_curvature)
 
 __all__ = ["SIDES", "check_side", "TCAResult", "ContactKinematics", "contact_kinematics",
@@ -237,6 +237,24 @@ class TCAResult:
     def on_flank(self):
         """(N,) pair 0 converged and inside both flank boundaries."""
         return (self.margin >= 0.0) & self.path.converged
+
+    #: names of :meth:`objectives`, in order
+    OBJECTIVES = ("ptp_arcsec", "mean_abs_srr", "max_abs_srr", "min_r_x_mm", "path_position")
+
+    def objectives(self, on):
+        """Scalar objectives of the pair (traceable; needs ``kinematics``), over the grid
+        points selected by the boolean mask ``on`` (fixed, e.g. the nominal design's
+        :attr:`on_flank`, so that every objective is smooth in the design): TE
+        peak-to-peak (arcsec), mean and max |SRR|, min R_x (mm), and the contact
+        position at the reference (hypoid: face-width position ``xi1``; otherwise the
+        radius on the pinion, mm).  Order: :attr:`OBJECTIVES`."""
+        on = np.asarray(on)
+        mid = on.shape[0] // 2
+        k = self.kinematics
+        srr = jnp.abs(jnp.where(on, k.srr, 0.0))
+        pos = self.coords["xi1"][mid] if self.family == "hypoid" else self.path.radial1[mid]
+        return jnp.stack([self.multi.ptp / ARCSEC, jnp.sum(srr) / on.sum(), jnp.max(srr),
+                          jnp.min(jnp.where(on, k.r_x, jnp.inf)), pos])
 
     def flags(self) -> dict:
         """Contact-quality flags of a concrete result (Python bools).
