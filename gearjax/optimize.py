@@ -356,7 +356,14 @@ def _lm_run(fun, jacobian, stateful, history_size, x0, aux0, args, lo, hi, maxit
         pred = -(jnp.dot(g, h) + 0.5 * jnp.dot(h, A @ h))
         actred = 0.5 * jnp.dot(r - r_t, r + r_t)
         rho = actred / jnp.where(pred > 0, pred, 1.0)
-        accept_step = started & ok_t & (pred > 0) & (actred > 0)
+        # below the rounding of the cost the actual reduction is noise of either sign;
+        # there a step that lowers the projected gradient is taken (near a minimum the
+        # gradient, not the cost, still resolves the distance to it)
+        in_noise = jnp.abs(actred) <= 64.0 * jnp.finfo(jnp.float64).eps * (cost + cost_t)
+        g_now = jnp.max(jnp.abs(_projected_grad(x, g, lo, hi)), initial=0.0)
+        g_t = jnp.max(jnp.abs(_projected_grad(x_t, J_t.T @ r_t, lo, hi)), initial=0.0)
+        decrease = (actred > 0) | (in_noise & (g_t < g_now))
+        accept_step = started & ok_t & (pred > 0) & decrease
         accept = jnp.where(started, accept_step, ok_t)
         # damping update of Nielsen (1999): mu *= max(1/3, 1 - (2 rho - 1)^3), nu = 2 on
         # acceptance; mu *= nu, nu *= 2 on rejection.  Or Marquardt's (1963) fixed
