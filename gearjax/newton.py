@@ -64,6 +64,22 @@ class NewtonResult(NamedTuple):
     converged: Any
 
 
+def _jacobian(f, x):
+    """``df/dx`` (n x n) of ``f: (n,) -> (n,)`` by forward mode; one ``jvp`` for n = 1
+    (a scalar solve -- the envelope of a generated flank -- is the innermost and most
+    often repeated; ``jacfwd`` would wrap it in a batch of one)."""
+    if x.shape[0] == 1:
+        return jnp.reshape(jax.jvp(f, (x,), (jnp.ones_like(x),))[1], (1, 1))
+    return jax.jacfwd(f)(x)
+
+
+def _lin_solve(J, b):
+    """``J^-1 b``; a division for a 1 x 1 system (no LU factorisation)."""
+    if J.shape[0] == 1:
+        return b / J[0, 0]
+    return jnp.linalg.solve(J, b)
+
+
 def _loop(F, tol, xtol, max_steps, max_halvings, x0, theta):
     """Damped Newton iterations on the flattened unknown."""
     shape = jnp.shape(x0)
@@ -84,8 +100,8 @@ def _loop(F, tol, xtol, max_steps, max_halvings, x0, theta):
 
     def body(state):
         x, fx, res, k, _ = state
-        J = jax.jacfwd(f)(x)
-        dx = jnp.linalg.solve(J, -fx)
+        J = _jacobian(f, x)
+        dx = _lin_solve(J, -fx)
         ok = jnp.all(jnp.isfinite(dx))
         dx = jnp.where(ok, dx, 0.0)
 
@@ -154,9 +170,9 @@ def _solve_jvp(F, tol, xtol, max_steps, max_halvings, primals, tangents):
                 th[i] = v
             return jnp.reshape(F(xs, jax.tree_util.tree_unflatten(treedef, th)), (-1,))
 
-        J = jax.jacfwd(fx)(jnp.reshape(xs, (-1,)))
+        J = _jacobian(fx, jnp.reshape(xs, (-1,)))
         _, f_dot = jax.jvp(f_theta, tuple(leaves[i] for i in nz), tuple(t_leaves[i] for i in nz))
-        x_dot = jnp.reshape(-jnp.linalg.solve(J, f_dot), shape)
+        x_dot = jnp.reshape(-_lin_solve(J, f_dot), shape)
     zero_int = np.zeros(jnp.shape(out[2]), dtype=jax.dtypes.float0)
     zero_bool = np.zeros(jnp.shape(out[3]), dtype=jax.dtypes.float0)
     return out, (x_dot, jnp.zeros_like(out[1]), zero_int, zero_bool)

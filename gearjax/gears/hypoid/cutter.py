@@ -49,7 +49,7 @@ from gearjax.errors import check_positive, check_range, is_traced
 
 __all__ = ["FaceMillCutter", "make_cutter", "cutter_point", "cutter_normal",
            "cutter_tangents", "fillet_start", "fillet_point", "fillet_normal",
-           "blade_radius"]
+           "blade_radius", "blade_data", "cone_radius", "cone_point", "cone_normal"]
 
 
 @functools.partial(jax.tree_util.register_dataclass,
@@ -98,23 +98,48 @@ def make_cutter(point_radius, blade_angle_deg, edge_radius, flank: str) -> FaceM
                           1 if flank == "convex" else -1)
 
 
+def blade_data(c: FaceMillCutter):
+    """The blade's constants ``(R_p, sgn sin(alpha), cos(alpha), sgn cos(alpha),
+    sin(alpha))`` (5,): the cone and its normal below need nothing else, so a flank
+    solve can take them once instead of the cutter (whose sign is static)."""
+    sa, ca = jnp.sin(c.blade_angle), jnp.cos(c.blade_angle)
+    return jnp.stack([c.point_radius, c.sign * sa, ca, c.sign * ca, sa])
+
+
+def cone_radius(blade, s):
+    """Radius of the blade cone at distance ``s`` (mm) from the tip: R_p - sgn s sin(alpha)
+    (``blade`` from :func:`blade_data`)."""
+    return blade[0] - s * blade[1]
+
+
+def cone_point(blade, s, theta):
+    """Point r_t(s, theta) of the straight-blade cone in the cutter frame (mm),
+    [HFT-hypoid] (``blade`` from :func:`blade_data`)."""
+    rho = cone_radius(blade, s)
+    return jnp.stack([rho * jnp.cos(theta), rho * jnp.sin(theta), -s * blade[2]])
+
+
+def cone_normal(blade, theta):
+    """Unit normal of the blade cone (out of the workpiece material into the slot),
+    ``(sgn cos(alpha) cos(theta), sgn cos(alpha) sin(theta), -sin(alpha))``."""
+    return jnp.stack([blade[3] * jnp.cos(theta), blade[3] * jnp.sin(theta),
+                      -blade[4] * jnp.ones_like(theta)])
+
+
 def blade_radius(c: FaceMillCutter, s):
     """Radius of the blade cone at distance ``s`` (mm) from the tip: R_p - sgn s sin(alpha)."""
-    return c.point_radius - c.sign * s * jnp.sin(c.blade_angle)
+    return cone_radius(blade_data(c), s)
 
 
 def cutter_point(c: FaceMillCutter, s, theta):
     """Point r_t(s, theta) of the straight-blade cone in the cutter frame (mm), [HFT-hypoid]."""
-    rho = blade_radius(c, s)
-    return jnp.stack([rho * jnp.cos(theta), rho * jnp.sin(theta), -s * jnp.cos(c.blade_angle)])
+    return cone_point(blade_data(c), s, theta)
 
 
 def cutter_normal(c: FaceMillCutter, s, theta):
     """Unit normal of the blade cone (points out of the workpiece material into the slot)."""
-    ca, sa = jnp.cos(c.blade_angle), jnp.sin(c.blade_angle)
-    sg = c.sign
     del s
-    return jnp.stack([sg * ca * jnp.cos(theta), sg * ca * jnp.sin(theta), -sa * jnp.ones_like(theta)])
+    return cone_normal(blade_data(c), theta)
 
 
 def cutter_tangents(c: FaceMillCutter, s, theta):

@@ -57,15 +57,19 @@ import jax.numpy as jnp
 import numpy as np
 
 from gearjax import frames
-from gearjax.gears.hypoid.cutter import FaceMillCutter, cutter_normal, cutter_point, fillet_start
+from gearjax.gears.hypoid.cutter import (FaceMillCutter, blade_data, cone_normal, cone_point,
+                                         cutter_normal, cutter_point, fillet_start)
 from gearjax.errors import check_int, check_positive, check_range, require_converged
-from gearjax.gears.hypoid.machine import MachineSettings, cutter_to_work, work_to_machine
+from gearjax.gears.hypoid.machine import (MachineSettings, cutter_to_cradle, cutter_to_work,
+                                          work_to_machine)
 from gearjax.newton import newton_solve
 
 __all__ = ["MemberBlank", "FlankSpec", "FlankGrid", "make_member_blank", "mean_cone_distance",
            "face_apex_offset", "root_apex_offset", "axial_coords", "pitch_distance", "xi_of",
            "face_cone_gap", "root_cone_gap", "work_point", "meshing_function", "mid_estimate",
            "solve_tip", "solve_point", "flank_points", "flank_surface", "spiral_angle_at",
+           "MachineChain", "machine_chain", "chain_point", "chain_normal", "body_family",
+           "body_point",
            "BLANK_FIELDS"]
 
 TOL = 1e-10   # mm, residual tolerance of every solve
@@ -192,34 +196,111 @@ def work_point(fl: FlankSpec, s, theta, psi=0.0):
     return r, n
 
 
-def body_family(fl: FlankSpec, shift, uv, psi):
-    """Tool family of a flank in the member's body frame: the cutter point at
-    ``uv = (theta, s)`` carried to cradle roll ``psi``, minus ``shift`` (3,) (the
-    crossing point).  Module-level so that ``jax.tree_util.Partial(body_family, fl,
-    shift)`` is a pytree whose jit caches are shared by every flank function built
-    from it (:func:`gearjax.gears.hypoid.pair.flank_function`)."""
-    return work_point(fl, uv[1], uv[0], psi)[0] - shift
+@functools.partial(jax.tree_util.register_dataclass,
+                   data_fields=["R_ct", "t_ct", "R_f", "t_f", "roll", "blade"],
+                   meta_fields=["generated"])
+@dataclass(frozen=True)
+class MachineChain:
+    """The roll-independent factors of :func:`work_point`'s machine chain (a pytree).
+
+    With ``M_mw(phi) = F Rz(phi)`` (``F = T(0, E_m, X_B) Ry(pi/2 - gamma_m) T(0, 0,
+    dX_D)``, :func:`gearjax.gears.hypoid.machine.work_to_machine`) the cutter point
+    and normal in the work frame are
+
+        r_w(s, theta, psi) = Rz(-phi(psi)) [R_f Rz(psi) (R_ct r_t + t_ct) + t_f]
+        n_w(s, theta, psi) = Rz(-phi(psi)) R_f Rz(psi) R_ct n_t
+
+    (``R_ct, t_ct``: the cutter in the cradle, ``M_ct``; ``R_f, t_f``: ``F^-1``;
+    ``roll = (R_a, 2C, 6D)``; ``r_t``, ``n_t`` the blade cone and its normal from
+    ``blade``, :func:`gearjax.gears.hypoid.cutter.blade_data`; formate members have no
+    ``Rz(psi)`` and ``phi = 0``).  Computed once per flank from the
+    settings, outside the solves, so that each evaluation of the tool inside the
+    solves and their derivatives costs two plane rotations and two 3x3 products
+    instead of the seven 4x4 transforms of the full chain -- the same mapping
+    (:func:`chain_point` is tested against :func:`work_point`).  Static:
+    ``generated`` (cradle roll or formate).
+    """
+
+    R_ct: jax.Array
+    t_ct: jax.Array
+    R_f: jax.Array
+    t_f: jax.Array
+    roll: jax.Array
+    blade: jax.Array
+    generated: bool = True
 
 
-def body_point(fl: FlankSpec, shift, uv):
+def machine_chain(fl: FlankSpec) -> MachineChain:
+    """:class:`MachineChain` of a flank (traceable)."""
+    ms, c = fl.machine, fl.cutter
+    M_ct = cutter_to_cradle(ms)
+    F_inv = frames.inverse(work_to_machine(ms, 0.0))
+    roll = jnp.stack([ms.ratio_of_roll, ms.modified_roll_2c, ms.modified_roll_6d])
+    return MachineChain(M_ct[:3, :3], M_ct[:3, 3], F_inv[:3, :3], F_inv[:3, 3], roll,
+                        blade_data(c), bool(ms.generated))
+
+
+def _plane_rotation(angle, v):
+    """``Rz(angle) v`` for one vector (3,)."""
+    c, s = jnp.cos(angle), jnp.sin(angle)
+    return jnp.stack([c * v[0] - s * v[1], s * v[0] + c * v[1], v[2]])
+
+
+def _chain(k: MachineChain, v, psi, translate: bool):
+    """The chain of :class:`MachineChain` applied to a cutter-frame point
+    (``translate``) or vector."""
+    q = k.R_ct @ v + (k.t_ct if translate else 0.0)
+    if k.generated:
+        q = _plane_rotation(psi, q)
+    q = k.R_f @ q + (k.t_f if translate else 0.0)
+    if not k.generated:
+        return q
+    ra, c2, d6 = k.roll[0], k.roll[1], k.roll[2]
+    phi = ra * (psi - 0.5 * c2 * psi ** 2 - d6 / 6.0 * psi ** 3)   # roll_angle
+    return _plane_rotation(-phi, q)
+
+
+def chain_point(k: MachineChain, uv, psi):
+    """Cutter point at ``uv = (theta, s)`` in the work frame at cradle roll ``psi``
+    (mm), by the factored chain (:class:`MachineChain`; formate: ``psi`` ignored).
+    Equals ``work_point(fl, s, theta, psi)[0]``."""
+    return _chain(k, cone_point(k.blade, uv[1], uv[0]), psi, True)
+
+
+def chain_normal(k: MachineChain, uv, psi):
+    """Unit cutter normal at ``uv`` in the work frame (``work_point(...)[1]``)."""
+    return _chain(k, cone_normal(k.blade, uv[0]), psi, False)
+
+
+def body_family(k: MachineChain, shift, uv, psi):
+    """Tool family of a generated flank in the member's body frame: the cutter point
+    at ``uv = (theta, s)`` carried to cradle roll ``psi`` (:func:`chain_point`), minus
+    ``shift`` (3,) (the crossing point).  Module-level so that
+    ``jax.tree_util.Partial(body_family, machine_chain(fl), shift)`` is a pytree whose
+    jit caches are shared by every flank function built from it
+    (:func:`gearjax.gears.hypoid.pair.flank_function`)."""
+    return chain_point(k, uv, psi) - shift
+
+
+def body_point(k: MachineChain, shift, uv):
     """Formate flank (the cutter cone placed by the settings) in the body frame."""
-    return work_point(fl, uv[1], uv[0], 0.0)[0] - shift
+    return chain_point(k, uv, 0.0) - shift
 
 
-def _carried(fl: FlankSpec, s, theta, psi):
+def _carried(k: MachineChain, s, theta, psi):
     """``(r_w, n_w, dr_w/dpsi)`` from one forward-mode pass through the machine chain
-    (the point, the normal and the relative velocity share one trace)."""
+    (the point and the relative velocity share one trace)."""
     psi = jnp.asarray(psi, float)
-    (r, n), (v, _) = jax.jvp(lambda p: work_point(fl, s, theta, p), (psi,),
-                             (jnp.ones_like(psi),))
-    return r, n, v
+    uv = jnp.stack([theta, s])
+    r, v = jax.jvp(lambda p: chain_point(k, uv, p), (psi,), (jnp.ones_like(psi),))
+    return r, chain_normal(k, uv, psi), v
 
 
 def meshing_function(fl: FlankSpec, s, theta, psi):
     """f1 = n_w . dr_w/dpsi (mm/rad): zero on the generated flank (0 for formate)."""
     if not fl.machine.generated:
         return jnp.zeros_like(jnp.asarray(psi, float))
-    _, n, v = _carried(fl, s, theta, psi)
+    _, n, v = _carried(machine_chain(fl), s, theta, psi)
     return jnp.dot(n, v)
 
 
@@ -227,27 +308,26 @@ def _target(b: MemberBlank, xi0):
     return b.outer_cone_distance - 0.5 * b.face_width * (1.0 - xi0)
 
 
-def _point_and_first_eq(fl, s, th, psi):
+def _point_and_first_eq(k: MachineChain, s, th, psi):
     """Work point and the first equation (meshing, or ``psi`` for formate): one pass."""
-    if fl.machine.generated:
-        r, n, v = _carried(fl, s, th, psi)
+    if k.generated:
+        r, n, v = _carried(k, s, th, psi)
         return r, jnp.dot(n, v)
-    return work_point(fl, s, th, psi)[0], psi
+    return chain_point(k, jnp.stack([th, s]), psi), psi
 
 
 def _F_tip(x, p):
-    fl, xi0 = p
+    k, b, xi0 = p
     s, th, psi = x[0], x[1], x[2]
-    r, f1 = _point_and_first_eq(fl, s, th, psi)
-    return jnp.stack([f1, pitch_distance(fl.blank, r) - _target(fl.blank, xi0),
-                      face_cone_gap(fl.blank, r)])
+    r, f1 = _point_and_first_eq(k, s, th, psi)
+    return jnp.stack([f1, pitch_distance(b, r) - _target(b, xi0), face_cone_gap(b, r)])
 
 
 def _F_point(x, p):
-    fl, s, xi0 = p
+    k, b, s, xi0 = p
     th, psi = x[0], x[1]
-    r, f1 = _point_and_first_eq(fl, s, th, psi)
-    return jnp.stack([f1, pitch_distance(fl.blank, r) - _target(fl.blank, xi0)])
+    r, f1 = _point_and_first_eq(k, s, th, psi)
+    return jnp.stack([f1, pitch_distance(b, r) - _target(b, xi0)])
 
 
 def mid_estimate(fl: FlankSpec):
@@ -271,12 +351,14 @@ def mid_estimate(fl: FlankSpec):
 
 def solve_tip(fl: FlankSpec, xi0, x0):
     """Tip point (on the face cone) at face-width position xi0: x = (s, theta, psi)."""
-    return newton_solve(_F_tip, x0, (fl, jnp.asarray(xi0, float)), tol=TOL)
+    return newton_solve(_F_tip, x0, (machine_chain(fl), fl.blank, jnp.asarray(xi0, float)),
+                        tol=TOL)
 
 
 def solve_point(fl: FlankSpec, s, xi0, x0):
     """Flank point at blade distance s and face-width position xi0: x = (theta, psi)."""
-    return newton_solve(_F_point, x0, (fl, jnp.asarray(s, float), jnp.asarray(xi0, float)), tol=TOL)
+    return newton_solve(_F_point, x0, (machine_chain(fl), fl.blank, jnp.asarray(s, float),
+                                       jnp.asarray(xi0, float)), tol=TOL)
 
 
 class FlankGrid(NamedTuple):
@@ -326,6 +408,7 @@ def flank_points(fl: FlankSpec, n_xi: int = 21, n_s: int = 11) -> FlankGrid:
         tips = tips_up
     tip_ok = tips.converged & mid.converged
     s_min = fillet_start(fl.cutter)
+    k = machine_chain(fl)
 
     def row(tip_x, xi0):
         s_max = tip_x[0]
@@ -334,7 +417,8 @@ def flank_points(fl: FlankSpec, n_xi: int = 21, n_s: int = 11) -> FlankGrid:
             s = s_min + (s_max - s_min) * t
             res = solve_point(fl, s, xi0, carry)
             nxt = jnp.where(res.converged, res.x, carry)
-            r, n = work_point(fl, s, res.x[0], res.x[1])
+            uv = jnp.stack([res.x[0], s])
+            r, n = chain_point(k, uv, res.x[1]), chain_normal(k, uv, res.x[1])
             return nxt, (r, n, jnp.stack([s, res.x[0], res.x[1]]), res.residual, res.converged)
 
         _, out = jax.lax.scan(step, tip_x[1:], jnp.asarray(ts))

@@ -107,7 +107,7 @@ class HypoidPair:
 
 
 def _f(v):
-    return jnp.asarray(float(v))
+    return jnp.asarray(float(v), jnp.float64)      # strongly typed (see strong_float64)
 
 
 def pair_flanks(design, side: str = "drive", *, hand: int = 1) -> HypoidPair:
@@ -202,14 +202,16 @@ def with_point_radius(fl: FlankSpec, d_radius, theta_m) -> FlankSpec:
 def flank_function(fl: FlankSpec, crossing):
     """Flank ``uv = (theta, s) -> (3,)`` in the member's body frame (origin at the
     crossing point): a GeneratedSurface for a generated member, else the placed cone."""
-    from gearjax.gears.hypoid.flank import body_family, body_point
+    from gearjax.gears.hypoid.flank import body_family, body_point, machine_chain
     shift = jnp.stack([0.0, 0.0, jnp.asarray(crossing, float)])
     # Partials of module-level functions (pytrees): every flank function built here
-    # shares one set of jit caches (gearjax.surfaces, "trace once")
+    # shares one set of jit caches (gearjax.surfaces, "trace once"); the machine
+    # chain's roll-independent factors are computed here, once, not inside the solves
+    k = machine_chain(fl)
     if fl.machine.generated:
-        return GeneratedSurface(jax.tree_util.Partial(body_family, fl, shift), 0.0,
+        return GeneratedSurface(jax.tree_util.Partial(body_family, k, shift), 0.0,
                                 tol=1e-12, max_steps=30)
-    return jax.tree_util.Partial(body_point, fl, shift)
+    return jax.tree_util.Partial(body_point, k, shift)
 
 
 def hypoid_assembly(pair: HypoidPair) -> Assembly:

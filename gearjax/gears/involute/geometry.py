@@ -53,7 +53,8 @@ from gearjax.kinematics import Kinematics, Mesh, eigen_kinematics, parallel_axes
 from gearjax.newton import newton_solve
 from gearjax.surfaces import GeneratedSurface, local_geometry, unit_normal
 
-__all__ = ["InvolutePair", "rack_flank", "generated_flank", "pair_geometry",
+__all__ = ["InvolutePair", "rack_flank", "generated_flank", "pair_geometry", "RackFamily",
+           "rack_point", "rack_family", "rack_psi0", "rack_family_data",
            "PathResult", "path_kinematics", "path_kinematics_traced", "closed_form_path",
            "involute_polar_angle", "wheel_flank_geometry", "path_table"]
 
@@ -95,8 +96,8 @@ class InvolutePair:
         x1 = check_range("x1", x1, -3.0, 3.0)
         x2 = check_range("x2", x2, -3.0, 3.0)
         deg = math.pi / 180.0
-        pair = cls(jnp.asarray(m), jnp.asarray(a * deg), jnp.asarray(b * deg),
-                   jnp.asarray(x1), jnp.asarray(x2), z1, z2)
+        f = lambda v: jnp.asarray(v, jnp.float64)          # strongly typed leaves
+        pair = cls(f(m), f(a * deg), f(b * deg), f(x1), f(x2), z1, z2)
         if not any(is_traced(v) for v in (m, a, b, x1, x2)):
             _check_tooth_form(pair)      # concrete values only (traced ones pass through)
         return pair
@@ -187,38 +188,76 @@ def rack_flank(m_n, alpha_n, beta, x, z, side):
 
     Returns ``(point(uv), m_t, alpha_t, r)``; ``side`` is +1 or -1 (static).
     """
+    k = rack_family_data(m_n, alpha_n, beta, x, z, side)
+    m_t, alpha_t, r, _ = _gear_basics(m_n, alpha_n, beta, z)
+    return jax.tree_util.Partial(rack_point, k), m_t, alpha_t, r
+
+
+class RackFamily(NamedTuple):
+    """Data of a (modified) rack flank carried by the generating roll (a pytree).
+
+    Rack point at ``psi = 0``: ``p0 + u e_prof + v e_lead + (c_u u^2 + c_v v^2) d``
+    (``d``: the crown offset direction, ``crowns = (c_u, c_v)``, zero for the
+    unmodified rack); ``r`` pitch radius of the generated member; ``slope`` =
+    ``side/tan(alpha_t)`` of the start value of the motion parameter.
+    """
+
+    p0: jax.Array
+    e_prof: jax.Array
+    e_lead: jax.Array
+    crown_dir: jax.Array
+    crowns: jax.Array
+    r: jax.Array
+    slope: jax.Array
+
+
+def rack_point(k: RackFamily, uv):
+    """Point of the (modified) rack flank at psi = 0, rack frame (mm)."""
+    return (k.p0 + uv[0] * k.e_prof + uv[1] * k.e_lead
+            + (k.crowns[0] * uv[0] ** 2 + k.crowns[1] * uv[1] ** 2) * k.crown_dir)
+
+
+def rack_family(k: RackFamily, uv, psi):
+    """Tool family ``r_w(uv, psi) = Rz(-psi) [rack(uv) - (r psi, 0, 0)]`` (body frame of
+    the generated member, mm).  Module-level so that ``jax.tree_util.Partial(rack_family,
+    k)`` is a pytree whose envelope solves are traced once
+    (:class:`gearjax.surfaces.GeneratedSurface`)."""
+    pr = rack_point(k, uv)
+    X = pr[0] - k.r * psi
+    c, s = jnp.cos(psi), jnp.sin(psi)
+    return jnp.stack([c * X + s * pr[1], -s * X + c * pr[1], pr[2]])
+
+
+def rack_psi0(k: RackFamily, uv):
+    """Start value of ``psi``: where the unmodified rack point crosses the rack's line of
+    action."""
+    pr = k.p0 + uv[0] * k.e_prof + uv[1] * k.e_lead
+    return (pr[0] - k.slope * (pr[1] - k.r)) / k.r
+
+
+def rack_family_data(m_n, alpha_n, beta, x, z, side, crown_dir=None, crowns=None) -> RackFamily:
+    """:class:`RackFamily` of the rack flank ``side`` (see :func:`rack_flank`)."""
     m_t, alpha_t, r, _ = _gear_basics(m_n, alpha_n, beta, z)
     s = m_t * (jnp.pi / 2) + 2 * x * m_n * jnp.tan(alpha_t)
     p0 = jnp.stack([side * s / 2, r, jnp.zeros_like(r)])
     e_prof = jnp.stack([-side * jnp.sin(alpha_n) * jnp.cos(beta), jnp.cos(alpha_n),
                         side * jnp.sin(alpha_n) * jnp.sin(beta)])
     e_lead = jnp.stack([jnp.sin(beta), jnp.zeros_like(beta), jnp.cos(beta)])
-
-    def point(uv):
-        return p0 + uv[0] * e_prof + uv[1] * e_lead
-
-    return point, m_t, alpha_t, r
+    d = jnp.zeros(3) if crown_dir is None else jnp.asarray(crown_dir, float)
+    c = jnp.zeros(2) if crowns is None else jnp.asarray(crowns, float)
+    return RackFamily(p0, e_prof, e_lead, d, c, r, side / jnp.tan(alpha_t))
 
 
 def generated_flank(m_n, alpha_n, beta, x, z, side, **newton_options) -> GeneratedSurface:
     """The gear flank enveloped by the rack flank ``side`` (body frame of the gear).
 
-    Family: ``r_w(uv, psi) = Rz(-psi) [rack(uv) - (r psi, 0, 0)]``.  The initial guess
-    for ``psi`` is where the rack point crosses the rack's line of action.
+    Family: ``r_w(uv, psi) = Rz(-psi) [rack(uv) - (r psi, 0, 0)]`` (:func:`rack_family`).
+    The initial guess for ``psi`` is where the rack point crosses the rack's line of
+    action.
     """
-    rack, m_t, alpha_t, r = rack_flank(m_n, alpha_n, beta, x, z, side)
-
-    def family(uv, psi):
-        pr = rack(uv)
-        X = pr[0] - r * psi
-        c, s = jnp.cos(psi), jnp.sin(psi)
-        return jnp.stack([c * X + s * pr[1], -s * X + c * pr[1], pr[2]])
-
-    def psi0(uv):
-        pr = rack(uv)
-        return (pr[0] - side * (pr[1] - r) / jnp.tan(alpha_t)) / r
-
-    return GeneratedSurface(family, psi0, **newton_options)
+    k = rack_family_data(m_n, alpha_n, beta, x, z, side)
+    P = jax.tree_util.Partial
+    return GeneratedSurface(P(rack_family, k), P(rack_psi0, k), **newton_options)
 
 
 def involute_polar_angle(R, zc, rb, r, s_t, alpha_t, beta, side):
