@@ -12,8 +12,9 @@ optimiser can pick the fields it varies and put new values back, without writing
 from __future__ import annotations
 
 import jax
+import jax.numpy as jnp
 
-__all__ = ["field_names", "get_fields", "with_fields"]
+__all__ = ["field_names", "get_fields", "with_fields", "strong_float64"]
 
 
 def _name(path) -> str:
@@ -54,3 +55,19 @@ def with_fields(tree, values: dict):
         raise KeyError(f"unknown field(s) {sorted(unknown)} (known: {', '.join(names)})")
     return jax.tree_util.tree_unflatten(treedef, [values.get(n, leaf)
                                                   for n, (_, leaf) in zip(names, flat)])
+
+
+def strong_float64(tree):
+    """``tree`` with every floating-point leaf as a strongly typed float64 array.
+
+    A leaf made from a Python float (``jnp.asarray(0.0)``) is *weakly* typed; a jitted
+    program called first with such a leaf and then with the same field as an ordinary
+    float64 array (after ``with_fields``, a user's update, an optimiser step) would
+    be traced and compiled twice.  The jitted entry points (TCA, EHL) canonicalise
+    their pytree arguments with this (values unchanged; tracers pass through).
+    """
+    def leaf(v):
+        if isinstance(v, (bool, int)) or not jnp.issubdtype(jnp.result_type(v), jnp.floating):
+            return v
+        return jnp.asarray(v, jnp.float64)
+    return jax.tree_util.tree_map(leaf, tree)

@@ -39,7 +39,10 @@ def _objectives(f, design, mis):
 
 def _check(f, design, fields, mis=None, rel_step=1e-4):
     mis = gj.Misalignment.zero() if mis is None else mis
-    g = jax.jit(_objectives(f, design, mis))
+    # values (nominal and the difference quotients) by eager calls of ``f``, which
+    # runs the TCA's own compiled program (compiled once, shared with the nominal
+    # call); the derivative by one jitted forward-mode program
+    g = _objectives(f, design, mis)
     allf = {**gj.get_fields(design), **{"mis." + k: v for k, v in gj.get_fields(mis).items()}}
     x0 = {k: jnp.asarray(allf[k], float) for k in fields}
     base = np.asarray(g(x0))

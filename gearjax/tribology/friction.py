@@ -103,9 +103,9 @@ def make_surface(sigma_um, density_per_mm2=1.0e4, beta_um=10.0, f_c=0.1, v_slip_
     if not (0.005 <= ebs <= 0.2):
         warnings.warn(f"Greenwood-Tripp asperity model: eta_s*beta*sigma = {ebs:g} is outside "
                       "the range 0.005..0.2 typical of engineering surfaces", stacklevel=2)
-    return Surface(jnp.asarray(float(sigma_um) * 1e-3), jnp.asarray(float(density_per_mm2)),
-                   jnp.asarray(float(beta_um) * 1e-3), jnp.asarray(float(f_c)),
-                   jnp.asarray(float(v_slip_mm_s)))
+    f = lambda v: jnp.asarray(float(v), jnp.float64)
+    return Surface(f(float(sigma_um) * 1e-3), f(density_per_mm2), f(float(beta_um) * 1e-3),
+                   f(f_c), f(v_slip_mm_s))
 
 
 class FrictionResult(NamedTuple):

@@ -106,8 +106,8 @@ def make_oil(eta0, alpha_per_GPa=None, tau0_MPa=5.0, rho0=880.0, name="custom", 
     if not (5.0 <= float(alpha_per_GPa) <= 40.0):
         warnings.warn(f"alpha = {float(alpha_per_GPa):g} 1/GPa is outside the range 5..40 1/GPa "
                       "of the Hamrock-Dowson film-thickness fits", stacklevel=2)
-    return Oil(jnp.asarray(float(eta0)), jnp.asarray(float(z)),
-               jnp.asarray(float(tau0_MPa)), jnp.asarray(float(rho0)), name)
+    f = lambda v: jnp.asarray(float(v), jnp.float64)      # strongly typed leaves
+    return Oil(f(eta0), f(z), f(tau0_MPa), f(rho0), name)
 
 
 def math_eta_inf() -> float:

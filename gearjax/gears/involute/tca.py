@@ -47,9 +47,11 @@ import jax.numpy as jnp
 import numpy as np
 
 from gearjax.errors import check_range
-from gearjax.gears.involute.geometry import InvolutePair, generated_flank, pair_geometry
+from gearjax.gears.involute.geometry import (InvolutePair, generated_flank, pair_geometry,
+                                             rack_family, rack_family_data, rack_psi0)
 from gearjax.surfaces import GeneratedSurface
-from gearjax.tca_result import TCAResult, check_side, contact_kinematics, register_family
+from gearjax.tca_result import (TCAResult, check_side, contact_kinematics, register_family,
+                                strong_float64)
 from gearjax.tca import (DEFAULT_APPROACH, Assembly, ContactPath, Misalignment, MultiPair,
                   contact_path, multi_pair, check_on_flank_converged, check_tca_options)
 
@@ -85,8 +87,8 @@ class InvoluteTCA:
         da = check_range("dalpha", dalpha_deg, -5.0, 5.0, unit="deg")
         a = check_range("profile_crown", profile_crown, 0.0, 0.1, unit="1/mm")
         c = check_range("lead_crown", lead_crown, 0.0, 0.1, unit="1/mm")
-        return cls(pair, jnp.asarray(da * (np.pi / 180.0)), jnp.asarray(a), jnp.asarray(c),
-                   jnp.asarray(b))
+        f = lambda v: jnp.asarray(v, jnp.float64)          # strongly typed leaves
+        return cls(pair, f(da * (np.pi / 180.0)), f(a), f(c), f(b))
 
 
 def crowned_pinion_flank(des: InvoluteTCA, side: int) -> GeneratedSurface:
@@ -94,9 +96,6 @@ def crowned_pinion_flank(des: InvoluteTCA, side: int) -> GeneratedSurface:
     :func:`gearjax.gears.involute.geometry.generated_flank`)."""
     p = des.pair
     alpha = p.pressure_angle + des.dalpha
-    base = generated_flank(p.module, alpha, p.helix, p.x1, p.z1, side)
-    m_t = p.module / jnp.cos(p.helix)
-    r = 0.5 * p.z1 * m_t
     beta = p.helix
     # unit normal of the rack plane pointing to +x (into the rack tooth of flank +1)
     e_prof = jnp.stack([-side * jnp.sin(alpha) * jnp.cos(beta), jnp.cos(alpha),
@@ -104,16 +103,11 @@ def crowned_pinion_flank(des: InvoluteTCA, side: int) -> GeneratedSurface:
     e_lead = jnp.stack([jnp.sin(beta), jnp.zeros_like(beta), jnp.cos(beta)])
     nr = jnp.cross(e_prof, e_lead)
     nr = nr / jnp.linalg.norm(nr) * jnp.sign(nr[0])
-
-    def family(uv, psi):
-        q = base.family(uv, jnp.zeros_like(psi))          # rack point at psi = 0 (rack frame)
-        dq = -side * (des.profile_crown * uv[0] ** 2 + des.lead_crown * uv[1] ** 2) * nr
-        pr = q + dq
-        X = pr[0] - r * psi
-        c, s = jnp.cos(psi), jnp.sin(psi)
-        return jnp.stack([c * X + s * pr[1], -s * X + c * pr[1], pr[2]])
-
-    return GeneratedSurface(family, base.psi0)
+    # rack point moved by -side (c_u u^2 + c_v v^2) along nr (profile and lead crown)
+    k = rack_family_data(p.module, alpha, beta, p.x1, p.z1, side, crown_dir=-side * nr,
+                         crowns=jnp.stack([des.profile_crown, des.lead_crown]))
+    P = jax.tree_util.Partial
+    return GeneratedSurface(P(rack_family, k), P(rack_psi0, k))
 
 
 def involute_assembly(pair: InvolutePair) -> Assembly:
@@ -203,11 +197,15 @@ def involute_tca_traced(des: InvoluteTCA, mis: Misalignment, *, side: int = -1,
                         line_contact=line_contact, approach=approach)
     path = path._replace(converged=path.converged & ok)
     margin, _ = involute_margin(des, path)
-    multi = multi_pair(path, margin, steps_per_pitch, p.z1, drive=(side == -1), n_pairs=n_pairs)
+    multi = multi_pair(path, margin, steps_per_pitch, p.z1, drive=(side < 0), n_pairs=n_pairs)
     return path, margin, multi
 
 
-@partial(jax.jit, static_argnames=("side", "steps_per_pitch", "half_pitches", "line_contact",
+# the side code (-1 drive, +1 coast) enters the flanks and the envelope only as a
+# number: it is a traced argument of the jitted programs, so the drive and the coast
+# side of a pair share one compiled program
+
+@partial(jax.jit, static_argnames=("steps_per_pitch", "half_pitches", "line_contact",
                                    "n_pairs"))
 def _involute_tca_jit(des, mis, side, steps_per_pitch, half_pitches, line_contact, n_pairs,
                       approach):
@@ -233,8 +231,9 @@ def involute_tca(des: InvoluteTCA, mis: Misalignment | None = None, *, side: int
         mis = Misalignment.zero()
     if line_contact is None:
         line_contact = float(des.lead_crown) == 0.0
-    out = _involute_tca_jit(des, mis, side, int(steps_per_pitch), float(half_pitches),
-                            bool(line_contact), int(n_pairs), float(approach))
+    out = _involute_tca_jit(strong_float64(des), strong_float64(mis), float(side),
+                            int(steps_per_pitch),
+                            float(half_pitches), bool(line_contact), int(n_pairs), float(approach))
     if strict:
         path, margin, _ = out
         check_on_flank_converged(path, margin)
@@ -260,7 +259,7 @@ def tca_summary(path: ContactPath, multi: MultiPair):
                       path.axial2[mid], path.radial2[mid], path.semi_major[mid]])
 
 
-@partial(jax.jit, static_argnames=("side", "steps_per_pitch", "half_pitches", "line_contact"))
+@partial(jax.jit, static_argnames=("steps_per_pitch", "half_pitches", "line_contact"))
 def _sensitivity_jit(des, mis, side, steps_per_pitch, half_pitches, line_contact):
     def f(d, m):
         path, _, multi = involute_tca_traced(d, m, side=side, steps_per_pitch=steps_per_pitch,
@@ -288,8 +287,9 @@ def misalignment_sensitivity(des: InvoluteTCA, mis: Misalignment | None = None, 
         mis = Misalignment.zero()
     if line_contact is None:
         line_contact = float(des.lead_crown) == 0.0
-    vals, (jac_des, jac) = _sensitivity_jit(des, mis, side, int(steps_per_pitch),
-                                            float(half_pitches), bool(line_contact))
+    vals, (jac_des, jac) = _sensitivity_jit(strong_float64(des), strong_float64(mis), float(side),
+                                            int(steps_per_pitch), float(half_pitches),
+                                            bool(line_contact))
     values = {k: float(v) for k, v in zip(SUMMARY_KEYS, np.asarray(vals))}
     table = {k: {name: float(np.asarray(getattr(jac, name))[i])
                  for name in ("dE", "dP", "dG", "dSigma")} for i, k in enumerate(SUMMARY_KEYS)}
@@ -312,13 +312,11 @@ def _side_code(side: str) -> int:
     return -1 if side == "drive" else 1
 
 
-def involute_result_traced(des: InvoluteTCA, mis: Misalignment, *, side: str = "drive",
-                           steps_per_pitch: int = 24, half_pitches: float = 1.25,
-                           line_contact: bool = True, n_pairs: int = 3,
-                           approach=DEFAULT_APPROACH, kinematics: bool = True) -> TCAResult:
-    """:func:`involute_tca_traced` as a :class:`~gearjax.tca_result.TCAResult` with the
-    kinematics at the contact points (traceable; ``side`` "drive"/"coast")."""
-    code = _side_code(side)
+def _result_parts(des: InvoluteTCA, mis: Misalignment, code, *, steps_per_pitch: int,
+                  half_pitches: float, line_contact: bool, n_pairs: int, approach,
+                  kinematics: bool):
+    """``(path, margin, multi, coords, kinematics)`` of the TCA of side ``code`` (-1
+    drive, +1 coast; may be traced)."""
     path, margin, multi = involute_tca_traced(des, mis, side=code, steps_per_pitch=steps_per_pitch,
                                               half_pitches=half_pitches, line_contact=line_contact,
                                               n_pairs=n_pairs, approach=approach)
@@ -330,16 +328,35 @@ def involute_result_traced(des: InvoluteTCA, mis: Misalignment, *, side: str = "
         r2 = generated_flank(p.module, p.pressure_angle, -p.helix, p.x2, p.z2, code)
         kin = contact_kinematics(r1, r2, involute_assembly(p), mis, path,
                                  line_contact=line_contact)
-    return TCAResult(path, margin, multi, {"margin_parts": parts}, kin, side, "involute")
+    return path, margin, multi, {"margin_parts": parts}, kin
 
 
-@partial(jax.jit, static_argnames=("side", "steps_per_pitch", "half_pitches", "line_contact",
+def involute_result_traced(des: InvoluteTCA, mis: Misalignment, *, side: str = "drive",
+                           steps_per_pitch: int = 24, half_pitches: float = 1.25,
+                           line_contact: bool = True, n_pairs: int = 3,
+                           approach=DEFAULT_APPROACH, kinematics: bool = True) -> TCAResult:
+    """:func:`involute_tca_traced` as a :class:`~gearjax.tca_result.TCAResult` with the
+    kinematics at the contact points (traceable; ``side`` "drive"/"coast")."""
+    parts = _result_parts(des, mis, float(_side_code(side)), steps_per_pitch=steps_per_pitch,
+                          half_pitches=half_pitches, line_contact=line_contact,
+                          n_pairs=n_pairs, approach=approach, kinematics=kinematics)
+    return TCAResult(*parts, side, "involute")
+
+
+@partial(jax.jit, static_argnames=("steps_per_pitch", "half_pitches", "line_contact",
                                    "n_pairs", "kinematics"))
-def _result_jit(des, mis, approach, *, side, steps_per_pitch, half_pitches, line_contact,
+def _result_jit(des, mis, approach, code, *, steps_per_pitch, half_pitches, line_contact,
                 n_pairs, kinematics):
-    return involute_result_traced(des, mis, side=side, steps_per_pitch=steps_per_pitch,
-                                  half_pitches=half_pitches, line_contact=line_contact,
-                                  n_pairs=n_pairs, approach=approach, kinematics=kinematics)
+    return _result_parts(des, mis, code, steps_per_pitch=steps_per_pitch,
+                         half_pitches=half_pitches, line_contact=line_contact, n_pairs=n_pairs,
+                         approach=approach, kinematics=kinematics)
+
+
+def _result(des, mis, approach, side, **static) -> TCAResult:
+    """The jitted TCA of ``side`` (one program for both sides) as a TCAResult."""
+    parts = _result_jit(strong_float64(des), strong_float64(mis), approach,
+                        float(_side_code(side)), **static)
+    return TCAResult(*parts, side, "involute")
 
 
 class _Adapter:
@@ -359,10 +376,10 @@ class _Adapter:
         side = check_side(side)
         check_tca_options(steps_per_pitch, half_pitches, n_pairs, approach)
         mis = Misalignment.zero() if mis is None else mis
-        res = _result_jit(des, mis, float(approach), side=side,
-                          steps_per_pitch=int(steps_per_pitch), half_pitches=float(half_pitches),
-                          line_contact=self._options(des, line_contact), n_pairs=int(n_pairs),
-                          kinematics=bool(kinematics))
+        res = _result(des, mis, float(approach), side,
+                      steps_per_pitch=int(steps_per_pitch), half_pitches=float(half_pitches),
+                      line_contact=self._options(des, line_contact), n_pairs=int(n_pairs),
+                      kinematics=bool(kinematics))
         if strict:
             check_on_flank_converged(res.path, res.margin)
         return res
@@ -374,11 +391,13 @@ class _Adapter:
         lc = self._options(des, line_contact)
 
         def f(d, mis=None):
+            # the jitted program of ``run`` (composable: inside a user's jit/grad/vmap
+            # it is traced once and inlined; called eagerly it runs compiled, not op
+            # by op)
             mis = Misalignment.zero() if mis is None else mis
-            return involute_result_traced(d, mis, side=side, steps_per_pitch=int(steps_per_pitch),
-                                          half_pitches=float(half_pitches), line_contact=lc,
-                                          n_pairs=int(n_pairs), approach=approach,
-                                          kinematics=kinematics)
+            return _result(d, mis, approach, side, steps_per_pitch=int(steps_per_pitch),
+                           half_pitches=float(half_pitches), line_contact=lc,
+                           n_pairs=int(n_pairs), kinematics=bool(kinematics))
         return f
 
     def sensitivity(self, des, mis=None, *, side="drive", steps_per_pitch=24,

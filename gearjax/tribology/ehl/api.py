@@ -34,6 +34,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from gearjax.errors import ConvergenceError, check_range
+from gearjax.fields import strong_float64
 from gearjax.tribology.ehl.grid import EHLGrid, make_grid
 from gearjax.tribology.ehl.implicit import attach_implicit_gradient
 from gearjax.tribology.ehl.model import EHLCase, fields, make_case, scales, unpack
@@ -100,6 +101,7 @@ def ehl_traced(case: EHLCase, grid: EHLGrid, angle_deg: float = 0.0, mixed: bool
     ``continuation`` : tuple of λ multipliers (static), see the module docstring.
     ``x0`` : optional start state (default: Hertz pressure, Hamrock–Dowson H0).
     """
+    case = strong_float64(case)          # one compiled solve for every case
     cs = jax.lax.stop_gradient(case)
     st = solve_state(cs, grid, angle_deg, mixed, tol=tol, max_steps=max_steps,
                      continuation=tuple(continuation), x0=x0)

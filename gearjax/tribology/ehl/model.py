@@ -108,7 +108,7 @@ def make_case(F, u_e, u_s, Rx, Ry, eta0, alpha_per_GPa, E_prime=226373.6, tau0_M
     check_positive("v_slip", v_slip_mm_s, "mm/s")
     vals = (F, u_e, u_s, Rx, Ry, eta0, float(alpha_per_GPa) * 1e-3, E_prime, tau0_MPa,
             float(sigma_um) * 1e-3, density_per_mm2, float(beta_um) * 1e-3, f_c, v_slip_mm_s)
-    case = EHLCase(*(jnp.asarray(float(v)) for v in vals))
+    case = EHLCase(*(jnp.asarray(float(v), jnp.float64) for v in vals))
     p_h = float(_scales_jit(case).p_h)
     check_range("p_max (Hertz)", p_h, 50.0, 3500.0, unit="MPa")
     return case
