@@ -266,6 +266,29 @@ class GeneratedSurface:
         psi = self._solve(uv).x
         return self.family(uv, psi), unit_normal(lambda q: self.family(q, psi), uv)
 
+    def at(self, uv, psi):
+        """``(point, tool normal, meshing residual)`` at a *given* motion parameter
+        ``psi`` -- explicit, no envelope solve (one forward-mode pass).  On the
+        envelope, i.e. where the residual ``n . dr_w/dpsi`` is 0, point and normal are
+        those of the generated surface: a contact analysis can carry ``psi`` as an
+        unknown with the meshing equation beside its contact equations instead of
+        nesting the envelope solve (Litvin & Fuentes ch. 9)."""
+        uv = jnp.asarray(uv, float)
+        psi = jnp.asarray(psi, float)
+        if _cacheable(self):
+            return _surface_at_jit("at", self.family, uv, psi)
+        return _at_impl(self.family, uv, psi)
+
+    def local_geometry_at(self, uv, psi) -> "LocalGeometry":
+        """:func:`local_geometry` of the generated surface at ``uv`` given the solved
+        motion parameter ``psi`` of that point (no envelope solve; ``psi`` must satisfy
+        the meshing equation)."""
+        uv = jnp.asarray(uv, float)
+        psi = jnp.asarray(psi, float)
+        if _cacheable(self):
+            return _surface_at_jit("geometry", self.family, uv, psi)
+        return _generated_local_geometry_at(self, uv, psi)
+
 
 # --------------------------------------------------------------------------- trace once
 #
@@ -303,6 +326,20 @@ def _surface_jit(what, opts, family, psi0, uv):
     return _generated_local_geometry_impl(surf, uv)
 
 
+def _at_impl(family, uv, psi):
+    J, v = jax.jacfwd(family, argnums=(0, 1))(uv, psi)
+    N = jnp.cross(J[:, 0], J[:, 1])
+    n = N / jnp.linalg.norm(N)
+    return family(uv, psi), n, jnp.dot(n, v)
+
+
+@partial(jax.jit, static_argnums=(0,))
+def _surface_at_jit(what, family, uv, psi):
+    if what == "at":
+        return _at_impl(family, uv, psi)
+    return _generated_local_geometry_at(GeneratedSurface(family, 0.0), uv, psi)
+
+
 def _generated_local_geometry(surf: GeneratedSurface, uv) -> LocalGeometry:
     uv = jnp.asarray(uv, float)
     if _cacheable(surf):
@@ -326,7 +363,11 @@ def _generated_local_geometry_impl(surf: GeneratedSurface, uv) -> LocalGeometry:
     order).  Derivatives with respect to anything the family closes over flow
     through ``psi*`` (custom JVP of the solve) and ``g``.
     """
-    psi = surf._solve(uv).x
+    return _generated_local_geometry_at(surf, uv, surf._solve(uv).x)
+
+
+def _generated_local_geometry_at(surf: GeneratedSurface, uv, psi) -> LocalGeometry:
+    """The body of :func:`_generated_local_geometry_impl` at a solved ``psi``."""
     z = jnp.concatenate([uv, jnp.reshape(psi, (1,))])
 
     def g(z):

@@ -84,7 +84,8 @@ from gearjax.errors import ConvergenceError, check_int, check_range, require_con
 from gearjax.newton import newton_solve
 from gearjax.surfaces import GeneratedSurface, local_geometry, unit_normal
 
-__all__ = ["Misalignment", "Assembly", "contact_equations", "point_normal", "gear_mount",
+__all__ = ["Misalignment", "Assembly", "contact_equations", "contact_system", "ContactSystem",
+           "local_geometry_on", "point_normal", "gear_mount",
            "ContactPath", "contact_path", "te_arcsec", "require_path",
            "ARCSEC", "ellipse_from_weingarten", "rotation_about", "relative_curvature",
            "MultiPair", "multi_pair", "DEFAULT_APPROACH", "NoContactError",
@@ -114,7 +115,7 @@ class Misalignment:
 
     @classmethod
     def zero(cls):
-        z = jnp.asarray(0.0)
+        z = jnp.asarray(0.0, float)
         return cls(z, z, z, z)
 
     @classmethod
@@ -173,6 +174,13 @@ class ContactPath(NamedTuple):
     major_dir : (N, 3) unit direction of the major axis (fixed frame).
     residual : max |F| of the contact solve (mm / dimensionless).
     converged : Newton converged (and the residual is finite).
+    weingarten1, weingarten2 : (N, 3, 3) Weingarten maps of pinion and gear flank in
+        the fixed frame for the common normal ``normal`` (1/mm; ``dn = W dr``), the
+        curvatures the ellipses come from; the kinematics at the contact points reuse
+        them.  ``None`` in paths built by hand.
+    psi1, psi2 : (N,) motion parameter of the generating tool at the contact point of a
+        generated flank (:class:`~gearjax.surfaces.GeneratedSurface`; NaN for another
+        flank), solved with the contact (:func:`contact_system`).
     """
 
     phi1: jnp.ndarray
@@ -193,6 +201,10 @@ class ContactPath(NamedTuple):
     major_dir: jnp.ndarray
     residual: jnp.ndarray
     converged: jnp.ndarray
+    weingarten1: jnp.ndarray | None = None
+    weingarten2: jnp.ndarray | None = None
+    psi1: jnp.ndarray | None = None
+    psi2: jnp.ndarray | None = None
 
 
 def te_arcsec(te_rad):
@@ -256,36 +268,54 @@ def point_normal(surf, uv):
     return surf(uv), unit_normal(surf, uv)
 
 
-def _solve_grid(F, xs_ref, phis, tol, max_steps):
-    """Continuation over ``phis`` from ``xs_ref`` with a linear predictor (lax.scan)."""
+def _solve_grid(F, x_prev, x_prev2, phis, tol, max_steps):
+    """Continuation over ``phis`` (lax.scan): each solve starts from the linear
+    predictor ``2 x_prev - x_prev2`` of the two previous points of the path.  A step
+    that fails keeps ``x_prev`` and drops the predictor (``x_prev2 = x_prev``) for the
+    next step."""
 
     def step(carry, phi):
         x_prev, x_prev2 = carry
         pred = jax.lax.stop_gradient(2.0 * x_prev - x_prev2)
         sol = newton_solve(F, pred, phi, tol=tol, max_steps=max_steps)
         ok = sol.converged
-        x_next = jnp.where(ok, sol.x, x_prev)
-        # the first solve (reference) starts from the guess itself: no predictor yet
-        first = jnp.all(x_prev == x_prev2)
-        return (x_next, jnp.where(ok & jnp.logical_not(first), x_prev, x_next)), sol
+        return (jnp.where(ok, sol.x, x_prev), x_prev), sol
 
-    _, sols = jax.lax.scan(step, (xs_ref, xs_ref), phis)
+    _, sols = jax.lax.scan(step, (x_prev, x_prev2), phis)
     return sols
 
 
-def contact_equations(r1: Callable, r2: Callable, asm: Assembly, mis: Misalignment,
-                      line_contact: bool, v1_fixed=0.0):
-    """The contact system ``F(x, phi1)`` of the module docstring, with ``unpack`` and
-    ``pack`` between the solver unknowns and ``(uv1, uv2, phi2)`` / the 5-vector.
+def path_tangent(F, x, phi):
+    """``dx/dphi = -F_x^{-1} F_phi`` of the root ``x(phi)`` of ``F(x, phi) = 0`` at a
+    solved point (no derivative flows through it): the first-order predictor of a
+    continuation step."""
+    x = jax.lax.stop_gradient(x)
+    phi = jax.lax.stop_gradient(phi)
+    J = jax.jacfwd(F)(x, phi)
+    _, F_phi = jax.jvp(lambda p: F(x, p), (phi,), (jnp.ones_like(phi),))
+    return -jnp.linalg.solve(J, F_phi)
 
-    Point contact: x = (u1, v1, u2, v2, phi2), 5 equations.  Line contact: x =
-    (u1, u2, v2, phi2) with ``v1 = v1_fixed``, 4 equations.  Position equations in
-    mm, normal equations dimensionless.
-    """
-    R, c = gear_mount(asm, mis)
+
+def _contact_residual(asm_mount, mis, line_contact, ph1, ph2, q1, m1, q2, m2):
+    """The 5 (line contact: 4) contact equations of the module docstring from the two
+    flanks' body-frame points and normals."""
+    R, c = asm_mount
     ez = jnp.array([0.0, 0.0, 1.0])
-    k2 = R[:, 2]
+    R1 = matrix_z(ph1)
+    R2 = R @ matrix_z(ph2)
+    p1 = R1 @ q1 + mis.dP * ez
+    p2 = c + R2 @ q2
+    n1 = R1 @ m1
+    n2 = R2 @ m2
+    ta = jnp.cross(R[:, 2], n2)
+    ta = ta / jnp.linalg.norm(ta)
+    if line_contact:
+        return jnp.concatenate([p1 - p2, jnp.stack([jnp.dot(n1, ta)])])
+    tb = jnp.cross(n2, ta)
+    return jnp.concatenate([p1 - p2, jnp.stack([jnp.dot(n1, ta), jnp.dot(n1, tb)])])
 
+
+def _packing(line_contact, v1_fixed):
     def unpack(x):
         if line_contact:
             return jnp.stack([x[0], jnp.asarray(v1_fixed, float)]), x[1:3], x[3]
@@ -295,25 +325,106 @@ def contact_equations(r1: Callable, r2: Callable, asm: Assembly, mis: Misalignme
         if line_contact:
             return jnp.stack([x5[0], x5[2], x5[3], x5[4]])
         return x5
+    return unpack, pack
+
+
+def contact_equations(r1: Callable, r2: Callable, asm: Assembly, mis: Misalignment,
+                      line_contact: bool, v1_fixed=0.0):
+    """The contact system ``F(x, phi1)`` of the module docstring, with ``unpack`` and
+    ``pack`` between the solver unknowns and ``(uv1, uv2, phi2)`` / the 5-vector.
+
+    Point contact: x = (u1, v1, u2, v2, phi2), 5 equations.  Line contact: x =
+    (u1, u2, v2, phi2) with ``v1 = v1_fixed``, 4 equations.  Position equations in
+    mm, normal equations dimensionless.  A generated flank's point and normal come
+    from its envelope solve (nested); :func:`contact_system` carries the motion
+    parameters as unknowns instead.
+    """
+    mount = gear_mount(asm, mis)
+    unpack, pack = _packing(line_contact, v1_fixed)
 
     def F(x, ph1):
         uv1, uv2, ph2 = unpack(x)
-        R1 = matrix_z(ph1)
-        R2 = R @ matrix_z(ph2)
         q1, m1 = point_normal(r1, uv1)
         q2, m2 = point_normal(r2, uv2)
-        p1 = R1 @ q1 + mis.dP * ez
-        p2 = c + R2 @ q2
-        n1 = R1 @ m1
-        n2 = R2 @ m2
-        ta = jnp.cross(k2, n2)
-        ta = ta / jnp.linalg.norm(ta)
-        if line_contact:
-            return jnp.concatenate([p1 - p2, jnp.stack([jnp.dot(n1, ta)])])
-        tb = jnp.cross(n2, ta)
-        return jnp.concatenate([p1 - p2, jnp.stack([jnp.dot(n1, ta), jnp.dot(n1, tb)])])
+        return _contact_residual(mount, mis, line_contact, ph1, ph2, q1, m1, q2, m2)
 
     return F, unpack, pack
+
+
+class ContactSystem(NamedTuple):
+    """The contact equations with the envelope parameters as unknowns
+    (:func:`contact_system`).  ``F(z, phi1)``; ``split(z) -> (x, psi1, psi2)`` and
+    ``join(x, psi1, psi2) -> z`` (``psi_i`` is ``None`` for a flank that is not a
+    :class:`~gearjax.surfaces.GeneratedSurface`); ``unpack``/``pack`` as in
+    :func:`contact_equations`; ``point1(z, phi1)`` the pinion contact point in the
+    fixed frame."""
+
+    F: Callable
+    split: Callable
+    join: Callable
+    unpack: Callable
+    pack: Callable
+    point1: Callable
+
+
+def contact_system(r1: Callable, r2: Callable, asm: Assembly, mis: Misalignment,
+                   line_contact: bool, v1_fixed=0.0) -> ContactSystem:
+    """The contact system with each generated flank's motion parameter ``psi_i`` as an
+    unknown and its meshing equation ``n_i . dr_i/dpsi_i = 0`` beside the contact
+    equations (Litvin & Fuentes ch. 9): unknowns ``z = (x, psi1, psi2)`` (the
+    ``psi`` of the generated flanks only), equations the 5 (4) of
+    :func:`contact_equations` and one meshing equation per generated flank (mm/rad).
+    Same roots and the same implicit derivatives as the nested form (where a root
+    satisfies the meshing equations, point and tool normal are the envelope's), but
+    every function inside the Newton iteration is explicit -- no envelope solve
+    nested in the contact solve, its Jacobian or its derivative rule.
+    """
+    mount = gear_mount(asm, mis)
+    unpack, pack = _packing(line_contact, v1_fixed)
+    gen = (isinstance(r1, GeneratedSurface), isinstance(r2, GeneratedSurface))
+    nx = 4 if line_contact else 5
+
+    def split(z):
+        x, i, psis = z[:nx], nx, []
+        for g in gen:
+            psis.append(z[i] if g else None)
+            i += int(g)
+        return x, psis[0], psis[1]
+
+    def join(x, psi1, psi2):
+        extra = [jnp.reshape(p, (1,)) for g, p in zip(gen, (psi1, psi2)) if g]
+        return jnp.concatenate([x] + extra)
+
+    def flank(r, uv, psi):
+        if psi is None:
+            q, m = point_normal(r, uv)
+            return q, m, None
+        return r.at(uv, psi)
+
+    def F(z, ph1):
+        x, psi1, psi2 = split(z)
+        uv1, uv2, ph2 = unpack(x)
+        q1, m1, f1 = flank(r1, uv1, psi1)
+        q2, m2, f2 = flank(r2, uv2, psi2)
+        eqs = _contact_residual(mount, mis, line_contact, ph1, ph2, q1, m1, q2, m2)
+        mesh = [jnp.reshape(f, (1,)) for f in (f1, f2) if f is not None]
+        return jnp.concatenate([eqs] + mesh)
+
+    def point1(z, ph1):
+        x, psi1, _ = split(z)
+        uv1 = unpack(x)[0]
+        q1 = r1(uv1) if psi1 is None else r1.family(uv1, psi1)
+        return matrix_z(ph1) @ q1 + mis.dP * jnp.array([0.0, 0.0, 1.0])
+
+    return ContactSystem(F, split, join, unpack, pack, point1)
+
+
+def local_geometry_on(r, uv, psi):
+    """Local geometry of a flank at ``uv`` (at the solved motion ``psi`` of a generated
+    flank: no envelope solve)."""
+    if psi is None:
+        return local_geometry(r, uv)
+    return r.local_geometry_at(uv, psi)
 
 
 def contact_path(r1: Callable, r2: Callable, asm: Assembly, mis: Misalignment, phi1,
@@ -339,27 +450,37 @@ def contact_path(r1: Callable, r2: Callable, asm: Assembly, mis: Misalignment, p
     R, c = gear_mount(asm, mis)
     ez = jnp.array([0.0, 0.0, 1.0])
     v1_fixed = jax.lax.stop_gradient(jnp.asarray(x_ref)[1])
-    F, unpack, pack = contact_equations(r1, r2, asm, mis, line_contact, v1_fixed)
+    cs = contact_system(r1, r2, asm, mis, line_contact, v1_fixed)
 
-    def frames(x, ph1):
-        uv1, uv2, ph2 = unpack(x)
-        return uv1, uv2, ph2, matrix_z(ph1), R @ matrix_z(ph2)
+    x_ref = jax.lax.stop_gradient(jnp.asarray(x_ref, float))
+    # start values of the motion parameters: the envelope solves at the guess
+    psi_ref = [jax.lax.stop_gradient(r.solve(uv).x) if isinstance(r, GeneratedSurface) else None
+               for r, uv in ((r1, x_ref[0:2]), (r2, x_ref[2:4]))]
+    z0 = cs.join(cs.pack(x_ref), *psi_ref)
+    # the reference contact, then one scan vmapped over the two directions away from
+    # it; the first step of each starts from the tangent predictor at the reference
+    # (a virtual previous point one grid step behind it), later steps from the
+    # linear predictor of the two previous points
+    ref = newton_solve(cs.F, z0, phi1[mid], tol=tol, max_steps=max_steps)
+    tangent = path_tangent(cs.F, ref.x, phi1[mid])
+    seqs = jnp.stack([phi1[mid + 1:], phi1[:mid][::-1]])
+    behind = ref.x[None, :] - (seqs[:, :1] - phi1[mid]) * tangent[None, :]
+    sols = jax.vmap(lambda x2, s: _solve_grid(cs.F, ref.x, x2, s, tol, max_steps))(behind, seqs)
 
-    x0 = jax.lax.stop_gradient(pack(jnp.asarray(x_ref, float)))
-    # one scan, vmapped over the two directions (forwards from the reference and
-    # backwards from it); both start by solving the reference point itself
-    seqs = jnp.stack([phi1[mid:], phi1[:mid + 1][::-1]])
-    sols = jax.vmap(lambda s: _solve_grid(F, x0, s, tol, max_steps))(seqs)
-    X = jnp.concatenate([sols.x[1, 1:mid + 1][::-1], sols.x[0]], axis=0)
-    res = jnp.concatenate([sols.residual[1, 1:mid + 1][::-1], sols.residual[0]])
-    conv = jnp.concatenate([sols.converged[1, 1:mid + 1][::-1], sols.converged[0]])
-    conv = conv & sols.converged[0, 0] & sols.converged[1, 0]
-    ref_x = sols.x[0, 0]
+    def whole(two_ways, at_ref):
+        return jnp.concatenate([two_ways[1][::-1], at_ref[None], two_ways[0]], axis=0)
 
-    def post(x, ph1):
-        uv1, uv2, ph2, R1, R2 = frames(x, ph1)
-        g1 = local_geometry(r1, uv1)
-        g2 = local_geometry(r2, uv2)
+    Z = whole(sols.x, ref.x)
+    res = whole(sols.residual, ref.residual)
+    conv = whole(sols.converged, ref.converged) & ref.converged
+    ref_x = cs.split(ref.x)[0]
+
+    def post(z, ph1):
+        x, psi1, psi2 = cs.split(z)
+        uv1, uv2, ph2 = cs.unpack(x)
+        R1, R2 = matrix_z(ph1), R @ matrix_z(ph2)
+        g1 = local_geometry_on(r1, uv1, psi1)
+        g2 = local_geometry_on(r2, uv2, psi2)
         n = R1 @ g1.n
         W1 = R1 @ g1.W @ R1.T
         n2 = R2 @ g2.n
@@ -369,9 +490,12 @@ def contact_path(r1: Callable, r2: Callable, asm: Assembly, mis: Misalignment, p
         p1b = g1.r
         p2b = g2.r
         point = R1 @ p1b + mis.dP * ez
-        return (ph2, uv1, uv2, point, n, p1b, p2b, a, b, major)
+        nan = jnp.full((), jnp.nan)
+        return (ph2, uv1, uv2, point, n, p1b, p2b, a, b, major, W1, W2,
+                nan if psi1 is None else psi1, nan if psi2 is None else psi2)
 
-    ph2, uv1, uv2, point, n, p1b, p2b, a, b, major = jax.vmap(post)(X, phi1)
+    (ph2, uv1, uv2, point, n, p1b, p2b, a, b, major, W1, W2, psi1,
+     psi2) = jax.vmap(post)(Z, phi1)
     ph2_0 = ref_x[-1]
     rho = asm.z1 / asm.z2
     te = asm.ratio_sign * (ph2 - ph2_0) - rho * (phi1 - phi1[mid])
@@ -380,7 +504,7 @@ def contact_path(r1: Callable, r2: Callable, asm: Assembly, mis: Misalignment, p
     rad1 = jnp.linalg.norm(p1b[:, :2], axis=1)
     rad2 = jnp.linalg.norm(p2b[:, :2], axis=1)
     return ContactPath(phi1, ph2, te, uv1, uv2, point, n, p1b, p2b, p1b[:, 2], rad1,
-                       p2b[:, 2], rad2, a, b, major, res, conv)
+                       p2b[:, 2], rad2, a, b, major, res, conv, W1, W2, psi1, psi2)
 
 
 class MultiPair(NamedTuple):
@@ -445,7 +569,7 @@ def multi_pair(path: ContactPath, margin, steps_per_pitch: int, z1: int, drive: 
 
     te_pairs = jnp.stack([shifted(te0, k, jnp.nan) for k in ks])
     inside = jnp.stack([shifted(inside0, k, False) for k in ks])
-    sgn = 1.0 if drive else -1.0
+    sgn = jnp.where(drive, 1.0, -1.0)        # ``drive`` may be traced
     key = jnp.where(inside, sgn * te_pairs, -jnp.inf)
     active = jnp.argmax(key, axis=0)
     env = sgn * jnp.max(key, axis=0)

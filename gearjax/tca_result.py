@@ -57,13 +57,14 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from gearjax.fields import strong_float64
 from gearjax.frames import matrix_z
 from gearjax.surfaces import local_geometry
 from gearjax.tca import (ARCSEC, Assembly, ContactPath, Misalignment, MultiPair, contact_equations,
-                         gear_mount, relative_curvature)
+                         contact_system, gear_mount, relative_curvature)
 
 __all__ = ["SIDES", "check_side", "TCAResult", "ContactKinematics", "contact_kinematics",
-           "contact_motion",
+           "contact_motion", "strong_float64",
            "register_family", "family_of"]
 
 #: the side convention of every family: the flank pair that transmits the load in
@@ -120,30 +121,45 @@ class ContactKinematics(NamedTuple):
 
 def contact_motion(r1: Callable, r2: Callable, asm: Assembly, mis: Misalignment,
                    line_contact: bool, v1_fixed):
-    """``motion(uv1, uv2, phi2, phi1, n) -> (r, v_c, dphi2, W1, W2)`` at one contact
-    point (traceable): the contact point ``r`` (fixed frame), its velocity
-    ``v_c = dr/dphi1`` and the gear speed ``dphi2/dphi1`` from the implicit derivative
-    of the contact equations (``dx/dphi1 = -F_x^-1 F_phi1``), and both flanks'
-    Weingarten maps in the fixed frame for the common normal ``n``.  Also returns the
-    gear mount ``(R, c)``."""
+    """``motion(uv1, uv2, phi2, phi1, n, W12=None, psi12=None) -> (r, v_c, dphi2, W1,
+    W2)`` at one contact point (traceable): the contact point ``r`` (fixed frame), its
+    velocity ``v_c = dr/dphi1`` and the gear speed ``dphi2/dphi1`` from the implicit
+    derivative of the contact equations (``dx/dphi1 = -F_x^-1 F_phi1``), and both
+    flanks' Weingarten maps in the fixed frame for the common normal ``n`` (computed
+    here unless given as ``W12``, e.g. those of the contact path).  With ``psi12``,
+    the generating motions of the contact on generated flanks (those of the contact
+    path), the derivative is taken of :func:`~gearjax.tca.contact_system` (explicit,
+    no envelope solve); without, of :func:`~gearjax.tca.contact_equations` (the
+    nested envelope solves).  Also returns the gear mount ``(R, c)``."""
     R, c = gear_mount(asm, mis)
     ez = jnp.array([0.0, 0.0, 1.0])
     F, unpack, pack = contact_equations(r1, r2, asm, mis, line_contact, v1_fixed)
+    cs = contact_system(r1, r2, asm, mis, line_contact, v1_fixed)
 
     def point(x, ph1):
         uv1, _, _ = unpack(x)
         return matrix_z(ph1) @ r1(uv1) + mis.dP * ez
 
-    def motion(uv1, uv2, ph2, ph1, n):
+    def motion(uv1, uv2, ph2, ph1, n, W12=None, psi12=None):
         x = pack(jnp.concatenate([uv1, uv2, jnp.stack([ph2])]))
-        Fx = jax.jacfwd(F, 0)(x, ph1)
-        Fp = jax.jacfwd(F, 1)(x, ph1)
-        dx = -jnp.linalg.solve(Fx, Fp)
-        r, v_c = jax.jvp(point, (x, ph1), (dx, jnp.ones_like(ph1)))
-        R1, R2 = matrix_z(ph1), R @ matrix_z(ph2)
-        g1, g2 = local_geometry(r1, uv1), local_geometry(r2, uv2)
-        W1 = jnp.sign(jnp.dot(R1 @ g1.n, n)) * (R1 @ g1.W @ R1.T)
-        W2 = jnp.sign(jnp.dot(R2 @ g2.n, n)) * (R2 @ g2.W @ R2.T)
+        # F_x and F_phi1 in one forward-mode pass
+        if psi12 is None:
+            Fx, Fp = jax.jacfwd(F, (0, 1))(x, ph1)
+            dx = -jnp.linalg.solve(Fx, Fp)
+            r, v_c = jax.jvp(point, (x, ph1), (dx, jnp.ones_like(ph1)))
+        else:
+            z = cs.join(x, *psi12)
+            Fz, Fp = jax.jacfwd(cs.F, (0, 1))(z, ph1)
+            dz = -jnp.linalg.solve(Fz, Fp)
+            r, v_c = jax.jvp(cs.point1, (z, ph1), (dz, jnp.ones_like(ph1)))
+            dx = cs.split(dz)[0]
+        if W12 is None:
+            R1, R2 = matrix_z(ph1), R @ matrix_z(ph2)
+            g1, g2 = local_geometry(r1, uv1), local_geometry(r2, uv2)
+            W1 = jnp.sign(jnp.dot(R1 @ g1.n, n)) * (R1 @ g1.W @ R1.T)
+            W2 = jnp.sign(jnp.dot(R2 @ g2.n, n)) * (R2 @ g2.W @ R2.T)
+        else:
+            W1, W2 = W12
         return r, v_c, dx[-1], W1, W2
 
     return motion, (R, c)
@@ -163,8 +179,8 @@ def contact_kinematics(r1: Callable, r2: Callable, asm: Assembly, mis: Misalignm
     k2 = R[:, 2]
     ez = jnp.array([0.0, 0.0, 1.0])
 
-    def one(uv1, uv2, ph2, ph1, n, major):
-        r, v_c, dph2, W1, W2 = motion(uv1, uv2, ph2, ph1, n)
+    def one(uv1, uv2, ph2, ph1, n, major, W12, psi12):
+        r, v_c, dph2, W1, W2 = motion(uv1, uv2, ph2, ph1, n, W12, psi12)
         e = major - jnp.dot(major, n) * n
         e = e / jnp.linalg.norm(e)
         t = jnp.cross(n, e)
@@ -187,7 +203,12 @@ def contact_kinematics(r1: Callable, r2: Callable, asm: Assembly, mis: Misalignm
                 jnp.arctan2(jnp.dot(we, A[:, 1]), jnp.dot(we, t)), 1.0 / kx, r_y, t, v_c,
                 dph2)
 
-    out = jax.vmap(one)(path.uv1, path.uv2, path.phi2, path.phi1, path.normal, path.major_dir)
+    # the flanks' curvatures at the contact points are those of the path (its ellipses)
+    W12 = None if path.weingarten1 is None else (path.weingarten1, path.weingarten2)
+    # and so are the generating motions of the contact on generated flanks
+    psi12 = None if path.psi1 is None else (path.psi1, path.psi2)
+    out = jax.vmap(one)(path.uv1, path.uv2, path.phi2, path.phi1, path.normal, path.major_dir,
+                        W12, psi12)
     return ContactKinematics(*out)
 
 

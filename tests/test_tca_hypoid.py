@@ -231,7 +231,7 @@ def test_misaligned_contact_points_coincide_in_the_fixed_frame(conjugate, point_
     2e-15; tolerance 1e-9); the reported point is that point (3e-14 mm)."""
     pair = _modified(conjugate, 2.0, 0.02)
     vals = (0.05, 0.1, -0.1, 2e-4)
-    res = point_tca(pair, Misalignment(*(jnp.asarray(v) for v in vals)))
+    res = point_tca(pair, Misalignment(*(jnp.asarray(v, float) for v in vals)))
     p = res.path
     r1 = jax.jit(partial(_point_and_jacobian, th.flank_function(pair.pinion, pair.pinion_crossing)))
     r2 = jax.jit(partial(_point_and_jacobian, th.flank_function(pair.gear, pair.gear_crossing)))
@@ -258,6 +258,33 @@ def test_misaligned_contact_points_coincide_in_the_fixed_frame(conjugate, point_
         np.testing.assert_allclose(p1, p2, rtol=0, atol=1e-9)
         assert np.linalg.norm(np.cross(R1 @ m1, R2 @ m2)) < 1e-9
         np.testing.assert_allclose(np.asarray(p.point[i]), p1, rtol=0, atol=1e-9)
+
+
+def test_augmented_contact_system_equals_the_nested_solve(conjugate, point_tca):
+    """The path is solved as one system in (x, psi1, psi2) with the two meshing
+    equations beside the contact equations.  Second route: Newton on the nested
+    residual (contact_equations: each flank point from its own envelope solve), started
+    0.01 away from the path's solution, reaches the same (u1, v1, u2, v2, phi2) (measured
+    1e-13; tolerance 1e-9), and the path's psi are the flanks' envelope solves at the
+    contact (measured 1e-15 rad)."""
+    from gearjax.newton import newton_solve
+    from gearjax.tca import contact_equations
+    pair = _modified(conjugate, 2.0, 0.02)
+    mis = Misalignment(*(jnp.asarray(v, float) for v in (0.05, 0.1, -0.1, 2e-4)))
+    p = point_tca(pair, mis).path
+    r1 = th.flank_function(pair.pinion, pair.pinion_crossing)
+    r2 = th.flank_function(pair.gear, pair.gear_crossing)
+    F, _, _ = contact_equations(r1, r2, th.hypoid_assembly(pair), mis, False)
+    solve = jax.jit(lambda x0, ph1: newton_solve(F, x0, ph1, tol=1e-12, max_steps=40))
+    psi = jax.jit(lambda uv1, uv2: (r1.solve(uv1).x, r2.solve(uv2).x))
+    for i in (MID - 6, MID, MID + 6):
+        x = np.concatenate([np.asarray(p.uv1[i]), np.asarray(p.uv2[i]), [float(p.phi2[i])]])
+        sol = solve(jnp.asarray(x + 0.01), p.phi1[i])
+        assert bool(sol.converged)
+        np.testing.assert_allclose(np.asarray(sol.x), x, rtol=0, atol=1e-9)
+        q1, q2 = psi(p.uv1[i], p.uv2[i])
+        np.testing.assert_allclose([float(p.psi1[i]), float(p.psi2[i])],
+                                   [float(q1), float(q2)], rtol=0, atol=1e-10)
 
 
 def test_gradients_match_central_differences(conjugate, point_tca):

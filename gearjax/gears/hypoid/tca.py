@@ -34,10 +34,12 @@ from gearjax.gears.hypoid.pair import (SIDES, HypoidPair, complementary_pinion, 
                                        flank_function, hypoid_assembly, hypoid_margin,
                                        mean_dedendum, mean_point, pair_flanks, with_point_radius)
 from gearjax.newton import newton_solve
-from gearjax.tca_result import TCAResult, check_side, contact_kinematics, register_family
+from gearjax.surfaces import GeneratedSurface
+from gearjax.tca_result import (TCAResult, check_side, contact_kinematics, register_family,
+                                strong_float64)
 from gearjax.tca import (DEFAULT_APPROACH, ContactPath, Misalignment, MultiPair,
                          NoContactError, check_on_flank_converged, check_tca_options,
-                         contact_equations, contact_path, multi_pair)
+                         contact_path, contact_system, multi_pair)
 
 __all__ = ["mean_dedendum", "HypoidPair", "pair_flanks", "complementary_pinion",
            "hypoid_assembly", "flank_function", "reference_guess", "hypoid_margin",
@@ -116,30 +118,49 @@ def _rotz_np(a, v):
 
 
 
+def _mean_point_contact(r1, r2, pair: HypoidPair, mis: Misalignment, x_guess, phi1_guess):
+    """Where the pinion's point ``uv1 = x_guess[:2]`` meets the gear flank: position
+    coincidence and one normal equation for ``(phi1, theta2, s2, phi2)``, with the
+    motion parameters of the generated flanks and their meshing equations beside
+    them (:func:`~gearjax.tca.contact_system`).  Returns the Newton result (``x[0]``
+    = phi1, differentiable), the contact system and the 5-vector ``x1``."""
+    cs = contact_system(r1, r2, hypoid_assembly(pair), mis, False)
+    x_guess = jax.lax.stop_gradient(jnp.asarray(x_guess, float))
+    uv1 = x_guess[:2]
+    psis = [jax.lax.stop_gradient(r.solve(uv).x) if isinstance(r, GeneratedSurface) else None
+            for r, uv in ((r1, uv1), (r2, x_guess[2:4]))]
+    n_psi = sum(p is not None for p in psis)
+
+    def G(y, _):
+        z = jnp.concatenate([uv1, y[1:4 + n_psi]])
+        f = cs.F(z, y[0])
+        return jnp.concatenate([f[:4], f[5:]])        # all but the second normal eq.
+
+    y0 = jnp.concatenate([jnp.stack([jnp.asarray(phi1_guess, float)]), x_guess[2:]]
+                         + [jnp.reshape(p, (1,)) for p in psis if p is not None])
+    sol = newton_solve(G, y0, (), tol=1e-11, max_steps=40)
+    x1 = jnp.concatenate([uv1, sol.x[1:4]])
+    return sol, cs, x1
+
+
 def reference_contact(pair: HypoidPair, mis: Misalignment, x_guess, phi1_guess):
     """Refine the reference contact near the pinion's mean point (traceable, no derivatives).
 
     Step 1 keeps the pinion point ``uv1`` of the guess fixed and solves position
-    coincidence and one normal equation for ``(phi1, theta2, s2, phi2)`` (4x4): where
-    the pinion's mean point meets the gear flank.  Step 2 solves the full 5x5 point
-    contact at that ``phi1``.  Returns ``(x_ref, phi1_ref, ok)`` (``phi1_ref``
-    differentiable with respect to the settings); where step 2 fails
-    (a pair in line contact, whose 5x5 system is singular) ``x_ref`` is step 1's.
+    coincidence and one normal equation for ``(phi1, theta2, s2, phi2)`` (4x4, with
+    the generating motions as unknowns): where the pinion's mean point meets the
+    gear flank.  Step 2 solves the full point contact at that ``phi1``.  Returns
+    ``(x_ref, phi1_ref, ok)`` (``phi1_ref`` differentiable with respect to the
+    settings); where step 2 fails (a pair in line contact, whose 5x5 system is
+    singular) ``x_ref`` is step 1's.
     """
     r1 = flank_function(pair.pinion, pair.pinion_crossing)
     r2 = flank_function(pair.gear, pair.gear_crossing)
-    F, _, _ = contact_equations(r1, r2, hypoid_assembly(pair), mis, False)
-    x_guess = jax.lax.stop_gradient(jnp.asarray(x_guess, float))
-    uv1 = x_guess[:2]
-
-    def G(y, _):
-        return F(jnp.concatenate([uv1, y[1:]]), y[0])[:4]
-
-    y0 = jnp.concatenate([jnp.stack([jnp.asarray(phi1_guess, float)]), x_guess[2:]])
-    s1 = newton_solve(G, y0, (), tol=1e-11, max_steps=40)
-    x1 = jnp.concatenate([uv1, s1.x[1:]])
-    s2 = newton_solve(F, x1, s1.x[0], tol=1e-11, max_steps=40)
-    x_ref = jnp.where(s2.converged, s2.x, x1)
+    s1, cs, x1 = _mean_point_contact(r1, r2, pair, mis, x_guess, phi1_guess)
+    x1 = jax.lax.stop_gradient(x1)
+    z1 = jnp.concatenate([x1, jax.lax.stop_gradient(s1.x[4:])])
+    s2 = newton_solve(cs.F, z1, s1.x[0], tol=1e-11, max_steps=40)
+    x_ref = jnp.where(s2.converged, cs.split(s2.x)[0], x1)
     # phi1_ref keeps its (implicit-function) derivatives: the grid moves with the
     # settings, so the reference contact stays the pinion's mean point under
     # differentiation as it does under finite differences
@@ -221,17 +242,9 @@ def hypoid_tca_traced(pair: HypoidPair, mis: Misalignment, x_ref, phi1_ref, *,
         # that angle): solving it here too would put a third contact Newton into the
         # program.  Where step 1 fails the reference stays at the guess; the path's
         # own solves carry the convergence flags.
-        F, _, _ = contact_equations(r1, r2, hypoid_assembly(pair), mis, False)
         x_guess = jax.lax.stop_gradient(jnp.asarray(x_ref, float))
-        uv1 = x_guess[:2]
-
-        def G(y, _):
-            return F(jnp.concatenate([uv1, y[1:]]), y[0])[:4]
-
-        y0 = jnp.concatenate([jnp.stack([jnp.asarray(phi1_ref, float)]), x_guess[2:]])
-        s1 = newton_solve(G, y0, (), tol=1e-11, max_steps=40)
-        x1 = jax.lax.stop_gradient(jnp.concatenate([uv1, s1.x[1:]]))
-        x_ref = jnp.where(s1.converged, x1, x_guess)
+        s1, _, x1 = _mean_point_contact(r1, r2, pair, mis, x_guess, phi1_ref)
+        x_ref = jnp.where(s1.converged, jax.lax.stop_gradient(x1), x_guess)
         phi1_ref = jnp.where(s1.converged, s1.x[0],
                              jax.lax.stop_gradient(jnp.asarray(phi1_ref, float)))
     h = 2.0 * np.pi / (pair.z1 * steps_per_pitch)
@@ -274,8 +287,8 @@ def hypoid_tca(pair: HypoidPair | Prepared, mis: Misalignment | None = None, *,
     prep = pair if isinstance(pair, Prepared) else prepare(pair)
     if mis is None:
         mis = Misalignment.zero()
-    out = _tca_jit(prep.pair, mis, jnp.asarray(prep.x_ref), jnp.asarray(prep.phi1_ref),
-                   float(approach), steps_per_pitch=int(steps_per_pitch),
+    out = _tca_jit(strong_float64(prep.pair), strong_float64(mis), jnp.asarray(prep.x_ref),
+                   jnp.asarray(prep.phi1_ref), float(approach), steps_per_pitch=int(steps_per_pitch),
                    half_pitches=float(half_pitches), line_contact=bool(line_contact),
                    n_pairs=int(n_pairs), drive=bool(prep.drive))
     if strict:
@@ -333,7 +346,8 @@ def misalignment_sensitivity(prep: Prepared, mis: Misalignment | None = None, *,
     check_tca_options(steps_per_pitch, half_pitches, n_pairs, approach)
     if mis is None:
         mis = Misalignment.zero()
-    vals, jac = _sensitivity_jit(prep.pair, mis, jnp.asarray(prep.x_ref),
+    vals, jac = _sensitivity_jit(strong_float64(prep.pair), strong_float64(mis),
+                                 jnp.asarray(prep.x_ref),
                                  jnp.asarray(prep.phi1_ref), float(approach),
                                  steps_per_pitch=int(steps_per_pitch),
                                  half_pitches=float(half_pitches), line_contact=False,
@@ -433,7 +447,8 @@ class _Adapter:
         check_tca_options(steps_per_pitch, half_pitches, n_pairs, approach)
         prep, side = self._prepared(design, side)
         mis = Misalignment.zero() if mis is None else mis
-        res = _result_jit(prep.pair, mis, jnp.asarray(prep.x_ref), jnp.asarray(prep.phi1_ref),
+        res = _result_jit(strong_float64(prep.pair), strong_float64(mis), jnp.asarray(prep.x_ref),
+                          jnp.asarray(prep.phi1_ref),
                           float(approach), side=side, drive=bool(prep.drive),
                           steps_per_pitch=int(steps_per_pitch),
                           half_pitches=float(half_pitches), line_contact=bool(line_contact),
@@ -450,12 +465,15 @@ class _Adapter:
         hand, drive = prep.pair.hand, bool(prep.drive)
 
         def f(pair: HypoidPair, mis=None):
+            # the jitted program of ``run`` (composable: inside a user's jit/grad/vmap
+            # it is traced once and inlined; called eagerly it runs compiled, not op
+            # by op)
             mis = Misalignment.zero() if mis is None else mis
-            return hypoid_result_traced(replace(pair, hand=hand), mis, x_ref, phi1_ref,
-                                        side=side, drive=drive, steps_per_pitch=int(steps_per_pitch),
-                                        half_pitches=float(half_pitches),
-                                        line_contact=bool(line_contact), n_pairs=int(n_pairs),
-                                        approach=approach, kinematics=kinematics)
+            return _result_jit(strong_float64(replace(pair, hand=hand)), strong_float64(mis),
+                               x_ref, phi1_ref, approach,
+                               side=side, drive=drive, steps_per_pitch=int(steps_per_pitch),
+                               half_pitches=float(half_pitches), line_contact=bool(line_contact),
+                               n_pairs=int(n_pairs), kinematics=bool(kinematics))
         f.pair = prep.pair
         return f
 
