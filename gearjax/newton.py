@@ -3,7 +3,9 @@
 Solves ``F(x, theta) = 0`` for ``x`` (a scalar or a 1-D array) given parameters
 ``theta`` (any pytree).  The Jacobian ``dF/dx`` comes from forward-mode autodiff.
 Each iteration takes the full Newton step ``dx = -J^{-1} F`` and backtracks
-(halving, Armijo condition on ``||F||``) when the step does not reduce the residual.
+(halving, Armijo condition on ``max|F|``) when the step does not reduce the residual;
+with ``natural_monotonicity=True`` a step is also accepted when it passes Deuflhard's
+natural monotonicity test (the simplified Newton correction shrinks).
 
 Derivatives of the solution with respect to ``theta`` are **not** obtained by
 differentiating through the iterations.  The solution map carries a
@@ -30,8 +32,9 @@ Every solve returns a :class:`NewtonResult` with the residual norm
 for the public entry points, which check the flags on concrete values.
 
 Reference: Nocedal & Wright, *Numerical Optimization*, 2nd ed., ch. 11 (Newton with
-line search); Blondel et al., "Efficient and modular implicit differentiation",
-NeurIPS 2022 (implicit function theorem for root finding).
+line search); [Deuflhard2004] §3.3 (natural monotonicity); Blondel et al.,
+"Efficient and modular implicit differentiation", NeurIPS 2022 (implicit function
+theorem for root finding).
 """
 
 from __future__ import annotations
@@ -80,7 +83,7 @@ def _lin_solve(J, b):
     return jnp.linalg.solve(J, b)
 
 
-def _loop(F, tol, xtol, max_steps, max_halvings, x0, theta):
+def _loop(F, tol, xtol, max_steps, max_halvings, natural, x0, theta):
     """Damped Newton iterations on the flattened unknown."""
     shape = jnp.shape(x0)
 
@@ -108,22 +111,34 @@ def _loop(F, tol, xtol, max_steps, max_halvings, x0, theta):
         # the full step is the loop's first pass (i = -1 -> 0, alpha = 1), so ``F``
         # appears once in the line search, not twice (half the program to trace and
         # compile for an ``F`` that itself contains solves)
+        dx_norm = jnp.linalg.norm(dx)
+
         def ls_cond(s):
-            alpha, xn, fn, rn, i = s
+            alpha, xn, fn, rn, theta_n, i = s
             good = rn <= (1.0 - 1e-4 * alpha) * res
+            if natural:
+                good = good | (theta_n <= (1.0 - 0.25 * alpha) * dx_norm)
             return (i < 0) | ((i < max_halvings) & jnp.logical_not(good))
 
         def ls_body(s):
-            alpha, _, _, _, i = s
+            alpha, _, _, _, _, i = s
             alpha = 0.5 * alpha
             xn = x + alpha * dx
             fn = f(xn)
             rn = jnp.max(jnp.abs(fn))
             rn = jnp.where(jnp.isfinite(rn), rn, jnp.inf)
-            return alpha, xn, fn, rn, i + 1
+            if natural:
+                # Deuflhard's natural monotonicity test: the simplified Newton
+                # correction J(x)^-1 F(x_new) is shorter than the step
+                theta_n = jnp.linalg.norm(_lin_solve(J, fn))
+                theta_n = jnp.where(jnp.isfinite(theta_n), theta_n, jnp.inf)
+            else:
+                theta_n = jnp.asarray(jnp.inf, x.dtype)
+            return alpha, xn, fn, rn, theta_n, i + 1
 
-        alpha, xn, fn, rn, _ = jax.lax.while_loop(
-            ls_cond, ls_body, (jnp.asarray(2.0, x.dtype), x, fx, res, -1))
+        alpha, xn, fn, rn, _, _ = jax.lax.while_loop(
+            ls_cond, ls_body, (jnp.asarray(2.0, x.dtype), x, fx, res,
+                               jnp.asarray(jnp.inf, x.dtype), -1))
         step = jnp.max(jnp.abs(alpha * dx))
         small = step <= xtol * (1.0 + jnp.max(jnp.abs(xn)))
         done = jnp.logical_not(ok) | ((rn <= tol) & small) | (rn == 0.0)
@@ -139,15 +154,16 @@ def _loop(F, tol, xtol, max_steps, max_halvings, x0, theta):
     return jnp.reshape(x, shape), res, k, converged
 
 
-@partial(jax.custom_jvp, nondiff_argnums=(0, 1, 2, 3, 4))
-def _solve(F, tol, xtol, max_steps, max_halvings, x0, theta):
-    return _loop(F, tol, xtol, max_steps, max_halvings, jax.lax.stop_gradient(x0), theta)
+@partial(jax.custom_jvp, nondiff_argnums=(0, 1, 2, 3, 4, 5))
+def _solve(F, tol, xtol, max_steps, max_halvings, natural, x0, theta):
+    return _loop(F, tol, xtol, max_steps, max_halvings, natural, jax.lax.stop_gradient(x0),
+                 theta)
 
 
-def _solve_jvp(F, tol, xtol, max_steps, max_halvings, primals, tangents):
+def _solve_jvp(F, tol, xtol, max_steps, max_halvings, natural, primals, tangents):
     x0, theta = primals
     _, theta_dot = tangents
-    out = _solve(F, tol, xtol, max_steps, max_halvings, x0, theta)
+    out = _solve(F, tol, xtol, max_steps, max_halvings, natural, x0, theta)
     xs = out[0]
     shape = jnp.shape(xs)
 
@@ -182,7 +198,8 @@ _solve.defjvp(_solve_jvp, symbolic_zeros=True)
 
 
 def newton_solve(F: Callable, x0, theta=(), *, tol: float = 1e-10, xtol: float = 1e-12,
-                 max_steps: int = 50, max_halvings: int = 12) -> NewtonResult:
+                 max_steps: int = 50, max_halvings: int = 12,
+                 natural_monotonicity: bool = False) -> NewtonResult:
     """Solve the square system ``F(x, theta) = 0`` by damped Newton iterations.
 
     Parameters
@@ -196,6 +213,13 @@ def newton_solve(F: Callable, x0, theta=(), *, tol: float = 1e-10, xtol: float =
     xtol : relative step size below which iterations stop once ``max|F| <= tol``.
     max_steps : maximum number of Newton steps.
     max_halvings : maximum number of step halvings in the backtracking line search.
+    natural_monotonicity : also accept a (damped) step that passes Deuflhard's natural
+        monotonicity test ``|J(x)^-1 F(x + a dx)| <= (1 - a/4) |dx|`` (the simplified
+        Newton correction shrinks) when it does not reduce ``max|F|``.  For nearly
+        singular systems with badly scaled equations (a long contact path near line
+        contact), where the full Newton step is right but raises the residual of one
+        equation and the residual test would damp the iteration to a crawl.
+        Reference: [Deuflhard2004] §3.3.
 
     Returns
     -------
@@ -211,7 +235,7 @@ def newton_solve(F: Callable, x0, theta=(), *, tol: float = 1e-10, xtol: float =
         # the options: a module-level ``F`` is traced and compiled once per process
         # instead of at every call (an eager ``while_loop`` compiles its loop anew)
         return _newton_jit(F, float(tol), float(xtol), int(max_steps), int(max_halvings),
-                           x0, theta)
+                           bool(natural_monotonicity), x0, theta)
     converted, consts = jax.closure_convert(lambda x, th: F(x, th), x0, theta)
 
     def F_all(x, th_all):
@@ -219,7 +243,8 @@ def newton_solve(F: Callable, x0, theta=(), *, tol: float = 1e-10, xtol: float =
         return converted(x, th, *cs)
 
     x, res, steps, conv = _solve(F_all, float(tol), float(xtol), int(max_steps),
-                                 int(max_halvings), x0, (theta, tuple(consts)))
+                                 int(max_halvings), bool(natural_monotonicity), x0,
+                                 (theta, tuple(consts)))
     return NewtonResult(x, res, steps, conv)
 
 
@@ -235,7 +260,7 @@ def _eager(theta) -> bool:
                for t in jax.tree_util.tree_leaves(theta))
 
 
-@partial(jax.jit, static_argnums=(0, 1, 2, 3, 4))
-def _newton_jit(F, tol, xtol, max_steps, max_halvings, x0, theta):
+@partial(jax.jit, static_argnums=(0, 1, 2, 3, 4, 5))
+def _newton_jit(F, tol, xtol, max_steps, max_halvings, natural, x0, theta):
     return newton_solve(F, x0, theta, tol=tol, xtol=xtol, max_steps=max_steps,
-                        max_halvings=max_halvings)
+                        max_halvings=max_halvings, natural_monotonicity=natural)

@@ -277,7 +277,8 @@ def _solve_grid(F, x_prev, x_prev2, phis, tol, max_steps):
     def step(carry, phi):
         x_prev, x_prev2 = carry
         pred = jax.lax.stop_gradient(2.0 * x_prev - x_prev2)
-        sol = newton_solve(F, pred, phi, tol=tol, max_steps=max_steps)
+        sol = newton_solve(F, pred, phi, tol=tol, max_steps=max_steps,
+                           natural_monotonicity=True)
         ok = sol.converged
         return (jnp.where(ok, sol.x, x_prev), x_prev), sol
 
@@ -461,7 +462,8 @@ def contact_path(r1: Callable, r2: Callable, asm: Assembly, mis: Misalignment, p
     # it; the first step of each starts from the tangent predictor at the reference
     # (a virtual previous point one grid step behind it), later steps from the
     # linear predictor of the two previous points
-    ref = newton_solve(cs.F, z0, phi1[mid], tol=tol, max_steps=max_steps)
+    ref = newton_solve(cs.F, z0, phi1[mid], tol=tol, max_steps=max_steps,
+                       natural_monotonicity=True)
     tangent = path_tangent(cs.F, ref.x, phi1[mid])
     seqs = jnp.stack([phi1[mid + 1:], phi1[:mid][::-1]])
     behind = ref.x[None, :] - (seqs[:, :1] - phi1[mid]) * tangent[None, :]

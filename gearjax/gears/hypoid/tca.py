@@ -138,7 +138,7 @@ def _mean_point_contact(r1, r2, pair: HypoidPair, mis: Misalignment, x_guess, ph
 
     y0 = jnp.concatenate([jnp.stack([jnp.asarray(phi1_guess, float)]), x_guess[2:]]
                          + [jnp.reshape(p, (1,)) for p in psis if p is not None])
-    sol = newton_solve(G, y0, (), tol=1e-11, max_steps=40)
+    sol = newton_solve(G, y0, (), tol=1e-11, max_steps=40, natural_monotonicity=True)
     x1 = jnp.concatenate([uv1, sol.x[1:4]])
     return sol, cs, x1
 
@@ -159,7 +159,8 @@ def reference_contact(pair: HypoidPair, mis: Misalignment, x_guess, phi1_guess):
     s1, cs, x1 = _mean_point_contact(r1, r2, pair, mis, x_guess, phi1_guess)
     x1 = jax.lax.stop_gradient(x1)
     z1 = jnp.concatenate([x1, jax.lax.stop_gradient(s1.x[4:])])
-    s2 = newton_solve(cs.F, z1, s1.x[0], tol=1e-11, max_steps=40)
+    s2 = newton_solve(cs.F, z1, s1.x[0], tol=1e-11, max_steps=40,
+                      natural_monotonicity=True)
     x_ref = jnp.where(s2.converged, cs.split(s2.x)[0], x1)
     # phi1_ref keeps its (implicit-function) derivatives: the grid moves with the
     # settings, so the reference contact stays the pinion's mean point under
