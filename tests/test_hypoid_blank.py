@@ -152,6 +152,14 @@ def test_blank_outputs_by_independent_relations(method):
                                math.asin(math.tan(b["alpha_lim"]) / math.tan(b["beta_m1"])), **tol)
 
 
+# The tangent-cones blank comes from a Newton solve whose residual stops at its rounding
+# floor (about 1e-12, gearjax/gears/hypoid/pitch_cones.py); two compilations of it (eager
+# ops, one jitted program, the sensitivity program) round differently and stop at
+# different points of that floor: measured up to 4.9e-12 relative (XLA CPU loop
+# emitters, tests/conftest.py).  A wiring error is O(1).
+FLOOR = dict(rtol=5e-11, atol=5e-11)
+
+
 def test_jit_matches_eager_and_no_nans():
     inp = BlankInput.from_dict(dict(SAMPLE2, method="tangent-cones"))
     a = blank_geometry(inp)
@@ -159,7 +167,7 @@ def test_jit_matches_eager_and_no_nans():
     for n, _, _ in hb.OUTPUTS:
         if n == "machine_tilt":
             continue
-        np.testing.assert_allclose(getattr(b, n), getattr(a, n), rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(getattr(b, n), getattr(a, n), **FLOOR)
         assert np.isfinite(float(getattr(a, n))), n
 
 
@@ -203,7 +211,7 @@ def test_sensitivity_matches_central_differences(method):
     # the values are the blank's outputs
     b = blank_geometry(inp)
     np.testing.assert_allclose(s["values"], [float(getattr(b, n)) for n in s["outputs"]],
-                               rtol=1e-13, atol=1e-13)
+                               **FLOOR)
 
 
 @pytest.mark.parametrize("method", ["iso23509-method1", "tangent-cones"])
