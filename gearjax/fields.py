@@ -14,7 +14,7 @@ from __future__ import annotations
 import jax
 import jax.numpy as jnp
 
-__all__ = ["field_names", "get_fields", "with_fields", "strong_float64"]
+__all__ = ["field_names", "get_fields", "with_fields", "strong_float64", "float64_array"]
 
 
 def _name(path) -> str:
@@ -57,6 +57,12 @@ def with_fields(tree, values: dict):
                                                   for n, (_, leaf) in zip(names, flat)])
 
 
+def float64_array(v):
+    """``v`` as a strongly typed float64 array (a tracer stays a tracer): the leaf type
+    of every continuous design field (see :func:`strong_float64`)."""
+    return jnp.asarray(v, jnp.float64)
+
+
 def strong_float64(tree):
     """``tree`` with every floating-point leaf as a strongly typed float64 array.
 
@@ -69,5 +75,5 @@ def strong_float64(tree):
     def leaf(v):
         if isinstance(v, (bool, int)) or not jnp.issubdtype(jnp.result_type(v), jnp.floating):
             return v
-        return jnp.asarray(v, jnp.float64)
+        return float64_array(v)
     return jax.tree_util.tree_map(leaf, tree)

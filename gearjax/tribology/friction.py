@@ -50,6 +50,7 @@ import numpy as np
 
 from gearjax.contact import MAX_LOG_RATIO, hertz_exact
 from gearjax.errors import check_positive, check_range, require_converged
+from gearjax.fields import float64_array
 from gearjax.tribology.asperity import load_sharing_traced
 from gearjax.tribology.lubricant import Oil, eyring_shear, viscosity
 
@@ -103,9 +104,9 @@ def make_surface(sigma_um, density_per_mm2=1.0e4, beta_um=10.0, f_c=0.1, v_slip_
     if not (0.005 <= ebs <= 0.2):
         warnings.warn(f"Greenwood-Tripp asperity model: eta_s*beta*sigma = {ebs:g} is outside "
                       "the range 0.005..0.2 typical of engineering surfaces", stacklevel=2)
-    f = lambda v: jnp.asarray(float(v), jnp.float64)
-    return Surface(f(float(sigma_um) * 1e-3), f(density_per_mm2), f(float(beta_um) * 1e-3),
-                   f(f_c), f(v_slip_mm_s))
+    return Surface(*(float64_array(float(v)) for v in
+                     (float(sigma_um) * 1e-3, density_per_mm2, float(beta_um) * 1e-3, f_c,
+                      v_slip_mm_s)))
 
 
 class FrictionResult(NamedTuple):

@@ -38,6 +38,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from gearjax.errors import check_positive, check_range
+from gearjax.fields import float64_array
 
 __all__ = ["Oil", "make_oil", "get_oil", "OILS", "roelands_z", "roelands_viscosity",
            "barus_viscosity", "viscosity", "dowson_higginson_density", "eyring_shear",
@@ -106,8 +107,7 @@ def make_oil(eta0, alpha_per_GPa=None, tau0_MPa=5.0, rho0=880.0, name="custom", 
     if not (5.0 <= float(alpha_per_GPa) <= 40.0):
         warnings.warn(f"alpha = {float(alpha_per_GPa):g} 1/GPa is outside the range 5..40 1/GPa "
                       "of the Hamrock-Dowson film-thickness fits", stacklevel=2)
-    f = lambda v: jnp.asarray(float(v), jnp.float64)      # strongly typed leaves
-    return Oil(f(eta0), f(z), f(tau0_MPa), f(rho0), name)
+    return Oil(*(float64_array(float(v)) for v in (eta0, z, tau0_MPa, rho0)), name)
 
 
 def math_eta_inf() -> float:

@@ -61,6 +61,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from gearjax.fields import float64_array
 from gearjax.frames import matrix_x
 from gearjax.gears.hypoid.cutter import FaceMillCutter
 from gearjax.gears.hypoid.flank import (FlankSpec, face_cone_gap, mid_estimate, pitch_distance,
@@ -107,7 +108,7 @@ class HypoidPair:
 
 
 def _f(v):
-    return jnp.asarray(float(v), jnp.float64)      # strongly typed (see strong_float64)
+    return float64_array(float(v))
 
 
 def pair_flanks(design, side: str = "drive", *, hand: int = 1) -> HypoidPair:

@@ -47,6 +47,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from gearjax.fields import float64_array
 from gearjax.frames import matrix_z
 from gearjax.errors import check_int, check_range, is_traced, require_converged
 from gearjax.kinematics import Kinematics, Mesh, eigen_kinematics, parallel_axes
@@ -96,7 +97,7 @@ class InvolutePair:
         x1 = check_range("x1", x1, -3.0, 3.0)
         x2 = check_range("x2", x2, -3.0, 3.0)
         deg = math.pi / 180.0
-        f = lambda v: jnp.asarray(v, jnp.float64)          # strongly typed leaves
+        f = float64_array
         pair = cls(f(m), f(a * deg), f(b * deg), f(x1), f(x2), z1, z2)
         if not any(is_traced(v) for v in (m, a, b, x1, x2)):
             _check_tooth_form(pair)      # concrete values only (traced ones pass through)

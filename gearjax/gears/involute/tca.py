@@ -47,6 +47,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from gearjax.errors import check_range
+from gearjax.fields import float64_array
 from gearjax.gears.involute.geometry import (InvolutePair, generated_flank, pair_geometry,
                                              rack_family, rack_family_data, rack_psi0)
 from gearjax.surfaces import GeneratedSurface
@@ -87,7 +88,7 @@ class InvoluteTCA:
         da = check_range("dalpha", dalpha_deg, -5.0, 5.0, unit="deg")
         a = check_range("profile_crown", profile_crown, 0.0, 0.1, unit="1/mm")
         c = check_range("lead_crown", lead_crown, 0.0, 0.1, unit="1/mm")
-        f = lambda v: jnp.asarray(v, jnp.float64)          # strongly typed leaves
+        f = float64_array
         return cls(pair, f(da * (np.pi / 180.0)), f(a), f(c), f(b))
 
 

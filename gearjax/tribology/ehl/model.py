@@ -43,6 +43,7 @@ import numpy as np
 
 from gearjax.contact import hertz_exact
 from gearjax.errors import check_positive, check_range
+from gearjax.fields import float64_array
 from gearjax.tribology.asperity import gt_coefficient, log_F_n
 from gearjax.tribology.ehl.grid import EHLGrid, deformation, influence_kernel
 from gearjax.tribology.lubricant import P_ROELANDS_MPA, PA_S_TO_MPA_S
@@ -108,7 +109,7 @@ def make_case(F, u_e, u_s, Rx, Ry, eta0, alpha_per_GPa, E_prime=226373.6, tau0_M
     check_positive("v_slip", v_slip_mm_s, "mm/s")
     vals = (F, u_e, u_s, Rx, Ry, eta0, float(alpha_per_GPa) * 1e-3, E_prime, tau0_MPa,
             float(sigma_um) * 1e-3, density_per_mm2, float(beta_um) * 1e-3, f_c, v_slip_mm_s)
-    case = EHLCase(*(jnp.asarray(float(v), jnp.float64) for v in vals))
+    case = EHLCase(*(float64_array(float(v)) for v in vals))
     p_h = float(_scales_jit(case).p_h)
     check_range("p_max (Hertz)", p_h, 50.0, 3500.0, unit="MPa")
     return case
