@@ -85,7 +85,7 @@ from gearjax.newton import newton_solve
 from gearjax.surfaces import GeneratedSurface, local_geometry, unit_normal
 
 __all__ = ["Misalignment", "Assembly", "contact_equations", "contact_system", "ContactSystem",
-           "local_geometry_on", "point_normal", "gear_mount",
+           "local_geometry_on", "point_normal", "flank_at", "path_tangent", "solve_grid", "gear_mount",
            "ContactPath", "contact_path", "te_arcsec", "require_path",
            "ARCSEC", "ellipse_from_weingarten", "rotation_about", "relative_curvature",
            "MultiPair", "multi_pair", "DEFAULT_APPROACH", "NoContactError",
@@ -181,6 +181,9 @@ class ContactPath(NamedTuple):
     psi1, psi2 : (N,) motion parameter of the generating tool at the contact point of a
         generated flank (:class:`~gearjax.surfaces.GeneratedSurface`; NaN for another
         flank), solved with the contact (:func:`contact_system`).
+    edge_kind : (N,) int, -1 where the contact is a tangency of the two flanks, else
+        the face end carrying it (index into :data:`gearjax.edge_contact.EDGE_NAMES`;
+        there the semi-axes are NaN: no Hertz ellipse at an edge).  ``None`` where face ends were not examined.
     """
 
     phi1: jnp.ndarray
@@ -205,6 +208,7 @@ class ContactPath(NamedTuple):
     weingarten2: jnp.ndarray | None = None
     psi1: jnp.ndarray | None = None
     psi2: jnp.ndarray | None = None
+    edge_kind: jnp.ndarray | None = None
 
 
 def te_arcsec(te_rad):
@@ -268,8 +272,9 @@ def point_normal(surf, uv):
     return surf(uv), unit_normal(surf, uv)
 
 
-def _solve_grid(F, x_prev, x_prev2, phis, tol, max_steps):
-    """Continuation over ``phis`` (lax.scan): each solve starts from the linear
+def solve_grid(F, x_prev, x_prev2, phis, tol, max_steps):
+    """Continuation over ``phis`` (lax.scan; ``phis`` may be a tuple of arrays scanned
+    together, passed to ``F`` as its parameter): each solve starts from the linear
     predictor ``2 x_prev - x_prev2`` of the two previous points of the path.  A step
     that fails keeps ``x_prev`` and drops the predictor (``x_prev2 = x_prev``) for the
     next step."""
@@ -284,6 +289,9 @@ def _solve_grid(F, x_prev, x_prev2, phis, tol, max_steps):
 
     _, sols = jax.lax.scan(step, (x_prev, x_prev2), phis)
     return sols
+
+
+_solve_grid = solve_grid
 
 
 def path_tangent(F, x, phi):
@@ -368,6 +376,16 @@ class ContactSystem(NamedTuple):
     point1: Callable
 
 
+def flank_at(r, uv, psi):
+    """Body-frame point, unit normal and meshing residual of a flank at ``uv``: at the
+    motion ``psi`` of a generated flank (:meth:`~gearjax.surfaces.GeneratedSurface.at`),
+    or ``(point, normal, None)`` of another flank (``psi`` is then ``None``)."""
+    if psi is None:
+        q, m = point_normal(r, uv)
+        return q, m, None
+    return r.at(uv, psi)
+
+
 def contact_system(r1: Callable, r2: Callable, asm: Assembly, mis: Misalignment,
                    line_contact: bool, v1_fixed=0.0) -> ContactSystem:
     """The contact system with each generated flank's motion parameter ``psi_i`` as an
@@ -396,17 +414,11 @@ def contact_system(r1: Callable, r2: Callable, asm: Assembly, mis: Misalignment,
         extra = [jnp.reshape(p, (1,)) for g, p in zip(gen, (psi1, psi2)) if g]
         return jnp.concatenate([x] + extra)
 
-    def flank(r, uv, psi):
-        if psi is None:
-            q, m = point_normal(r, uv)
-            return q, m, None
-        return r.at(uv, psi)
-
     def F(z, ph1):
         x, psi1, psi2 = split(z)
         uv1, uv2, ph2 = unpack(x)
-        q1, m1, f1 = flank(r1, uv1, psi1)
-        q2, m2, f2 = flank(r2, uv2, psi2)
+        q1, m1, f1 = flank_at(r1, uv1, psi1)
+        q2, m2, f2 = flank_at(r2, uv2, psi2)
         eqs = _contact_residual(mount, mis, line_contact, ph1, ph2, q1, m1, q2, m2)
         mesh = [jnp.reshape(f, (1,)) for f in (f1, f2) if f is not None]
         return jnp.concatenate([eqs] + mesh)
@@ -467,7 +479,7 @@ def contact_path(r1: Callable, r2: Callable, asm: Assembly, mis: Misalignment, p
     tangent = path_tangent(cs.F, ref.x, phi1[mid])
     seqs = jnp.stack([phi1[mid + 1:], phi1[:mid][::-1]])
     behind = ref.x[None, :] - (seqs[:, :1] - phi1[mid]) * tangent[None, :]
-    sols = jax.vmap(lambda x2, s: _solve_grid(cs.F, ref.x, x2, s, tol, max_steps))(behind, seqs)
+    sols = jax.vmap(lambda x2, s: solve_grid(cs.F, ref.x, x2, s, tol, max_steps))(behind, seqs)
 
     def whole(two_ways, at_ref):
         return jnp.concatenate([two_ways[1][::-1], at_ref[None], two_ways[0]], axis=0)

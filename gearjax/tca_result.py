@@ -18,7 +18,8 @@ the kinematics at its contact points.
   every family; ``family`` (static) -- ``"involute"`` or ``"hypoid"``.
 
 :meth:`TCAResult.flags` gives the contact-quality flags on concrete results
-(converged, reference on the flank, edge contact, contact ratio below 1).
+(converged, reference on the flank, edge contact -- at a flank boundary or a
+face end --, contact ratio below 1, a large TE).
 
 **Kinematics at the contact points** (:func:`contact_kinematics`).  Pinion =
 member 1 turning at 1 rad/s about its body z axis, gear = member 2 turning at the
@@ -57,6 +58,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from gearjax.edge_contact import EDGE_NAMES
 from gearjax.fields import strong_float64
 from gearjax.frames import matrix_z
 from gearjax.surfaces import local_geometry
@@ -84,6 +86,9 @@ def check_side(side) -> str:
 
 
 _SAME_TE = 1e-9   # rad (2e-4 arc-seconds): TE curves that coincide
+
+#: arc-seconds: a TE peak-to-peak above this raises the ``large_te`` flag
+LARGE_TE_ARCSEC = 60.0
 
 
 class ContactKinematics(NamedTuple):
@@ -173,9 +178,11 @@ def contact_kinematics(r1: Callable, r2: Callable, asm: Assembly, mis: Misalignm
     where the path did not converge give meaningless values: mask them with
     ``path.converged``.
     """
-    mid = path.phi1.shape[0] // 2
+    # the fixed face-width parameter of a line contact: that of a surface contact (at
+    # an edge contact the pinion point lies on a face end)
+    ref = path.phi1.shape[0] // 2 if path.edge_kind is None else jnp.argmax(path.edge_kind < 0)
     motion, (R, c) = contact_motion(r1, r2, asm, mis, line_contact,
-                                    jax.lax.stop_gradient(path.uv1[mid, 1]))
+                                    jax.lax.stop_gradient(path.uv1[ref, 1]))
     k2 = R[:, 2]
     ez = jnp.array([0.0, 0.0, 1.0])
 
@@ -209,6 +216,13 @@ def contact_kinematics(r1: Callable, r2: Callable, asm: Assembly, mis: Misalignm
     psi12 = None if path.psi1 is None else (path.psi1, path.psi2)
     out = jax.vmap(one)(path.uv1, path.uv2, path.phi2, path.phi1, path.normal, path.major_dir,
                         W12, psi12)
+    if path.edge_kind is not None:
+        # at an edge contact one radius of curvature is zero and the surface-contact
+        # equations behind the contact velocity do not hold: no rolling/sliding
+        # values there (NaN, flagged by ``edge_kind``)
+        edge = path.edge_kind >= 0
+        out = [jnp.where(edge.reshape(edge.shape + (1,) * (a.ndim - 1)), jnp.nan, a)
+               for a in out]
     return ContactKinematics(*out)
 
 
@@ -289,8 +303,16 @@ class TCAResult:
             two pairs cross -- the load is then carried at the edge of a tooth.  Pairs
             whose TE curves coincide (conjugate pairs) touch simultaneously and are
             not flagged.
+            Also raised with ``face_end_contact``.
+        face_end_contact : pair 0 carries the load (it is the active pair of the
+            envelope) at a face end of a flank -- toe or heel of pinion or gear
+            (``path.edge_kind``, :mod:`gearjax.edge_contact`): the bearing has run
+            off the face, e.g. an uncrowned pair under a shaft-angle error.
         low_contact_ratio : contact ratio below 1 (or not found): gaps in the
             envelope, the motion is not transmitted continuously.
+        large_te : the TE envelope's peak-to-peak exceeds :data:`LARGE_TE_ARCSEC`
+            (60 arcsec): far above the 5-15 arcsec of a designed parabolic TE, a
+            sign of a mismatched pair or a bearing that is not where it should be.
         """
         conv = np.asarray(self.path.converged)
         on = np.asarray(self.on_flank)
@@ -315,9 +337,24 @@ class TCAResult:
             with np.errstate(invalid="ignore"):
                 same = both & (np.abs(te[a, sl] - te[b, sl]) < _SAME_TE)
             edge = edge or not (crossing or bool(same.any()))
+        face_end = bool(self.face_ends_loaded())
         cr = float(self.multi.contact_ratio)
+        ptp = float(self.multi.ptp) / ARCSEC
         return dict(converged=ok, reference_on_flank=bool(on[on.shape[0] // 2]),
-                    edge_contact=bool(edge), low_contact_ratio=not (np.isfinite(cr) and cr >= 1.0))
+                    edge_contact=bool(edge) or face_end, face_end_contact=face_end,
+                    low_contact_ratio=not (np.isfinite(cr) and cr >= 1.0),
+                    large_te=bool(np.isfinite(ptp) and ptp > LARGE_TE_ARCSEC))
+
+    def face_ends_loaded(self) -> list[str]:
+        """Names (:data:`gearjax.edge_contact.EDGE_NAMES`) of the face ends at which
+        tooth pair 0 carries the load somewhere on the grid (concrete; empty if none)."""
+        kinds = self.path.edge_kind
+        if kinds is None:
+            return []
+        kinds = np.asarray(kinds)
+        k0 = np.asarray(self.multi.inside).shape[0] // 2
+        carrying = np.asarray(self.multi.inside)[k0] & (np.asarray(self.multi.active) == k0)
+        return [EDGE_NAMES[k] for k in sorted(set(kinds[carrying & (kinds >= 0)].tolist()))]
 
     def warnings(self) -> list[str]:
         """Human-readable warnings for the flags that are raised (empty if none)."""
@@ -327,10 +364,19 @@ class TCAResult:
             out.append("a contact solve did not converge on the working flank")
         if not f["reference_on_flank"]:
             out.append("the reference contact lies outside a flank boundary (off-flank)")
-        if f["edge_contact"]:
+        if f["face_end_contact"]:
+            out.append("edge contact at the " + ", ".join(self.face_ends_loaded())
+                       + ": the bearing runs off the face (no Hertz ellipse there)")
+        elif f["edge_contact"]:
             out.append("edge contact: a tooth pair carries the load up to a flank boundary")
         if f["low_contact_ratio"]:
-            out.append(f"contact ratio {float(self.multi.contact_ratio):.3f} below 1")
+            cr = float(self.multi.contact_ratio)
+            out.append(f"contact ratio {cr:.3f} below 1" if np.isfinite(cr) else
+                       "contact ratio not found: tooth pair 0 does not both enter and leave "
+                       "the flanks within the grid (widen it, e.g. --pitches 2)")
+        if f["large_te"]:
+            out.append(f"TE peak-to-peak {float(self.multi.ptp) / ARCSEC:.1f} arcsec above "
+                       f"{LARGE_TE_ARCSEC:.0f} arcsec: a mismatched pair or a misplaced bearing")
         return out
 
 

@@ -248,6 +248,33 @@ def flank_coordinates(fl: FlankSpec, crossing, p_body):
     return xi, root_cone_gap(b, r), face_cone_gap(b, r)   # face_cone_gap > 0 below the tip
 
 
+def hypoid_face_ends(pair: HypoidPair):
+    """``(margin_parts, g1, g2)`` of :func:`gearjax.edge_contact.face_end_contact`: each
+    member's boundary margins (mm) -- face width ``F (1 - |xi|)/2`` and the others
+    (below the face cone, above the fillet) -- at body points, and the face-end
+    functions ``g(q, e) = (F/2) (xi(q) - e)`` (toe ``e = -1``, heel ``e = +1``)."""
+    members = ((pair.pinion, pair.pinion_crossing), (pair.gear, pair.gear_crossing))
+
+    def parts_of(fl, t, q):
+        xi, above_root, tip_gap = flank_coordinates(fl, t, q)
+        c = fl.cutter
+        h_fillet = c.edge_radius * (1.0 - jnp.sin(c.blade_angle))
+        return (0.5 * fl.blank.face_width * (1.0 - jnp.abs(xi)),
+                jnp.minimum(tip_gap, above_root - h_fillet))
+
+    def margin_parts(q1, q2):
+        f1, r1 = jax.vmap(lambda q: parts_of(*members[0], q))(q1)
+        f2, r2 = jax.vmap(lambda q: parts_of(*members[1], q))(q2)
+        return f1, r1, f2, r2
+
+    def end(fl, t):
+        def g(q, e):
+            return 0.5 * fl.blank.face_width * (flank_coordinates(fl, t, q)[0] - e)
+        return g
+
+    return margin_parts, end(*members[0]), end(*members[1])
+
+
 def hypoid_margin(pair: HypoidPair, path: ContactPath):
     """Boundary margin (mm) of the contact on both flanks; >= 0 on the working flanks.
     Also returns the per-member coordinates ``{xi1, h1, xi2, h2}``."""

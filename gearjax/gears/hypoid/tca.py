@@ -31,8 +31,10 @@ import numpy as np
 from gearjax.gears.hypoid.design_file import HypoidDesign
 from gearjax.gears.hypoid.flank import face_apex_offset, root_apex_offset
 from gearjax.gears.hypoid.pair import (SIDES, HypoidPair, complementary_pinion, flank_coordinates,
-                                       flank_function, hypoid_assembly, hypoid_margin,
+                                       flank_function, hypoid_assembly, hypoid_face_ends,
+                                       hypoid_margin,
                                        mean_dedendum, mean_point, pair_flanks, with_point_radius)
+from gearjax.edge_contact import face_end_contact
 from gearjax.newton import newton_solve
 from gearjax.surfaces import GeneratedSurface
 from gearjax.tca_result import (TCAResult, check_side, contact_kinematics, register_family,
@@ -226,13 +228,16 @@ def prepare(pair: HypoidPair, n_search: int = 181) -> Prepared:
 def hypoid_tca_traced(pair: HypoidPair, mis: Misalignment, x_ref, phi1_ref, *,
                       steps_per_pitch: int = 16, half_pitches: float = 2.0,
                       line_contact: bool = False, n_pairs: int = 5, drive: bool = True,
-                      approach=DEFAULT_APPROACH) -> HypoidTCA:
+                      approach=DEFAULT_APPROACH, face_ends: bool = True) -> HypoidTCA:
     """Traceable TCA of a hypoid/spiral-bevel flank pair (see :func:`hypoid_tca`).
 
     Point contact: the reference contact is refined near the pinion's mean point
     (:func:`reference_contact`) and the grid is centred on its pinion angle.  Line
     contact (conjugate pairs): the grid is centred on ``phi1_ref`` and the pinion
-    blade position ``s`` stays at ``x_ref[1]``.
+    blade position ``s`` stays at ``x_ref[1]``.  With ``face_ends`` (default) the
+    contact at the toe and heel of both members is solved too and the contact made
+    at each pinion angle is the surface or the edge contact
+    (:func:`gearjax.edge_contact.face_end_contact`; ``path.edge_kind``).
     """
     r1 = flank_function(pair.pinion, pair.pinion_crossing)
     r2 = flank_function(pair.gear, pair.gear_crossing)
@@ -251,9 +256,15 @@ def hypoid_tca_traced(pair: HypoidPair, mis: Misalignment, x_ref, phi1_ref, *,
     h = 2.0 * np.pi / (pair.z1 * steps_per_pitch)
     k = int(round(half_pitches * steps_per_pitch))
     grid = phi1_ref + h * jnp.arange(-k, k + 1, dtype=float)
-    path = contact_path(r1, r2, hypoid_assembly(pair), mis, grid, x_ref,
+    asm = hypoid_assembly(pair)
+    path = contact_path(r1, r2, asm, mis, grid, x_ref,
                         line_contact=line_contact, approach=approach)
     margin, coords = hypoid_margin(pair, path)
+    if face_ends:
+        parts, g1, g2 = hypoid_face_ends(pair)
+        path, margin, _ = face_end_contact(r1, r2, asm, mis, path, margin, parts, g1, g2,
+                                           drive=drive, line_contact=line_contact)
+        _, coords = hypoid_margin(pair, path)
     multi = multi_pair(path, margin, steps_per_pitch, pair.z1, drive=drive, n_pairs=n_pairs)
     return HypoidTCA(path, margin, multi, coords)
 

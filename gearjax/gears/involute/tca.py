@@ -46,6 +46,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from gearjax.edge_contact import face_end_contact
 from gearjax.errors import check_range
 from gearjax.fields import float64_array
 from gearjax.gears.involute.geometry import (InvolutePair, generated_flank, pair_geometry,
@@ -139,6 +140,28 @@ def involute_margin(des: InvoluteTCA, path: ContactPath):
     return jnp.min(parts, axis=0), parts
 
 
+def involute_face_ends(des: InvoluteTCA):
+    """``(margin_parts, g1, g2)`` of :func:`gearjax.edge_contact.face_end_contact`: the
+    boundary margins (face width, and tip/form circle) of each member at body points,
+    and the face-end functions ``g(q, e) = q_z - e b/2`` of pinion and gear (mm)."""
+    p = des.pair
+    geo = pair_geometry(p)
+    rf1 = _form_radius(p.module, p.pressure_angle + des.dalpha, p.helix, p.x1, p.z1)
+    rf2 = _form_radius(p.module, p.pressure_angle, p.helix, p.x2, p.z2)
+    hb = 0.5 * des.face_width
+
+    def margin_parts(q1, q2):
+        r1 = jnp.linalg.norm(q1[..., :2], axis=-1)
+        r2 = jnp.linalg.norm(q2[..., :2], axis=-1)
+        return (hb - jnp.abs(q1[..., 2]), jnp.minimum(geo["ra1"] - r1, r1 - rf1),
+                hb - jnp.abs(q2[..., 2]), jnp.minimum(geo["ra2"] - r2, r2 - rf2))
+
+    def g(q, e):
+        return q[2] - e * hb
+
+    return margin_parts, g, g
+
+
 def reference_guess(des: InvoluteTCA, side: int):
     """Initial guess (u1, v1, u2, v2, phi2) and phi1 near the pitch-point contact.
 
@@ -180,8 +203,12 @@ def reference_guess(des: InvoluteTCA, side: int):
 def involute_tca_traced(des: InvoluteTCA, mis: Misalignment, *, side: int = -1,
                         steps_per_pitch: int = 24, half_pitches: float = 1.25,
                         line_contact: bool = True, n_pairs: int = 3,
-                        approach=DEFAULT_APPROACH):
+                        approach=DEFAULT_APPROACH, face_ends: bool = True):
     """Traceable TCA of an involute pair: ``(path, margin, multi)``.
+
+    With ``face_ends`` (default) the contact at the face ends of both members is
+    solved too and the contact made at each pinion angle is the surface or the edge
+    contact (:func:`gearjax.edge_contact.face_end_contact`; ``path.edge_kind``).
 
     The grid of pinion angles is uniform with step ``2 pi/(z1 steps_per_pitch)``,
     centred on the nominal pitch-point contact, ``half_pitches`` pitches each side
@@ -194,10 +221,15 @@ def involute_tca_traced(des: InvoluteTCA, mis: Misalignment, *, side: int = -1,
     grid = phi1_ref + h * jnp.arange(-k, k + 1, dtype=float)
     r1 = crowned_pinion_flank(des, side)
     r2 = generated_flank(p.module, p.pressure_angle, -p.helix, p.x2, p.z2, side)
-    path = contact_path(r1, r2, involute_assembly(p), mis, grid, x_ref,
+    asm = involute_assembly(p)
+    path = contact_path(r1, r2, asm, mis, grid, x_ref,
                         line_contact=line_contact, approach=approach)
     path = path._replace(converged=path.converged & ok)
     margin, _ = involute_margin(des, path)
+    if face_ends:
+        parts, g1, g2 = involute_face_ends(des)
+        path, margin, _ = face_end_contact(r1, r2, asm, mis, path, margin, parts, g1, g2,
+                                           drive=side < 0, line_contact=line_contact)
     multi = multi_pair(path, margin, steps_per_pitch, p.z1, drive=(side < 0), n_pairs=n_pairs)
     return path, margin, multi
 

@@ -1,0 +1,288 @@
+"""Edge contact at the face ends of tooth flanks (toe and heel), found by the TCA.
+
+The surface contact of :func:`gearjax.tca.contact_path` is a tangency of the two
+flanks.  Where that tangency lies beyond a face end (an uncrowned pair under a
+shaft-angle error, a bearing pushed off the face by a misalignment) the flanks
+do not touch there: the rigid teeth touch first at the *edge* of one tooth, the
+curve where its flank meets its face-end surface.  This module finds those
+contacts and picks, at every pinion angle, the one that is actually made.
+
+**Face ends.**  The adapter of a gear family describes the face ends of member
+``k`` by a body-frame function ``g_k(q, e)`` (mm) that is zero on the end
+``e = -1`` (toe, front end, ``z = -b/2``) or ``e = +1`` (heel, back end) and
+grows into the face, e.g. ``g = q_z - e b/2`` for an involute gear and
+``g = (F/2)(xi(q) - e)`` with the face-width position ``xi`` for a bevel gear.
+The edge curve is the intersection of the flank with ``g_k = 0``; its tangent at
+a point ``q`` is ``m_k x grad g_k(q)`` (``m_k`` the flank normal).
+
+**Edge-contact equations** (curve-to-surface tangency, Litvin & Fuentes,
+*Gear Geometry and Applied Theory*, 2nd ed., §9.3 and ch. 15, where the crossing
+of the axes of unmodified helical gears causes edge contact): at pinion angle
+``phi1``, unknowns ``(u1, v1, u2, v2, phi2)`` and the generating motions of the
+generated flanks (as in :func:`gearjax.tca.contact_system`), for an edge of
+member ``k`` touching flank ``j``::
+
+    r1f - r2f = 0                                        (3)  common point
+    g_k(q_k, e) = 0                                      (1)  on the edge
+    n_jf . R_k (m_k x grad g_k) / |m_k x grad g_k| = 0   (1)  edge tangent in
+                                                              flank j's tangent plane
+    n_i . dr_i/dpsi_i = 0                                     meshing equations
+
+a square system of the same size as the point-contact system.  It is reached
+from the surface contact at the reference pinion angle by a homotopy
+``g_k = s g_k(q_ref)``, ``s = 1 -> 0`` (at ``s = 1`` the surface contact solves it:
+the normals are collinear, so any tangent is in flank j's tangent plane), and
+continued along the grid of pinion angles like the surface contact (the
+implicit-differentiated Newton of :mod:`gearjax.newton`; derivatives of the
+edge contact with respect to every design field follow).
+
+**Which contact is made.**  The teeth are rigid: at a pinion angle the gear
+turns until the first pair of points touches.  The candidates are the surface
+contact (valid where it lies inside both flanks) and the four face-end contacts
+(valid where the edge point lies inside the other boundaries of its flank --
+tip, root -- and the point of flank ``j`` inside flank ``j``).  The contact made
+is the candidate furthest ahead in the sense of the load, ``max s TE`` with
+``s = +1`` on the drive side and ``-1`` on the coast side -- the rule of the TE
+envelope of consecutive pairs (:func:`gearjax.tca.multi_pair`).  Where the
+face-width section ``z`` touches at ``f(z)`` (the TE of the profile section at
+``z``), this is ``max f`` over the face: the interior tangency where ``f`` peaks
+inside, an end where it peaks there.  The surface contact is kept unless an edge
+leads it by more than ``EDGE_LEAD`` (1e-9 rad, 2e-4 arcsec): along a line contact
+(a conjugate pair) every section touches at once and the contact is not an edge;
+for the same reason, in line-contact mode (one face-width section solved), a
+face-end contact with the TE of that section is a point of its contact line.
+
+At an edge contact no Hertz ellipse exists (one radius of curvature is zero: the
+load concentrates on the edge); the path reports the semi-axes as NaN there and
+marks the point in ``edge_kind`` (its major axis and Weingarten maps are those of
+the surface solve at that angle, kept finite so that no NaN enters a derivative;
+the kinematics at edge points are NaN, :func:`gearjax.tca_result.contact_kinematics`).
+Tip and root edges are not solved as contacts: a contact path that reaches them
+leaves the flank (``margin < 0``), which the contact ratio, the TE envelope and
+the quality flags of :class:`gearjax.tca_result.TCAResult` report.
+
+Units: mm, rad.
+"""
+
+from __future__ import annotations
+
+from typing import Callable, NamedTuple
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from gearjax.frames import matrix_z
+from gearjax.newton import newton_solve
+from gearjax.tca import ContactPath, contact_system, flank_at, gear_mount
+
+__all__ = ["EDGE_NAMES", "EDGE_LEAD", "EdgeContact", "edge_contact_system", "face_end_contact"]
+
+#: names of the four face ends, in the order of :attr:`EdgeContact.kind`
+EDGE_NAMES = ("pinion toe", "pinion heel", "gear toe", "gear heel")
+_PINION = np.array([1.0, 1.0, 0.0, 0.0])
+_END = np.array([-1.0, 1.0, -1.0, 1.0])
+
+#: rad: an edge contact replaces the surface contact only when it is this far ahead
+EDGE_LEAD = 1e-9
+
+
+class EdgeContact(NamedTuple):
+    """The face-end contacts beside a surface contact path (arrays over the grid).
+
+    kind : (N,) int, -1 where the contact is the surface contact, else the index into
+        :data:`EDGE_NAMES` of the face end carrying the contact.
+    te : (4, N) TE of each face-end contact (rad, the path's reference), NaN where
+        that candidate is not valid.
+    valid : (4, N) the face-end contact converged and lies inside the other
+        boundaries of both flanks.
+    residual : (4, N) max |F| of the edge-contact solves.
+    """
+
+    kind: jax.Array
+    te: jax.Array
+    valid: jax.Array
+    residual: jax.Array
+
+
+def edge_contact_system(r1: Callable, r2: Callable, asm, mis, g1: Callable, g2: Callable):
+    """The edge-contact system ``F(z, theta)`` of the module docstring.
+
+    ``theta = (phi1, s, g0, pinion, e)``: pinion angle, homotopy level, ``g_k`` at the
+    start point, 1.0 for an edge of the pinion (0.0: of the gear), end ``e``.  The
+    unknown ``z`` is packed as in :func:`gearjax.tca.contact_system` (point contact).
+    Returns ``(F, cs)`` with ``cs`` that :class:`~gearjax.tca.ContactSystem`.
+    """
+    R, c = gear_mount(asm, mis)
+    cs = contact_system(r1, r2, asm, mis, False)
+    ez = jnp.array([0.0, 0.0, 1.0])
+
+    def tangency(n_other, Rk, m, grad_g):
+        t = Rk @ jnp.cross(m, grad_g)
+        nt = jnp.linalg.norm(t)
+        return jnp.dot(n_other, t) / jnp.where(nt > 0.0, nt, 1.0)
+
+    def F(z, theta):
+        ph1, s, g0, pinion, e = theta
+        x, psi1, psi2 = cs.split(z)
+        uv1, uv2, ph2 = cs.unpack(x)
+        q1, m1, f1 = flank_at(r1, uv1, psi1)
+        q2, m2, f2 = flank_at(r2, uv2, psi2)
+        R1 = matrix_z(ph1)
+        R2 = R @ matrix_z(ph2)
+        p1 = R1 @ q1 + mis.dP * ez
+        p2 = c + R2 @ q2
+        ga, da = jax.value_and_grad(g1)(q1, e)
+        gb, db = jax.value_and_grad(g2)(q2, e)
+        is1 = pinion > 0.5
+        on_edge = jnp.where(is1, ga, gb) - s * g0
+        tang = jnp.where(is1, tangency(R2 @ m2, R1, m1, da), tangency(R1 @ m1, R2, m2, db))
+        mesh = [jnp.reshape(f, (1,)) for f in (f1, f2) if f is not None]
+        return jnp.concatenate([p1 - p2, jnp.stack([on_edge, tang])] + mesh)
+
+    return F, cs
+
+
+def _continue(F, z0, thetas, fresh, n_homotopy, tol, max_steps):
+    """Solve ``F(z, theta_i) = 0`` along the scanned ``thetas`` (lax.scan), each solve
+    from the linear predictor of the two previous solutions (uniform steps of the
+    homotopy level, then of the angle); a constant predictor where ``fresh`` (the
+    first angle step after the homotopy, the first ``n_homotopy`` steps).  A failed step keeps the previous
+    solution.  Where the homotopy has not reached its end (its last solve failed) the
+    angle steps are marked not converged."""
+
+    def step(carry, inp):
+        x_prev, x_prev2, ok_h = carry
+        theta, new, i = inp
+        linear = jax.lax.stop_gradient(2.0 * x_prev - x_prev2)
+        pred = jnp.where(new, x_prev, linear)
+        sol = newton_solve(F, pred, theta, tol=tol, max_steps=max_steps,
+                           natural_monotonicity=True)
+        ok = sol.converged
+        ok_h = jnp.where(i == n_homotopy - 1, ok, ok_h)
+        sol = sol._replace(converged=ok & ((i < n_homotopy) | ok_h))
+        return (jnp.where(ok, sol.x, x_prev), x_prev, ok_h), sol
+
+    idx = jnp.arange(fresh.shape[0])
+    _, sols = jax.lax.scan(step, (z0, z0, jnp.asarray(True)), (thetas, fresh, idx))
+    return sols
+
+
+def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, margin,
+                     margin_parts: Callable, g1: Callable, g2: Callable, *, drive,
+                     line_contact: bool = False, tol: float = 1e-11, max_steps: int = 30, n_homotopy: int = 8):
+    """Face-end contacts beside ``path`` and the contact actually made (traceable).
+
+    ``path``, ``margin`` : the surface contact path and its boundary margin (mm).
+    ``margin_parts(p1_body, p2_body) -> (face1, rest1, face2, rest2)`` : boundary
+    margins (mm, >= 0 inside) of each member's face width and of its other boundaries
+    (tip, root) at body-frame points (N, 3).  ``g1, g2`` : face-end functions of pinion
+    and gear (module docstring).  ``drive`` : True on the drive side (may be traced).
+    ``line_contact`` : ``path`` was solved in line-contact mode (one face-width section):
+    a face-end contact with the TE of that section lies on its contact line and is
+    not an edge contact.
+
+    Returns ``(path, margin, edges)``: the path with the contact made at every grid
+    point (surface or edge), its margin (>= 0 on the flanks; 0 on the edge's own face
+    end), and the :class:`EdgeContact`.  The TE keeps the reference of ``path``.
+    """
+    n = path.phi1.shape[0]
+    mid = n // 2
+    F, cs = edge_contact_system(r1, r2, asm, mis, g1, g2)
+    R, c = gear_mount(asm, mis)
+    x0 = jnp.concatenate([path.uv1[mid], path.uv2[mid], path.phi2[mid][None]])
+    psi_mid = [None if p is None else p[mid] for p in (path.psi1, path.psi2)]
+    z_ref = jax.lax.stop_gradient(cs.join(x0, *psi_mid))
+    ph_mid = path.phi1[mid]
+    s_levels = jnp.linspace(1.0, 0.0, n_homotopy + 1)[1:]
+    # each direction away from the reference: the homotopy s = 1 -> 0 at the reference
+    # angle, then the continuation along the grid -- one scan, one Newton in the program
+    k = s_levels.shape[0]
+    phis = jnp.stack([jnp.concatenate([jnp.full((k,), ph_mid), path.phi1[mid + 1:]]),
+                      jnp.concatenate([jnp.full((k,), ph_mid), path.phi1[:mid][::-1]])])
+    levels = jnp.concatenate([s_levels, jnp.zeros(mid)])
+    # the linear predictor starts afresh at the first angle step (a constant predictor)
+    fresh = jnp.concatenate([jnp.zeros(k, bool), jnp.ones(1, bool), jnp.zeros(mid - 1, bool)])
+
+    def one_edge(pinion, e):
+        g0 = jnp.where(pinion > 0.5, g1(path.p1_body[mid], e), g2(path.p2_body[mid], e))
+        g0 = jax.lax.stop_gradient(g0)
+
+        def run(ph):
+            return _continue(F, z_ref, (ph, levels, g0 + 0.0 * levels, pinion + 0.0 * levels,
+                                        e + 0.0 * levels), fresh, k, tol, max_steps)
+
+        sols = jax.vmap(run)(phis)
+        at_ref = jax.tree_util.tree_map(lambda a: a[0, k - 1], sols)
+        ok_ref = at_ref.converged & sols.converged[1, k - 1]
+
+        def whole(field, ref_val):
+            two = field[:, k:]
+            return jnp.concatenate([two[1][::-1], ref_val[None], two[0]], axis=0)
+
+        Z = whole(sols.x, at_ref.x)
+        conv = whole(sols.converged, at_ref.converged) & ok_ref
+        res = whole(sols.residual, at_ref.residual)
+        return Z, conv, res
+
+    Z, conv, res = jax.vmap(one_edge)(jnp.asarray(_PINION), jnp.asarray(_END))
+
+    def post(z, ph1):
+        x, psi1, psi2 = cs.split(z)
+        uv1, uv2, ph2 = cs.unpack(x)
+        q1, m1, _ = flank_at(r1, uv1, psi1)
+        q2, m2, _ = flank_at(r2, uv2, psi2)
+        nan = jnp.full((), jnp.nan)
+        return (ph2, uv1, uv2, q1, q2, matrix_z(ph1) @ m1, R @ matrix_z(ph2) @ m2,
+                nan if psi1 is None else psi1, nan if psi2 is None else psi2)
+
+    (ph2, uv1, uv2, q1, q2, n1, n2, psi1, psi2) = jax.vmap(
+        lambda zz: jax.vmap(post)(zz, path.phi1))(Z)
+    face1, rest1, face2, rest2 = jax.vmap(margin_parts)(q1, q2)
+    pin = _PINION[:, None] > 0.5
+    other = jnp.where(pin, jnp.minimum(rest1, jnp.minimum(face2, rest2)),
+                      jnp.minimum(face1, jnp.minimum(rest1, rest2)))
+    valid = conv & (other >= 0.0)
+    te = path.te[None, :] + asm.ratio_sign * (ph2 - path.phi2[None, :])
+    sgn = jnp.where(drive, 1.0, -1.0)
+    surf_ok = (margin >= 0.0) & path.converged
+    key_s = jnp.where(surf_ok, sgn * path.te, -jnp.inf)
+    key_e = jnp.where(valid, sgn * te, -jnp.inf)
+    best = jnp.argmax(key_e, axis=0)
+    lead = jnp.max(key_e, axis=0)
+    use = jnp.isfinite(lead) & (lead > key_s + EDGE_LEAD)
+    if line_contact:
+        # a face-end point on the line contact of the section solved (same TE): part
+        # of the line contact, not an edge contact, wherever that section lies
+        same = path.converged & (jnp.abs(lead - sgn * path.te) <= EDGE_LEAD)
+        use = use & ~same
+    kind = jnp.where(use, best, -1)
+    cols = jnp.arange(n)
+
+    def pick(edge_arr, surf_arr):
+        e = edge_arr[best, cols]
+        u = use.reshape(use.shape + (1,) * (surf_arr.ndim - 1))
+        return jnp.where(u, e, surf_arr)
+
+    normal_e = jnp.where(pin[..., None], n2, n1)          # the mating flank's normal
+    nanv = jnp.full_like(path.semi_major, jnp.nan)
+    out = path._replace(
+        phi2=pick(ph2, path.phi2), te=pick(te, path.te), uv1=pick(uv1, path.uv1),
+        uv2=pick(uv2, path.uv2), normal=pick(normal_e, path.normal),
+        p1_body=pick(q1, path.p1_body), p2_body=pick(q2, path.p2_body),
+        residual=pick(res, path.residual), converged=pick(conv, path.converged),
+        semi_major=jnp.where(use, nanv, path.semi_major),
+        semi_minor=jnp.where(use, nanv, path.semi_minor))
+    p1b = out.p1_body
+    out = out._replace(point=jax.vmap(lambda p, q: matrix_z(p) @ q)(path.phi1, p1b)
+                       + mis.dP * jnp.array([0.0, 0.0, 1.0]),
+                       axial1=p1b[:, 2], radial1=jnp.linalg.norm(p1b[:, :2], axis=1),
+                       axial2=out.p2_body[:, 2],
+                       radial2=jnp.linalg.norm(out.p2_body[:, :2], axis=1))
+    if path.psi1 is not None:
+        out = out._replace(psi1=pick(psi1, path.psi1), psi2=pick(psi2, path.psi2))
+    out = out._replace(edge_kind=kind)
+    edge_margin = jnp.maximum(other[best, cols], 0.0)
+    margin_out = jnp.where(use, edge_margin, margin)
+    te_valid = jnp.where(valid, te, jnp.nan)
+    return out, margin_out, EdgeContact(kind, te_valid, valid, res)
