@@ -38,7 +38,7 @@ import numpy as np
 from gearjax.errors import check_int, check_range, require_converged
 from gearjax.gears.hypoid import iso23509
 from gearjax.gears.hypoid import pitch_cones
-__all__ = ["METHODS", "METHOD_ALIASES", "BlankInput", "BlankData", "OUTPUTS", "blank_geometry",
+__all__ = ["METHODS", "METHOD_ALIASES", "FILE_DEFAULTS", "BlankInput", "BlankData", "OUTPUTS", "blank_geometry",
            "blank_sensitivity", "SENSITIVITY_INPUTS"]
 
 METHODS = ("iso23509-method0", "iso23509-method1", "tangent-cones")
@@ -96,7 +96,9 @@ _REQUIRED = ("z1", "z2", "gear_outer_pitch_diameter_mm", "gear_face_width_mm",
 class BlankInput:
     """Designer's input for a face-milled bevel/hypoid blank (mm, rad).
 
-    Static (meta) fields: ``z1, z2`` tooth numbers (pinion, gear); ``method`` one of
+    Static (meta) fields: ``z1, z2`` tooth numbers (pinion, gear; integers with
+    1 <= z1 <= 400 and z1 <= z2 <= 2000 -- one-tooth pinions exist in high-ratio
+    hypoids, so no larger minimum is imposed); ``method`` one of
     :data:`METHODS`; ``hand`` of spiral of the pinion ("left"/"right");
     ``spiral_member`` whose mean spiral angle ``spiral_angle`` is ("pinion" --
     the ISO Method 1 input -- or "gear"; Method 0 has equal angles); ``taper`` the
@@ -149,8 +151,10 @@ class BlankInput:
         ``pressure_angle_drive_deg`` [20], ``pressure_angle_coast_deg`` [20],
         ``limit_pressure_angle_factor`` [1], ``addendum_factor`` [1.0],
         ``dedendum_factor`` [1.25], ``profile_shift`` [0], ``wheel_addendum_angle_deg``
-        [0], ``wheel_dedendum_angle_deg`` [0].  Raises ``ValueError`` with one line
-        naming the field, its value and the allowed range.
+        [0], ``wheel_dedendum_angle_deg`` [0] (:data:`FILE_DEFAULTS`).  Raises
+        ``ValueError`` with one line naming the field, its value and the allowed
+        range; a string, boolean or array where a number is expected, a float
+        tooth number, NaN and inf are refused.
         """
         if not isinstance(d, dict):
             raise ValueError(f"[blank] must be a table, got {type(d).__name__}")
@@ -169,11 +173,18 @@ class BlankInput:
             v = d[key]
             if kind == "str":
                 if not isinstance(v, str):
-                    raise ValueError(f"{key} = {v!r} must be a string")
+                    raise ValueError(f"{key} = {v!r} must be a string, got {type(v).__name__}")
                 kw[attr] = v
             elif kind == "int":
+                if not isinstance(v, (int, np.integer)) or isinstance(v, (bool, np.bool_)):
+                    raise ValueError(f"{key} = {v!r} must be an integer, got {type(v).__name__}")
                 kw[attr] = check_int(key, v, 1)
             else:
+                if (not isinstance(v, (int, float, np.integer, np.floating))
+                        or isinstance(v, (bool, np.bool_))):
+                    raise ValueError(f"{key} = {v!r} must be a number"
+                                     + (f" ({kind})" if kind in ("mm", "deg") else "")
+                                     + f", got {type(v).__name__}")
                 x = check_range(key, v)
                 kw[attr] = math.radians(x) if kind == "deg" else x
         inp = cls(**kw)
@@ -248,6 +259,24 @@ class BlankInput:
                           ("wheel_dedendum_angle_deg", "wheel_dedendum_angle")):
             check_range(key, math.degrees(getattr(self, attr)), -10.0, 20.0, unit="deg")
         return self
+
+
+def _file_defaults() -> dict:
+    """{file key: (default in file units, unit)} of every optional ``[blank]`` key."""
+    dflt = {f.name: f.default for f in fields(BlankInput)}
+    out = {}
+    for key, attr, kind in _KEYS:
+        if key in _REQUIRED:
+            continue
+        v = dflt[attr]
+        out[key] = (_deg_exact(v) if kind == "deg" else v, {"deg": "deg", "mm": "mm"}.get(kind, "-"))
+    return out
+
+
+#: defaults of the optional ``[blank]`` keys, file units: {key: (value, unit)}; a
+#: design that relies on one gets it printed by ``gearjax example show`` and
+#: ``gearjax blank`` (``defaults applied: ...``)
+FILE_DEFAULTS = _file_defaults()
 
 
 _META = ("z1", "z2", "method", "hand", "spiral_member", "taper")
