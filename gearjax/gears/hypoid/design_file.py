@@ -68,7 +68,7 @@ from gearjax.io import check_string, dumps_toml, read_toml
 from gearjax.io import require_key as _req
 
 __all__ = ["HypoidDesign", "load_design", "save_design", "design_from_dict", "defaults_applied",
-           "cross_check", "CROSS_CHECK_RTOL", "MACHINE_DEFAULTS"]
+           "format_defaults", "cross_check", "CROSS_CHECK_RTOL", "MACHINE_DEFAULTS"]
 
 MEMBERS = ("pinion", "gear")
 FLANKS = ("convex", "concave")
@@ -356,13 +356,14 @@ def defaults_applied(design: HypoidDesign) -> list:
     return out
 
 
-def format_defaults(design: HypoidDesign) -> str:
-    """One line: ``defaults applied: key = value unit, ...`` (or ``none``)."""
-    items = defaults_applied(design)
-    if not items:
-        return "defaults applied: none (every key is given)"
-    txt = ", ".join(f"{k} = {v!r}" + (f" {_u(u)}" if _u(u) else "") for k, v, u in items)
-    return f"defaults applied: {txt}"
+def format_defaults(design: HypoidDesign) -> list:
+    """``["key = value unit", ...]``: :func:`defaults_applied` as printable lines
+    (TOML syntax, so that they can be pasted into the design file)."""
+    out = []
+    for k, v, u in defaults_applied(design):
+        out.append(f"{k} = {v!r}" if isinstance(v, str) else f"{k} = {v!r}"
+                   + (f"    # {_u(u)}" if _u(u) else ""))
+    return out
 
 
 def design_from_dict(data: dict) -> HypoidDesign:
