@@ -105,6 +105,9 @@ class BlankInput:
     depthwise taper of ISO 23509 annex C.5 ("standard", "uniform",
     "constant-slot", "modified-slot", "manual").
 
+    Sane bounds besides the ranges of :meth:`validate`: gear outer pitch diameter
+    and cutter radius at most 1e4 mm (10 m).
+
     Continuous (data) fields, differentiable: ``shaft_angle`` Sigma (rad, default
     pi/2); ``offset`` hypoid offset E (mm, >= 0, default 0); ``gear_outer_pitch_
     diameter`` d_e2 (mm, the **outer** pitch diameter of the gear); ``gear_face_
@@ -231,14 +234,14 @@ class BlankInput:
         sig = check_range("shaft_angle_deg", math.degrees(self.shaft_angle), 45.0, sig_max,
                           unit="deg")
         de2 = check_range("gear_outer_pitch_diameter_mm", self.gear_outer_pitch_diameter,
-                          0.0, None, lo_open=True, unit="mm")
+                          0.0, 1e4, lo_open=True, unit="mm")
         # outer cone distance of the bevel pitch cone as the face-width bound
         S = math.radians(sig)
         d2 = S - math.atan2(math.sin(S), z2 / z1 + math.cos(S))
         Re2 = de2 / (2.0 * math.sin(d2))
         check_range("gear_face_width_mm", self.gear_face_width, 0.0, Re2, lo_open=True,
                     hi_open=True, unit="mm")
-        check_range("cutter_radius_mm", self.cutter_radius, 0.0, None, lo_open=True, unit="mm")
+        check_range("cutter_radius_mm", self.cutter_radius, 0.0, 1e4, lo_open=True, unit="mm")
         if self.method == "iso23509-method0":
             check_range("offset_mm", self.offset, 0.0, 0.0, unit="mm")
             check_range("spiral_angle_deg", math.degrees(self.spiral_angle), 0.0, 70.0,

@@ -30,8 +30,11 @@ by ``gearjax example show`` and ``gearjax blank`` when applied, see
   (not used; any keys).
 
 Every number must be a finite TOML int or float (no bool, string, array, NaN,
-inf); tooth numbers TOML integers; angles (degrees) of the machine tables in
-[-360, 360].  Unknown keys raise ``ValueError`` naming the key.
+inf); tooth numbers TOML integers; sane ranges: angles (degrees) of the machine
+tables and dials in [-360, 360], every length in [-1e4, 1e4] mm, ratio_of_roll and
+the modified-roll coefficients in [-1e3, 1e3]; the constructors add the finer
+ranges (e.g. blade angle in (0, 45) deg, tilt in [0, 90) deg, face width below the
+outer cone distance).  Unknown keys raise ``ValueError`` naming the key.
 
 Cross-checks between the tables of one design (:func:`cross_check`), relative
 tolerance :data:`CROSS_CHECK_RTOL` = 1e-3 for real numbers (the published tables
@@ -97,6 +100,8 @@ _PLACEMENT = ("radial_distance", "cradle_angle", "tilt", "swivel")
 MACHINE_DEFAULTS = {"modified_roll_2c": 0.0, "modified_roll_6d": 0.0}
 _ROLL_KEYS = ("ratio_of_roll", "modified_roll_2c", "modified_roll_6d")
 _ANGLE_LIMIT = 360.0            # |angle| bound (deg) of machine-table angles and dials
+_LENGTH_LIMIT = 1e4             # |length| bound (mm) of every length in a design file (10 m)
+_ROLL_LIMIT = 1e3               # |ratio_of_roll|, |2C| (1/rad), |6D| (1/rad^2) bound
 #: relative tolerance of the cross-checks between tables (real numbers)
 CROSS_CHECK_RTOL = 1e-3
 
@@ -106,11 +111,18 @@ def _u(unit):
 
 
 def _num(where, d, key, unit):
-    """Required finite number ``d[key]`` (float); angles (unit deg) in [-360, 360]."""
+    """Required finite number ``d[key]`` (float) within its sane range: angles of the
+    machine tables (deg) in [-360, 360], lengths (mm) in [-1e4, 1e4], roll
+    coefficients in [-1e3, 1e3] (finer ranges: the constructors)."""
     x = check_number(where, key, _req(where, d, key), _u(unit))
-    if unit == "deg" and where.endswith(("machine", "no116")) and abs(x) > _ANGLE_LIMIT:
-        raise ValueError(f"[{where}] {key} = {x:g} deg is outside the allowed range "
-                         f"[-{_ANGLE_LIMIT:g}, {_ANGLE_LIMIT:g}] deg")
+    if unit == "deg" and where.endswith(("machine", "no116")):
+        lim = _ANGLE_LIMIT
+    else:
+        lim = {"mm": _LENGTH_LIMIT}.get(unit, _ROLL_LIMIT if key in _ROLL_KEYS else None)
+    if lim is not None and abs(x) > lim:
+        u = f" {_u(unit)}" if _u(unit) else ""
+        raise ValueError(f"[{where}] {key} = {x:g}{u} is outside the allowed range "
+                         f"[-{lim:g}, {lim:g}]{u}")
     return x
 
 
