@@ -4,7 +4,7 @@ DESIGN is a path or ``example:NAME``; its ``[blank]`` table goes verbatim to
 :meth:`gearjax.gears.hypoid.blank.BlankInput.from_dict` and
 :func:`~gearjax.gears.hypoid.blank.blank_geometry` computes the blank.  The table is
 followed by the documented defaults the design relies on (keys left out of the
-file, :func:`gearjax.gears.hypoid.design_file.defaults_applied`); ``--json`` prints
+file, :meth:`gearjax.HypoidDesign.defaults_applied`); ``--json`` prints
 the blank data only."""
 
 from __future__ import annotations
@@ -23,7 +23,6 @@ def register(sub):
 
 def run(args) -> int:
     from gearjax import blank_geometry, load_design
-    from gearjax.gears.hypoid.design_file import format_defaults
     design = load_design(args.design)
     data = blank_geometry(design.blank_input())
     if args.json:
@@ -34,7 +33,7 @@ def run(args) -> int:
     sys.stdout.write(f"blank of {design.name or args.design}\n")
     for name, value, unit in rows:
         sys.stdout.write(f"  {name:<{w}s}  {value:14.6f}  {unit}\n")
-    lines = format_defaults(design)
+    lines = design.defaults_lines()
     sys.stdout.write("defaults applied (keys not in the design file):" + ("" if lines else " none")
                      + "\n")
     for ln in lines:

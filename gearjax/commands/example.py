@@ -31,11 +31,10 @@ def run_show(args) -> int:
     """Print the file, then the documented defaults it relies on (keys left out of
     the file) as TOML comments, so that the printed text still loads."""
     from gearjax import example_path, load_design
-    from gearjax.gears.hypoid.design_file import format_defaults
     from gearjax.io import EXAMPLE_ALIASES
     name = EXAMPLE_ALIASES.get(args.name, args.name)
     text = example_path(name).read_text(encoding="utf-8")
-    lines = format_defaults(load_design(f"example:{name}"))
+    lines = load_design(f"example:{name}").defaults_lines()
     sys.stdout.write(text if text.endswith("\n") else text + "\n")
     sys.stdout.write("\n# defaults applied (keys not in this file; gearjax uses these values):"
                      + ("" if lines else " none") + "\n")

@@ -147,6 +147,15 @@ class HypoidDesign:
     def to_dict(self) -> dict:
         return copy.deepcopy(self.data)
 
+    def defaults_applied(self) -> list:
+        """``[(dotted key, value, unit), ...]`` of the documented defaults this design
+        relies on (:func:`defaults_applied`)."""
+        return defaults_applied(self)
+
+    def defaults_lines(self) -> list:
+        """:meth:`defaults_applied` as printable ``"key = value  # unit"`` lines."""
+        return format_defaults(self)
+
     def flanks(self):
         """(member, flank) pairs present in the design."""
         return [(m, f) for m in MEMBERS for f in FLANKS if f in self.data.get(m, {})]
@@ -371,11 +380,8 @@ def defaults_applied(design: HypoidDesign) -> list:
 def format_defaults(design: HypoidDesign) -> list:
     """``["key = value unit", ...]``: :func:`defaults_applied` as printable lines
     (TOML syntax, so that they can be pasted into the design file)."""
-    out = []
-    for k, v, u in defaults_applied(design):
-        out.append(f"{k} = {v!r}" if isinstance(v, str) else f"{k} = {v!r}"
-                   + (f"    # {_u(u)}" if _u(u) else ""))
-    return out
+    return [f"{k} = {v!r}" + (f"    # {_u(u)}" if _u(u) else "")
+            for k, v, u in defaults_applied(design)]
 
 
 def design_from_dict(data: dict) -> HypoidDesign:
