@@ -120,8 +120,13 @@ class Misalignment:
 
     @classmethod
     def create(cls, dE=0.0, dP=0.0, dG=0.0, dSigma_deg=0.0):
-        """Validated constructor (mm, mm, mm, degrees) for user input: |dE|, |dP|, |dG|
-        <= 50 mm, |dSigma| <= 5 deg.  Traced values (inside ``jax.grad``) pass through."""
+        """Validated constructor (mm, mm, mm, degrees) for user input: finite numbers
+        (not bool or str) with |dE|, |dP|, |dG| <= 50 mm, |dSigma| <= 5 deg; ValueError
+        names the parameter, the value and the range.  Traced values (inside
+        ``jax.grad``) pass through."""
+        for k, v in (("dE", dE), ("dP", dP), ("dG", dG), ("dSigma", dSigma_deg)):
+            if v is None or isinstance(v, (bool, np.bool_, str, bytes, list, tuple, dict)):
+                raise ValueError(f"{k} = {v!r} must be a number, got {type(v).__name__}")
         vals = [check_range(k, v, -lim, lim, unit=u) for k, v, lim, u in
                 (("dE", dE, 50.0, "mm"), ("dP", dP, 50.0, "mm"), ("dG", dG, 50.0, "mm"),
                  ("dSigma", dSigma_deg, 5.0, "deg"))]

@@ -2,7 +2,10 @@
 
 DESIGN is a path or ``example:NAME``; its ``[blank]`` table goes verbatim to
 :meth:`gearjax.gears.hypoid.blank.BlankInput.from_dict` and
-:func:`~gearjax.gears.hypoid.blank.blank_geometry` computes the blank."""
+:func:`~gearjax.gears.hypoid.blank.blank_geometry` computes the blank.  The table is
+followed by the documented defaults the design relies on (keys left out of the
+file, :meth:`gearjax.HypoidDesign.defaults_applied`); ``--json`` prints
+the blank data only."""
 
 from __future__ import annotations
 
@@ -30,4 +33,9 @@ def run(args) -> int:
     sys.stdout.write(f"blank of {design.name or args.design}\n")
     for name, value, unit in rows:
         sys.stdout.write(f"  {name:<{w}s}  {value:14.6f}  {unit}\n")
+    lines = design.defaults_lines()
+    sys.stdout.write("defaults applied (keys not in the design file):" + ("" if lines else " none")
+                     + "\n")
+    for ln in lines:
+        sys.stdout.write(f"  {ln}\n")
     return 0

@@ -11,7 +11,7 @@ def register(sub):
     s = p.add_subparsers(dest="example_cmd", metavar="ACTION")
     s.required = True
     s.add_parser("list", help="list example names").set_defaults(func=run_list)
-    show = s.add_parser("show", help="print an example design file")
+    show = s.add_parser("show", help="print an example design file and the defaults it relies on")
     show.add_argument("name", help="example name (see 'gearjax example list')")
     show.set_defaults(func=run_show)
 
@@ -28,6 +28,16 @@ def run_list(args) -> int:
 
 
 def run_show(args) -> int:
-    from gearjax import example_path
-    sys.stdout.write(example_path(args.name).read_text(encoding="utf-8"))
+    """Print the file, then the documented defaults it relies on (keys left out of
+    the file) as TOML comments, so that the printed text still loads."""
+    from gearjax import example_path, load_design
+    from gearjax.io import EXAMPLE_ALIASES
+    name = EXAMPLE_ALIASES.get(args.name, args.name)
+    text = example_path(name).read_text(encoding="utf-8")
+    lines = load_design(f"example:{name}").defaults_lines()
+    sys.stdout.write(text if text.endswith("\n") else text + "\n")
+    sys.stdout.write("\n# defaults applied (keys not in this file; gearjax uses these values):"
+                     + ("" if lines else " none") + "\n")
+    for ln in lines:
+        sys.stdout.write(f"#   {ln}\n")
     return 0

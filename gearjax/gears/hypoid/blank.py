@@ -38,7 +38,7 @@ import numpy as np
 from gearjax.errors import check_int, check_range, require_converged
 from gearjax.gears.hypoid import iso23509
 from gearjax.gears.hypoid import pitch_cones
-__all__ = ["METHODS", "METHOD_ALIASES", "BlankInput", "BlankData", "OUTPUTS", "blank_geometry",
+__all__ = ["METHODS", "METHOD_ALIASES", "FILE_DEFAULTS", "BlankInput", "BlankData", "OUTPUTS", "blank_geometry",
            "blank_sensitivity", "SENSITIVITY_INPUTS"]
 
 METHODS = ("iso23509-method0", "iso23509-method1", "tangent-cones")
@@ -96,12 +96,17 @@ _REQUIRED = ("z1", "z2", "gear_outer_pitch_diameter_mm", "gear_face_width_mm",
 class BlankInput:
     """Designer's input for a face-milled bevel/hypoid blank (mm, rad).
 
-    Static (meta) fields: ``z1, z2`` tooth numbers (pinion, gear); ``method`` one of
+    Static (meta) fields: ``z1, z2`` tooth numbers (pinion, gear; integers with
+    1 <= z1 <= 400 and z1 <= z2 <= 2000 -- one-tooth pinions exist in high-ratio
+    hypoids, so no larger minimum is imposed); ``method`` one of
     :data:`METHODS`; ``hand`` of spiral of the pinion ("left"/"right");
     ``spiral_member`` whose mean spiral angle ``spiral_angle`` is ("pinion" --
     the ISO Method 1 input -- or "gear"; Method 0 has equal angles); ``taper`` the
     depthwise taper of ISO 23509 annex C.5 ("standard", "uniform",
     "constant-slot", "modified-slot", "manual").
+
+    Sane bounds besides the ranges of :meth:`validate`: gear outer pitch diameter
+    and cutter radius at most 1e4 mm (10 m).
 
     Continuous (data) fields, differentiable: ``shaft_angle`` Sigma (rad, default
     pi/2); ``offset`` hypoid offset E (mm, >= 0, default 0); ``gear_outer_pitch_
@@ -149,8 +154,10 @@ class BlankInput:
         ``pressure_angle_drive_deg`` [20], ``pressure_angle_coast_deg`` [20],
         ``limit_pressure_angle_factor`` [1], ``addendum_factor`` [1.0],
         ``dedendum_factor`` [1.25], ``profile_shift`` [0], ``wheel_addendum_angle_deg``
-        [0], ``wheel_dedendum_angle_deg`` [0].  Raises ``ValueError`` with one line
-        naming the field, its value and the allowed range.
+        [0], ``wheel_dedendum_angle_deg`` [0] (:data:`FILE_DEFAULTS`).  Raises
+        ``ValueError`` with one line naming the field, its value and the allowed
+        range; a string, boolean or array where a number is expected, a float
+        tooth number, NaN and inf are refused.
         """
         if not isinstance(d, dict):
             raise ValueError(f"[blank] must be a table, got {type(d).__name__}")
@@ -169,11 +176,18 @@ class BlankInput:
             v = d[key]
             if kind == "str":
                 if not isinstance(v, str):
-                    raise ValueError(f"{key} = {v!r} must be a string")
+                    raise ValueError(f"{key} = {v!r} must be a string, got {type(v).__name__}")
                 kw[attr] = v
             elif kind == "int":
+                if not isinstance(v, (int, np.integer)) or isinstance(v, (bool, np.bool_)):
+                    raise ValueError(f"{key} = {v!r} must be an integer, got {type(v).__name__}")
                 kw[attr] = check_int(key, v, 1)
             else:
+                if (not isinstance(v, (int, float, np.integer, np.floating))
+                        or isinstance(v, (bool, np.bool_))):
+                    raise ValueError(f"{key} = {v!r} must be a number"
+                                     + (f" ({kind})" if kind in ("mm", "deg") else "")
+                                     + f", got {type(v).__name__}")
                 x = check_range(key, v)
                 kw[attr] = math.radians(x) if kind == "deg" else x
         inp = cls(**kw)
@@ -220,14 +234,14 @@ class BlankInput:
         sig = check_range("shaft_angle_deg", math.degrees(self.shaft_angle), 45.0, sig_max,
                           unit="deg")
         de2 = check_range("gear_outer_pitch_diameter_mm", self.gear_outer_pitch_diameter,
-                          0.0, None, lo_open=True, unit="mm")
+                          0.0, 1e4, lo_open=True, unit="mm")
         # outer cone distance of the bevel pitch cone as the face-width bound
         S = math.radians(sig)
         d2 = S - math.atan2(math.sin(S), z2 / z1 + math.cos(S))
         Re2 = de2 / (2.0 * math.sin(d2))
         check_range("gear_face_width_mm", self.gear_face_width, 0.0, Re2, lo_open=True,
                     hi_open=True, unit="mm")
-        check_range("cutter_radius_mm", self.cutter_radius, 0.0, None, lo_open=True, unit="mm")
+        check_range("cutter_radius_mm", self.cutter_radius, 0.0, 1e4, lo_open=True, unit="mm")
         if self.method == "iso23509-method0":
             check_range("offset_mm", self.offset, 0.0, 0.0, unit="mm")
             check_range("spiral_angle_deg", math.degrees(self.spiral_angle), 0.0, 70.0,
@@ -248,6 +262,24 @@ class BlankInput:
                           ("wheel_dedendum_angle_deg", "wheel_dedendum_angle")):
             check_range(key, math.degrees(getattr(self, attr)), -10.0, 20.0, unit="deg")
         return self
+
+
+def _file_defaults() -> dict:
+    """{file key: (default in file units, unit)} of every optional ``[blank]`` key."""
+    dflt = {f.name: f.default for f in fields(BlankInput)}
+    out = {}
+    for key, attr, kind in _KEYS:
+        if key in _REQUIRED:
+            continue
+        v = dflt[attr]
+        out[key] = (_deg_exact(v) if kind == "deg" else v, {"deg": "deg", "mm": "mm"}.get(kind, "-"))
+    return out
+
+
+#: defaults of the optional ``[blank]`` keys, file units: {key: (value, unit)}; a
+#: design that relies on one gets it printed by ``gearjax example show`` and
+#: ``gearjax blank`` (``defaults applied: ...``)
+FILE_DEFAULTS = _file_defaults()
 
 
 _META = ("z1", "z2", "method", "hand", "spiral_member", "taper")

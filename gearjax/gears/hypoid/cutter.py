@@ -44,6 +44,7 @@ from dataclasses import dataclass
 
 import jax
 import jax.numpy as jnp
+import numpy as np
 
 from gearjax.errors import check_positive, check_range, is_traced
 
@@ -77,14 +78,29 @@ class FaceMillCutter:
         return "convex" if self.sign > 0 else "concave"
 
 
+def _reject_non_number(name, v):
+    """ValueError for a bool, string, bytes, None, list, tuple or dict where a number
+    is expected (``float()`` would accept some of them); numbers, arrays and JAX
+    tracers pass (tracers unchecked)."""
+    if v is None or isinstance(v, (bool, np.bool_, str, bytes, list, tuple, dict, set)):
+        raise ValueError(f"{name} = {v!r} must be a number, got {type(v).__name__}")
+
+
 def make_cutter(point_radius, blade_angle_deg, edge_radius, flank: str) -> FaceMillCutter:
     """Validated constructor (file units: mm and degrees).
 
     ``flank`` is "convex" (inside blade, sgn = +1) or "concave" (outside blade,
-    sgn = -1).  Raises ValueError naming the parameter and the allowed range.
+    sgn = -1).  Allowed: point_radius > 0 mm, blade_angle in (0, 45) deg,
+    edge_radius >= 0 mm and small enough for the blade tip (the fillet ends inside
+    the point radius), all finite numbers (not bool or str).  Raises ValueError
+    naming the parameter, the value and the allowed range; traced values (inside
+    ``jax.grad``) pass unchecked.
     """
-    if flank not in ("convex", "concave"):
+    if not isinstance(flank, str) or flank not in ("convex", "concave"):
         raise ValueError(f"flank = {flank!r} must be 'convex' or 'concave'")
+    for name, v in (("point_radius", point_radius), ("blade_angle", blade_angle_deg),
+                    ("edge_radius", edge_radius)):
+        _reject_non_number(name, v)
     R = check_positive("point_radius", point_radius, "mm")
     a = check_range("blade_angle", blade_angle_deg, 0.0, 45.0, lo_open=True, hi_open=True,
                     unit="deg")

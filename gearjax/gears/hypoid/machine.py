@@ -69,6 +69,7 @@ from dataclasses import dataclass
 
 import jax
 import jax.numpy as jnp
+import numpy as np
 
 from gearjax import frames
 from gearjax.errors import check_positive, check_range
@@ -118,15 +119,31 @@ class MachineSettings:
                blank_offset=0.0, sliding_base=0.0, center_to_back=0.0, ratio_of_roll=0.0,
                modified_roll_2c=0.0, modified_roll_6d=0.0, generated=True) -> "MachineSettings":
         """Validated constructor from internal units (mm, rad); traced values (inside
-        ``jax.grad``) pass through unchecked."""
+        ``jax.grad``) pass through unchecked.
+
+        Allowed (concrete values): every setting a finite number (not bool or str);
+        radial_distance > 0 mm; tilt in [0, pi/2) rad; cradle_angle, swivel and
+        machine_root_angle in [-2 pi, 2 pi] rad (one turn either way: published
+        settings such as a machine root angle of 356.67 deg fit); ratio_of_roll > 0
+        for a generated member; ``generated`` a bool.  ValueError names the
+        parameter, the value and the allowed range."""
+        if not isinstance(generated, (bool, np.bool_)):
+            raise ValueError(f"generated = {generated!r} must be True or False")
+        values = dict(radial_distance=radial_distance, cradle_angle=cradle_angle, tilt=tilt,
+                      swivel=swivel, blank_offset=blank_offset,
+                      machine_root_angle=machine_root_angle, sliding_base=sliding_base,
+                      center_to_back=center_to_back, ratio_of_roll=ratio_of_roll,
+                      modified_roll_2c=modified_roll_2c, modified_roll_6d=modified_roll_6d)
+        for name, v in values.items():
+            if v is None or isinstance(v, (bool, np.bool_, str, bytes, list, tuple, dict)):
+                raise ValueError(f"{name} = {v!r} must be a number, got {type(v).__name__}")
         check_positive("radial_distance", radial_distance, "mm")
         check_range("tilt", tilt, 0.0, math.pi / 2, hi_open=True, unit="rad")
-        for name, v in [("cradle_angle", cradle_angle), ("swivel", swivel),
-                        ("machine_root_angle", machine_root_angle), ("blank_offset", blank_offset),
-                        ("sliding_base", sliding_base), ("center_to_back", center_to_back),
-                        ("modified_roll_2c", modified_roll_2c),
-                        ("modified_roll_6d", modified_roll_6d)]:
-            check_range(name, v)
+        for name in ("cradle_angle", "swivel", "machine_root_angle"):
+            check_range(name, values[name], -2.0 * math.pi, 2.0 * math.pi, unit="rad")
+        for name in ("blank_offset", "sliding_base", "center_to_back", "ratio_of_roll",
+                     "modified_roll_2c", "modified_roll_6d"):
+            check_range(name, values[name])
         if generated:
             check_positive("ratio_of_roll", ratio_of_roll)
         f = lambda v: jnp.asarray(v, float)
