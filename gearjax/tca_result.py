@@ -270,8 +270,19 @@ class TCAResult:
 
     @property
     def on_flank(self):
-        """(N,) pair 0 converged and inside both flank boundaries."""
-        return (self.margin >= 0.0) & self.path.converged
+        """(N,) pair 0 converged and its flanks touch (surface contact) inside both flank
+        boundaries -- not at an edge (:attr:`edge_points`)."""
+        on = (self.margin >= 0.0) & self.path.converged
+        if self.path.edge_kind is None:
+            return on
+        return on & (self.path.edge_kind < 0)
+
+    @property
+    def edge_points(self):
+        """(N,) pair 0 touches at a face end (edge contact; ``path.edge_kind``)."""
+        if self.path.edge_kind is None:
+            return jnp.zeros(self.path.phi1.shape, bool)
+        return (self.margin >= 0.0) & self.path.converged & (self.path.edge_kind >= 0)
 
     #: names of :meth:`objectives`, in order
     OBJECTIVES = ("ptp_arcsec", "mean_abs_srr", "max_abs_srr", "min_r_x_mm", "path_position")
@@ -296,7 +307,8 @@ class TCAResult:
 
         converged : every contact solve between the first and last on-flank grid
             points converged (and the reference did).
-        reference_on_flank : the reference (middle) contact lies inside both flanks.
+        reference_on_flank : the reference (middle) contact lies inside both flanks
+            (or on a face end: then ``face_end_contact``).
         edge_contact : the unloaded TE envelope hands over from one tooth pair to the
             next where a pair runs off its flank (its contact reaches a flank boundary
             while it still carries the load) instead of where the TE curves of the
@@ -315,7 +327,7 @@ class TCAResult:
             sign of a mismatched pair or a bearing that is not where it should be.
         """
         conv = np.asarray(self.path.converged)
-        on = np.asarray(self.on_flank)
+        on = np.asarray(self.on_flank | self.edge_points)     # pair 0 touches
         idx = np.nonzero(on)[0]
         ok = bool(conv[conv.shape[0] // 2]) and (
             idx.size > 0 and bool(np.all(conv[idx[0]:idx[-1] + 1])))
