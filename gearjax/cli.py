@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 
 # sub-command modules, in the order they appear in ``gearjax --help``
@@ -39,19 +40,76 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+#: default location of the persistent compilation cache (``$GEARJAX_CACHE_DIR`` overrides)
+DEFAULT_CACHE_DIR = os.path.join(os.path.expanduser("~"), ".cache", "gearjax", "jax")
+
+
+def _cache_dir() -> str | None:
+    """The cache directory from ``$GEARJAX_CACHE_DIR`` (None when switched off)."""
+    path = os.environ.get("GEARJAX_CACHE_DIR", DEFAULT_CACHE_DIR)
+    if path.strip().lower() in ("off", "none", "0", "false", ""):
+        return None
+    return path
+
+
+def _drop_cache_entry(path: str, key: str) -> None:
+    """Delete the files of one cache entry (JAX's LRU file cache stores entry ``key``
+    as ``<key>-cache`` with its access time in ``<key>-atime``)."""
+    for suffix in ("-cache", "-atime"):
+        try:
+            os.unlink(os.path.join(path, f"{key}{suffix}"))
+        except OSError:
+            pass
+
+
+def _install_cache_repair(path: str) -> bool:
+    """Make a corrupt cache entry a one-off cache miss instead of a warning on every run.
+
+    JAX (0.10) reads an entry with ``compilation_cache.get_executable_and_time``; when
+    the entry is truncated or corrupt, decompression or deserialisation raises, the
+    compiler warns "Error reading persistent compilation cache entry", recompiles,
+    and its ``put`` keeps the bad file because an entry with that key exists, so
+    every later run warns again.  The wrapper installed here catches the error,
+    deletes the entry's files and reports a miss: JAX then recompiles and stores a
+    good entry.  Returns False (nothing installed) when this JAX has no such hook.
+    """
+    try:
+        from jax._src import compilation_cache as cc
+    except ImportError:  # pragma: no cover  (a JAX without the module)
+        return False
+    original = getattr(cc, "get_executable_and_time", None)
+    if original is None:  # pragma: no cover
+        return False
+    if getattr(original, "_gearjax_repair", False):
+        return True
+
+    def get_executable_and_time(cache_key, *args, **kwargs):
+        try:
+            return original(cache_key, *args, **kwargs)
+        except Exception:  # noqa: BLE001 - any unreadable entry is a miss
+            cache = getattr(cc, "_cache", None)    # the directory JAX actually uses
+            _drop_cache_entry(os.fspath(getattr(cache, "_path", None) or path), cache_key)
+            return None, None
+
+    get_executable_and_time._gearjax_repair = True
+    cc.get_executable_and_time = get_executable_and_time
+    return True
+
+
 def _enable_compilation_cache() -> None:
     """Persist compiled JAX programs between CLI runs (``$GEARJAX_CACHE_DIR`` or
-    ``~/.cache/gearjax/jax``; set ``GEARJAX_CACHE_DIR=off`` to disable)."""
-    import os
-
+    ``~/.cache/gearjax/jax``; set ``GEARJAX_CACHE_DIR=off`` to disable).  A corrupt
+    or truncated entry is deleted and recompiled once (:func:`_install_cache_repair`)."""
     import jax
 
-    path = os.environ.get("GEARJAX_CACHE_DIR", os.path.join(os.path.expanduser("~"), ".cache",
-                                                            "gearjax", "jax"))
-    if path.lower() in ("off", "none", ""):
+    path = _cache_dir()
+    if path is None:
         return
     try:
         os.makedirs(path, exist_ok=True)
+        if not os.access(path, os.W_OK | os.X_OK):
+            return                      # a read-only cache directory: run without the cache
+        _install_cache_repair(path)
         jax.config.update("jax_compilation_cache_dir", path)
         jax.config.update("jax_persistent_cache_min_compile_time_secs", 0.5)
     except (OSError, AttributeError, ValueError):  # read-only home or an older JAX
@@ -66,13 +124,27 @@ def main(argv=None) -> int:
     try:
         return int(args.func(args) or 0)
     except BrokenPipeError:  # output piped into `head` and the like
-        import os
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
         return 0
     except ValueError as exc:
         sys.stderr.write(f"gearjax: error: {exc}\n")
         return 2
+    except OSError as exc:  # a write (or read) failed: disk full, permissions, size limit
+        sys.stderr.write(f"gearjax: error: {_os_error_line(exc)}\n")
+        return 1
+
+
+def _os_error_line(exc: OSError) -> str:
+    from gearjax.io import WriteError
+
+    what = exc.strerror or str(exc) or type(exc).__name__
+    if isinstance(exc, WriteError):
+        return (f"cannot write {os.fspath(exc.filename)!r}: {what} "
+                "(nothing written; an existing file is left unchanged)")
+    if exc.filename:
+        return f"{os.fspath(exc.filename)!r}: {what}"
+    return f"input/output error: {what}"
 
 
 if __name__ == "__main__":  # pragma: no cover

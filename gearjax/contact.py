@@ -285,13 +285,22 @@ def hertz_point_traced(F, Rx, Ry, E_prime, method: str = "exact") -> HertzResult
 _hertz_point_jit = jax.jit(hertz_point_traced, static_argnames=("method",))
 
 
-def _check_array_positive(name, value, unit):
+#: highest accepted normal load (N) and reduced modulus E' (MPa; diamond on diamond
+#: is about 2.4e6 MPa) of the validated entry points
+LOAD_MAX_N = 1.0e7
+E_PRIME_MAX_MPA = 1.0e7
+
+
+def _check_array_positive(name, value, unit, hi=None):
+    """Every entry finite and in (0, hi]; ``ValueError`` naming the first bad one."""
     arr = np.asarray(value, dtype=float)
     if arr.size == 0:
         raise ValueError(f"{name} is empty")
     bad = ~np.isfinite(arr) | (arr <= 0)
+    if hi is not None:
+        bad |= arr > hi
     if np.any(bad):
-        check_positive(name, arr[bad].ravel()[0], unit)
+        check_range(name, arr[bad].ravel()[0], 0.0, hi, lo_open=True, unit=unit)
     return arr
 
 
@@ -300,11 +309,11 @@ def hertz_point(F, Rx, Ry, E_prime, method: str = "exact", strict: bool = True) 
 
     Parameters
     ----------
-    F : normal load, N (> 0).
+    F : normal load, N (in (0, 1e7]).
     Rx, Ry : relative principal radii of curvature in the rolling and transverse
         directions, mm (> 0, finite; for an infinitely long line contact use
         :func:`hertz_line`).
-    E_prime : reduced modulus E' = 2E*, MPa (> 0).
+    E_prime : reduced modulus E' = 2E*, MPa (in (0, 1e7]).
     method : ``"exact"`` (AGM elliptic integrals + Newton for the ellipticity) or a
         curve fit: ``"brewe_hamrock_1977"`` (alias ``"hamrock_brewe"``) or
         ``"hamrock_brewe_1983"`` (warned outside 1 ≤ max/min radius ≤ 100).
@@ -316,10 +325,10 @@ def hertz_point(F, Rx, Ry, E_prime, method: str = "exact", strict: bool = True) 
     :class:`HertzResult` (a, b in mm; p_max, p_mean in MPa; approach in mm).
     Equations (1)–(4) of the module docstring.
     """
-    _check_array_positive("F", F, "N")
+    _check_array_positive("F", F, "N", hi=LOAD_MAX_N)
     rx = _check_array_positive("Rx", Rx, "mm")
     ry = _check_array_positive("Ry", Ry, "mm")
-    _check_array_positive("E_prime", E_prime, "MPa")
+    _check_array_positive("E_prime", E_prime, "MPa", hi=E_PRIME_MAX_MPA)
     if method not in _METHODS:
         raise _method_error(method)
     ratio = np.maximum(rx, ry) / np.minimum(rx, ry)

@@ -8,14 +8,15 @@ roughness and asperity radius in µm, radii in mm, load in N, viscosity in Pa·s
 from __future__ import annotations
 
 import argparse
-import json
 import math
-import os
 import warnings
 
 import numpy as np
 
-from gearjax.errors import check_positive, check_range
+from gearjax.errors import check_range
+
+#: figure formats accepted by --plot
+PLOT_SUFFIXES = (".png", ".pdf", ".svg")
 
 FRICTION_KEYS_DOC = """JSON keys (friction):
   a_mm, b_mm            Hertz semi-axes: a transverse (along Ry), b rolling (along Rx) (mm)
@@ -40,27 +41,57 @@ STRIBECK_KEYS_DOC = """JSON keys (stribeck): arrays over the speed sweep
 plus p_max_MPa, a_mm, b_mm (constant along the sweep), input, and plot (the PNG path or null)."""
 
 
+#: accepted ranges of the operating inputs, (low, high, low bound excluded, unit); the
+#: library validates the same quantities (gearjax.contact, gearjax.tribology)
+RANGES = {
+    "--load-N": (0.0, 1e7, True, "N"),
+    "--rx-mm": (0.0, 1e6, True, "mm"),
+    "--ry-mm": (0.0, 1e6, True, "mm"),
+    "--eta0": (math.exp(-9.67), 100.0, True, "Pa·s"),
+    "--alpha-per-GPa": (0.0, 100.0, True, "1/GPa"),
+    "--tau0-MPa": (0.0, 100.0, True, "MPa"),
+    "--sigma-um": (0.0, 10.0, True, "um"),
+    "--asperity-density-per-mm2": (0.0, 1e6, True, "1/mm^2"),
+    "--asperity-radius-um": (0.0, 1000.0, True, "um"),
+    "--fc": (0.0, 1.0, False, ""),
+    "--E-prime-MPa": (0.0, 1e7, True, "MPa"),
+    "--ue": (0.0, 500.0, True, "m/s"),
+    "--us": (0.0, 500.0, False, "m/s"),
+    "--ue-min": (0.0, 500.0, True, "m/s"),
+    "--ue-max": (0.0, 500.0, True, "m/s"),
+    "--srr": (0.0, 2.0, False, ""),
+}
+
+
+def _check(flag, value):
+    lo, hi, lo_open, unit = RANGES[flag]
+    return check_range(flag, value, lo, hi, lo_open=lo_open, unit=unit)
+
+
 def _add_common(p):
-    p.add_argument("--load-N", type=float, required=True, help="normal load F_n (N, > 0)")
+    p.add_argument("--load-N", type=float, required=True, help="normal load F_n (N, in (0, 1e7])")
     p.add_argument("--rx-mm", type=float, required=True,
-                   help="relative radius of curvature in the rolling direction (mm, > 0)")
+                   help="relative radius of curvature in the rolling direction (mm, in (0, 1e6])")
     p.add_argument("--ry-mm", type=float, required=True,
-                   help="relative radius of curvature in the transverse direction (mm, > 0)")
+                   help="relative radius of curvature in the transverse direction (mm, in (0, 1e6])")
     g = p.add_mutually_exclusive_group(required=True)
     g.add_argument("--oil", help="example oil: mineral_vg100 | mineral_vg220 | pao_vg100")
-    g.add_argument("--eta0", type=float, help="inlet viscosity (Pa·s, > 6.3e-5)")
+    g.add_argument("--eta0", type=float, help="inlet viscosity (Pa·s, in (6.31e-5, 100])")
     p.add_argument("--alpha-per-GPa", type=float, default=20.0,
-                   help="pressure-viscosity coefficient with --eta0 (1/GPa, default 20)")
-    p.add_argument("--tau0-MPa", type=float, default=5.0, help="Eyring stress with --eta0 (MPa)")
+                   help="pressure-viscosity coefficient with --eta0 (1/GPa, in (0, 100], default 20)")
+    p.add_argument("--tau0-MPa", type=float, default=5.0,
+                   help="Eyring stress with --eta0 (MPa, in (0, 100], default 5)")
     p.add_argument("--sigma-um", type=float, required=True,
-                   help="composite RMS roughness sqrt(s1^2+s2^2) (um, > 0)")
+                   help="composite RMS roughness sqrt(s1^2+s2^2) (um, in (0, 10])")
     p.add_argument("--asperity-density-per-mm2", type=float, default=1e4,
-                   help="asperity density (1/mm^2, default 1e4)")
+                   help="asperity density (1/mm^2, in (0, 1e6], default 1e4)")
     p.add_argument("--asperity-radius-um", type=float, default=10.0,
-                   help="asperity tip radius (um, default 10)")
-    p.add_argument("--fc", type=float, default=0.1, help="boundary friction coefficient (default 0.1)")
+                   help="asperity tip radius (um, in (0, 1000], default 10)")
+    p.add_argument("--fc", type=float, default=0.1,
+                   help="boundary friction coefficient (in [0, 1], default 0.1)")
     p.add_argument("--E-prime-MPa", type=float, default=None,
-                   help="reduced modulus E' = 2/((1-v1^2)/E1+(1-v2^2)/E2) (MPa; default steel 226374)")
+                   help="reduced modulus E' = 2/((1-v1^2)/E1+(1-v2^2)/E2) (MPa, in (0, 1e7]; "
+                        "default steel 226374)")
     p.add_argument("--film", choices=["auto", "point", "line"], default="auto",
                    help="film formula (default auto: Hamrock-Dowson blended into line contact)")
     p.add_argument("--viscosity", choices=["roelands", "barus"], default="roelands")
@@ -73,8 +104,10 @@ def register(sub):
                                    "coefficient of one lubricated contact (seed 001 model).",
                        epilog=FRICTION_KEYS_DOC, formatter_class=argparse.RawDescriptionHelpFormatter)
     _add_common(p)
-    p.add_argument("--ue", type=float, required=True, help="entrainment speed (u1+u2)/2 (m/s, > 0)")
-    p.add_argument("--us", type=float, required=True, help="sliding speed |u1-u2| (m/s, >= 0)")
+    p.add_argument("--ue", type=float, required=True,
+                   help="entrainment speed (u1+u2)/2 (m/s, in (0, 500])")
+    p.add_argument("--us", type=float, required=True,
+                   help="sliding speed |u1-u2| (m/s, in [0, 500])")
     p.set_defaults(func=run_friction)
 
     s = sub.add_parser("stribeck", help="Stribeck curve (mu against eta0 u_e / F_n)",
@@ -83,10 +116,13 @@ def register(sub):
                        epilog=STRIBECK_KEYS_DOC, formatter_class=argparse.RawDescriptionHelpFormatter)
     _add_common(s)
     s.add_argument("--srr", type=float, default=0.2, help="slide-to-roll ratio u_s/u_e (in [0, 2])")
-    s.add_argument("--ue-min", type=float, default=0.01, help="lowest entrainment speed (m/s)")
-    s.add_argument("--ue-max", type=float, default=30.0, help="highest entrainment speed (m/s)")
+    s.add_argument("--ue-min", type=float, default=0.01,
+                   help="lowest entrainment speed (m/s, in (0, 500])")
+    s.add_argument("--ue-max", type=float, default=30.0,
+                   help="highest entrainment speed (m/s, in (0, 500], > --ue-min)")
     s.add_argument("--points", type=float, default=40, help="number of speeds (integer 2..2000)")
-    s.add_argument("--plot", default=None, help="write the Stribeck curve as a PNG to this file")
+    s.add_argument("--plot", default=None,
+                   help="write the Stribeck curve to this file (.png, .pdf or .svg)")
     s.set_defaults(func=run_stribeck)
 
 
@@ -94,22 +130,21 @@ def _materials(args):
     from gearjax.tribology import get_oil, make_oil, make_surface
     from gearjax.tribology.friction import STEEL_E_PRIME
 
-    check_positive("--load-N", args.load_N, "N")
-    check_positive("--rx-mm", args.rx_mm, "mm")
-    check_positive("--ry-mm", args.ry_mm, "mm")
-    check_positive("--sigma-um", args.sigma_um, "um")
-    check_positive("--asperity-density-per-mm2", args.asperity_density_per_mm2, "1/mm^2")
-    check_positive("--asperity-radius-um", args.asperity_radius_um, "um")
-    check_range("--fc", args.fc, 0.0, 1.0)
+    for flag in ("--load-N", "--rx-mm", "--ry-mm", "--sigma-um", "--asperity-density-per-mm2",
+                 "--asperity-radius-um", "--fc"):
+        _check(flag, getattr(args, flag[2:].replace("-", "_")))
+    ratio = max(args.rx_mm, args.ry_mm) / min(args.rx_mm, args.ry_mm)
+    if ratio > 1e15:
+        raise ValueError(f"--ry-mm / --rx-mm = {args.ry_mm / args.rx_mm:g} is outside the "
+                         "allowed range [1e-15, 1e15]")
     if args.oil is not None:
         oil = get_oil(args.oil)
     else:
-        check_range("--eta0", args.eta0, math.exp(-9.67), None, lo_open=True, unit="Pa·s")
-        check_positive("--alpha-per-GPa", args.alpha_per_GPa, "1/GPa")
-        check_positive("--tau0-MPa", args.tau0_MPa, "MPa")
+        for flag in ("--eta0", "--alpha-per-GPa", "--tau0-MPa"):
+            _check(flag, getattr(args, flag[2:].replace("-", "_")))
         oil = make_oil(args.eta0, args.alpha_per_GPa, args.tau0_MPa)
     surf = make_surface(args.sigma_um, args.asperity_density_per_mm2, args.asperity_radius_um, args.fc)
-    Ep = STEEL_E_PRIME if args.E_prime_MPa is None else check_positive("--E-prime-MPa", args.E_prime_MPa, "MPa")
+    Ep = STEEL_E_PRIME if args.E_prime_MPa is None else _check("--E-prime-MPa", args.E_prime_MPa)
     return oil, surf, Ep
 
 
@@ -123,15 +158,17 @@ def _input_dict(args, oil, Ep):
 def run_friction(args) -> int:
     from gearjax.tribology import REGIMES, friction_coefficient
 
-    oil, surf, Ep = _materials(args)
-    check_positive("--ue", args.ue, "m/s")
-    check_range("--us", args.us, 0.0, None, unit="m/s")
+    from gearjax.commands import print_json, warn_nonfinite
+
+    _check("--ue", args.ue)
+    _check("--us", args.us)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
+        oil, surf, Ep = _materials(args)
         r = friction_coefficient(args.load_N, args.ue * 1e3, args.us * 1e3, args.rx_mm, args.ry_mm,
                                  oil, surf, Ep, viscosity_model=args.viscosity, film_method=args.film)
+    import sys
     for w in caught:
-        import sys
         sys.stderr.write(f"gearjax: warning: {w.message}\n")
     out = {
         "a_mm": float(r.a), "b_mm": float(r.b), "k": float(r.k), "p_max_MPa": float(r.p_max),
@@ -145,8 +182,9 @@ def run_friction(args) -> int:
         "regime": REGIMES[int(r.regime)], "input": _input_dict(args, oil, Ep),
     }
     if args.json:
-        print(json.dumps(out, indent=2))
+        print_json(out, indent=2)
         return 0
+    warn_nonfinite(k for k, v in out.items() if isinstance(v, float) and not math.isfinite(v))
     rows = [("Hertz a x b", f"{out['a_mm']:.4f} x {out['b_mm']:.4f} mm (k = {out['k']:.3f})"),
             ("p_max", f"{out['p_max_MPa']:.1f} MPa"),
             ("film h_c / h_min", f"{out['h_c_um']:.4f} / {out['h_min_um']:.4f} um (smooth h_c "
@@ -163,23 +201,22 @@ def run_friction(args) -> int:
 
 
 def run_stribeck(args) -> int:
+    from gearjax.commands import print_json, warn_nonfinite
     from gearjax.errors import check_int
+    from gearjax.io import check_output_path
     from gearjax.tribology import REGIMES, stribeck_curve
 
-    oil, surf, Ep = _materials(args)
-    check_range("--srr", args.srr, 0.0, 2.0)
-    check_positive("--ue-min", args.ue_min, "m/s")
-    check_positive("--ue-max", args.ue_max, "m/s")
+    for flag in ("--srr", "--ue-min", "--ue-max"):
+        _check(flag, getattr(args, flag[2:].replace("-", "_")))
     if args.ue_max <= args.ue_min:
         raise ValueError(f"--ue-max = {args.ue_max:g} m/s must exceed --ue-min = {args.ue_min:g} m/s")
     n = check_int("--points", args.points, 2, 2000)
     if args.plot is not None:
-        d = os.path.dirname(os.path.abspath(args.plot))
-        if not os.path.isdir(d):
-            raise ValueError(f"--plot = {args.plot!r}: directory {d!r} does not exist")
+        check_output_path(args.plot, "--plot", PLOT_SUFFIXES)
     ue = np.logspace(np.log10(args.ue_min), np.log10(args.ue_max), n) * 1e3
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
+        oil, surf, Ep = _materials(args)
         c = stribeck_curve(args.load_N, args.rx_mm, args.ry_mm, args.srr, ue, oil, surf, Ep,
                            viscosity_model=args.viscosity, film_method=args.film)
     import sys
@@ -187,9 +224,10 @@ def run_stribeck(args) -> int:
         sys.stderr.write(f"gearjax: warning: {w.message}\n")
     fr = c.friction
     if args.plot is not None:
-        from gearjax.plot.tribology import save_figure_atomic, stribeck_figure
+        from gearjax.io import atomic_write_figure
+        from gearjax.plot.tribology import stribeck_figure
         fig = stribeck_figure([c], [f"F = {args.load_N:g} N, sigma = {args.sigma_um:g} um"])
-        save_figure_atomic(fig, args.plot)
+        atomic_write_figure(fig, args.plot, dpi=120)
     out = {
         "u_e_m_s": (ue * 1e-3).tolist(), "u_s_m_s": (ue * 1e-3 * args.srr).tolist(),
         "stribeck_number_per_m": np.asarray(c.stribeck_number).tolist(),
@@ -202,8 +240,11 @@ def run_stribeck(args) -> int:
         "input": _input_dict(args, oil, Ep), "plot": args.plot,
     }
     if args.json:
-        print(json.dumps(out, indent=2))
+        print_json(out, indent=2)
         return 0
+    warn_nonfinite(f"{k}[{i}]" for k in ("stribeck_number_per_m", "lambda_smooth", "lambda",
+                                          "asperity_load_ratio", "mu", "h_c_um")
+                   for i, v in enumerate(out[k]) if not math.isfinite(v))
     print(f"p_max = {out['p_max_MPa']:.1f} MPa, SRR = {args.srr:g}")
     print(f"{'u_e m/s':>10} {'eta0 ue/F 1/m':>14} {'lambda_s':>9} {'F_a/F_n':>9} {'mu':>8}  regime")
     for i in range(n):

@@ -10,7 +10,6 @@ curvature interference Phi_II = 0, entrainment reversal u_e = 0)."""
 
 from __future__ import annotations
 
-import json
 import math
 import re
 import sys
@@ -40,26 +39,27 @@ def register(sub):
     p.add_argument("--flank", choices=["convex", "concave"], default="convex",
                    help="gear flank (convex = drive side, default)")
     p.add_argument("--blade-angle-delta", type=float, default=0.0,
-                   help="blade angle change from the blank's pressure angle (deg)")
+                   help="blade angle change from the blank's pressure angle (deg, in [-10, 10])")
     p.add_argument("--cutter-shift", type=float, default=0.0,
-                   help="cutter centre shift normal to the tooth trace (mm)")
+                   help="cutter centre shift normal to the tooth trace (mm, in [-20, 20])")
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.add_argument("--plot", default=None, help="save field maps to this .png")
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
-    from pathlib import Path
-
+    from gearjax.commands import print_json, warn_nonfinite
+    from gearjax.errors import check_range
+    from gearjax.io import check_output_path
     from gearjax.studies import cutter_radius as hk
     from gearjax import load_design
     shape = _grid(args.grid)
+    # the ranges of StudySettings.make, checked before the design is read
+    check_range("--blade-angle-delta (blade_angle_delta_deg)", args.blade_angle_delta,
+                -10.0, 10.0, unit="deg")
+    check_range("--cutter-shift (cutter_shift_mm)", args.cutter_shift, -20.0, 20.0, unit="mm")
     if args.plot is not None:
-        pp = Path(args.plot)
-        if pp.suffix.lower() != ".png":
-            raise ValueError(f"--plot = {args.plot!r}: extension must be .png")
-        if not pp.parent.exists():
-            raise ValueError(f"--plot = {args.plot!r}: directory {str(pp.parent)!r} does not exist")
+        check_output_path(args.plot, "--plot", (".png",))
     design = load_design(args.design)
     inp = design.blank_input()
     if inp.method == "iso23509-method0" or float(inp.offset) <= 0.0:
@@ -75,11 +75,14 @@ def run(args) -> int:
            "limits": {k: {kk: v[kk] for kk in ("inside", "fraction", "margin",
                                                "zero_curve_axial")} for k, v in lim.items()}}
     if args.plot is not None:
-        from gearjax.plot.kinematics import field_maps, save_figure
-        save_figure(field_maps({f"{out['design']} {args.flank}": f}), args.plot)
+        from gearjax.io import atomic_write_figure
+        from gearjax.plot.kinematics import field_maps
+        atomic_write_figure(field_maps({f"{out['design']} {args.flank}": f}), args.plot, dpi=90)
     if args.json:
-        sys.stdout.write(json.dumps(out, indent=1) + "\n")
+        print_json(out)
         return 0
+    warn_nonfinite(f"stats.{k}.{kk}" for k in _FIELDS for kk, v in stats[k].items()
+                   if isinstance(v, float) and not math.isfinite(v))
     w = sys.stdout.write
     w(f"seed-000 kinematics of {out['design']}: gear {args.flank} flank, {shape[0]}x{shape[1]} "
       f"grid, r0 = {out['cutter_radius_mm']:g} mm, blade angle {out['blade_angle_deg']:.3f} deg\n")

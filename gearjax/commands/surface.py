@@ -36,21 +36,17 @@ def register(sub):
 
 
 def run(args) -> int:
-    from pathlib import Path
-
     from gearjax import flank_surface, load_design
-    from gearjax.io import write_flank, write_stl_tooth
+    from gearjax.io import check_output_path, write_flank, write_stl_tooth
     from gearjax.progress import Progress
     n_xi, n_s = _grid(args.grid)
-    out = Path(args.out)
-    if out.suffix.lower() not in (".csv", ".xyz", ".stl"):
-        raise ValueError(f"--out = {args.out!r}: extension must be .csv, .xyz or .stl")
+    out = check_output_path(args.out, "--out", (".csv", ".xyz", ".stl"))
     if args.tooth and out.suffix.lower() != ".stl":
         raise ValueError("--tooth needs an .stl output file")
-    if args.plot is not None and Path(args.plot).suffix.lower() not in (".png", ".pdf", ".svg"):
-        raise ValueError(f"--plot = {args.plot!r}: extension must be .png, .pdf or .svg")
-    if not out.parent.exists():
-        raise ValueError(f"--out = {args.out!r}: directory {str(out.parent)!r} does not exist")
+    if args.plot is not None:
+        plot = check_output_path(args.plot, "--plot", (".png", ".pdf", ".svg"))
+        if plot.resolve() == out.resolve():
+            raise ValueError(f"--plot = {args.plot!r} is the same file as --out")
     design = load_design(args.design)
     flanks = ["convex", "concave"] if args.tooth else [args.flank]
     grids = {}

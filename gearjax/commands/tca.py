@@ -11,8 +11,8 @@ crown 1/mm), or a hypoid/spiral-bevel design file (a path or ``example:NAME``;
 from __future__ import annotations
 
 import argparse
-import json
 import math
+import re
 import sys
 
 import numpy as np
@@ -32,6 +32,9 @@ JSON_KEYS_DOC = """JSON keys:
                    also {xi1, h1_mm, xi2, h2_mm}: face-width position (-1 toe, +1
                    heel) and height above the root cone
   (with --side both the output is {"drive": {...}, "coast": {...}})
+  error            only for a side whose TCA failed: the reason and what to try (that
+                   side's object is {"error": "..."}; with one side, the key sits next
+                   to "input"); the exit status is then 3
   ellipses         {semi_major_mm, semi_minor_mm}: contact ellipse (elastic approach
                    0.00632 mm; null = infinite, line contact)
   flags            {converged, on_flank, edge}: per grid point (edge: converged but
@@ -67,9 +70,12 @@ def register(sub):
                    help="also compute rolling/sliding velocities, SRR and effective radii at "
                         "the contact points (JSON key 'kinematics')")
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
-    p.add_argument("--plot", default=None, help="write the TE and contact-pattern figure (PNG)")
+    p.add_argument("--plot", default=None, help="write the TE and contact-pattern figure (.png)")
     p.set_defaults(func=run)
 
+
+#: widest accepted face width of an inline involute design (mm)
+MAX_FACE_WIDTH_MM = 1000.0
 
 _ALLOWED = {"z1", "z2", "m", "alpha", "b", "helix", "x1", "x2", "dalpha", "crown", "lead_crown"}
 
@@ -92,10 +98,13 @@ def _parse_kv(text, allowed, what):
 def _design(text):
     from gearjax import InvolutePair, InvoluteTCA
 
+    from gearjax.errors import check_range
+
     kv = _parse_kv(text[len("involute:"):], _ALLOWED, "design")
     missing = [k for k in ("z1", "z2", "m", "alpha", "b") if k not in kv]
     if missing:
         raise ValueError(f"design: missing {', '.join(missing)}")
+    check_range("design b (face width)", kv["b"], 0.0, MAX_FACE_WIDTH_MM, lo_open=True, unit="mm")
     pair = InvolutePair.create(kv["z1"], kv["z2"], kv["m"], kv["alpha"], kv.get("helix", 0.0),
                                kv.get("x1", 0.0), kv.get("x2", 0.0))
     return kv, InvoluteTCA.create(pair, kv["b"], kv.get("dalpha", 0.0), kv.get("crown", 0.0),
@@ -158,9 +167,37 @@ def _side_json(res):
     return out
 
 
+#: exit status when the TCA of a requested side failed (the other side, if any, is printed)
+FAILED_SIDE_STATUS = 3
+
+
+def _failure(side, exc, args) -> str:
+    """One actionable line for a failed side: what failed, on which side, what to try.
+
+    The library's own hint about the ``strict`` keyword is dropped: the command has
+    no such option."""
+    from gearjax import NoContactError
+
+    detail = re.sub(r"\s*;?\s*pass strict=False[^;]*$", "", str(exc)).strip().rstrip(".;")
+    tries = []
+    if args.misalign.strip():
+        tries.append("smaller or fewer --misalign values")
+    if args.pitches < 2.0:
+        tries.append("a wider grid (--pitches 2)")
+    if isinstance(exc, NoContactError):
+        what = "the flanks do not touch"
+        tries.append("check the design (flank sides, hands, mounting data)")
+    else:
+        what = "the contact solve did not converge"
+        tries += ["a finer grid (more --positions)", "check the design"]
+    return f"{side} side: {what} ({detail}); try {', '.join(tries)}"
+
+
 def run(args) -> int:
-    from gearjax import ConvergenceError, Misalignment, NoContactError
+    from gearjax import ConvergenceError, Misalignment
+    from gearjax.commands import print_json
     from gearjax.errors import check_int, check_range
+    from gearjax.io import check_output_path
 
     mis_kv = _parse_kv(args.misalign, {"dE", "dP", "dG", "dSigma"}, "misalign")
     mis = Misalignment.create(mis_kv.get("dE", 0.0), mis_kv.get("dP", 0.0),
@@ -170,6 +207,8 @@ def run(args) -> int:
         raise ValueError(f"positions = {n} must be of the form 10k+1 (11, 21, ..., 61, ...)")
     m = 4 * ((n - 1) // 10)
     half = check_range("pitches", args.pitches, 0.75, 4.0)
+    if args.plot:
+        check_output_path(args.plot, "--plot", (".png",))
     sides = ["drive", "coast"] if args.side == "both" else [args.side]
     if args.design.startswith("involute:"):
         _design(args.design)                       # validate before any tracing
@@ -178,17 +217,17 @@ def run(args) -> int:
         from gearjax import load_design
         design = load_design(args.design)
         solve = lambda side: _hypoid_side(design, mis, m, side, half, args.kinematics)
-    results = {}
+    results, failed = {}, {}
     for side in sides:
         try:
             results[side] = solve(side)
-        except NoContactError as exc:
-            sys.stderr.write(f"gearjax: error: {side} side: the flanks do not touch: {exc}\n")
-            return 3
-        except ConvergenceError as exc:
-            sys.stderr.write(f"gearjax: error: {side} side: the contact solve failed: {exc}\n")
-            return 3
-    if args.plot:
+        except ConvergenceError as exc:          # NoContactError is a ConvergenceError
+            failed[side] = _failure(side, exc, args)
+            sys.stderr.write(f"gearjax: error: {failed[side]}\n")
+    status = FAILED_SIDE_STATUS if failed else 0
+    if not results and not args.json:
+        return status
+    if args.plot and results:
         from gearjax.plot.tca import save_tca_plot
         save_tca_plot(args.plot, [(sd, r[0].path, r[0].margin, r[0].multi)
                                   for sd, r in results.items()],
@@ -201,10 +240,11 @@ def run(args) -> int:
            "pitches": half}
     if args.json:
         if len(sides) == 1:
-            print(json.dumps({"input": inp, **outs[sides[0]]}, indent=1))
+            print_json({"input": inp, **(outs.get(sides[0]) or {"error": failed[sides[0]]})})
         else:
-            print(json.dumps({"input": inp, **outs}, indent=1))
-        return 0
+            print_json({"input": inp, **{sd: outs.get(sd) or {"error": failed[sd]}
+                                         for sd in sides}})
+        return status
     for sd, (res, _) in results.items():
         path = res.path
         out = outs[sd]
@@ -221,4 +261,6 @@ def run(args) -> int:
             print(f"{math.degrees(float(path.phi1[i])):10.4f} {te[i]:11.5f} "
                   f"{float(path.axial1[i]):9.4f} {float(path.radial1[i]):9.4f} "
                   f"{2 * sm[i]:8.4f} {2 * float(path.semi_minor[i]):8.4f} {flag}")
-    return 0
+    for sd, msg in failed.items():
+        print(f"# TCA {args.design} ({sd}): FAILED, no result: {msg}")
+    return status

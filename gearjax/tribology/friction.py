@@ -48,8 +48,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax.contact import MAX_LOG_RATIO, hertz_exact
-from gearjax.errors import check_positive, check_range, require_converged
+from gearjax.contact import E_PRIME_MAX_MPA, LOAD_MAX_N, MAX_LOG_RATIO, hertz_exact
+from gearjax.errors import check_range, require_converged
 from gearjax.fields import float64_array
 from gearjax.tribology.asperity import load_sharing_traced
 from gearjax.tribology.lubricant import Oil, eyring_shear, viscosity
@@ -60,6 +60,8 @@ __all__ = ["Surface", "make_surface", "FrictionResult", "friction_point_traced",
 
 REGIMES = ("boundary", "mixed", "full film")
 STEEL_E_PRIME = 2.0 / (2.0 * (1.0 - 0.3 ** 2) / 206000.0)   # 226 374 MPa, steel on steel
+SIGMA_MAX_UM = 10.0          # highest accepted composite roughness, µm
+SPEED_MAX_MM_S = 5.0e5       # highest accepted entrainment / sliding speed, mm/s (500 m/s)
 
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(48)
 _S = 0.5 * (_GL_X + 1.0)
@@ -94,12 +96,16 @@ def make_surface(sigma_um, density_per_mm2=1.0e4, beta_um=10.0, f_c=0.1, v_slip_
     Defaults (η_s = 1e4 mm⁻² = 1e10 m⁻², β = 10 µm, f_c = 0.1) are representative of
     ground steel gear flanks (η_s β σ ≈ 0.03–0.05 for σ ≈ 0.3–0.5 µm, the range
     quoted by Gelinck & Schipper 2000); measured values should replace them.
+
+    Accepted ranges (``ValueError`` otherwise): σ in (0, 10] µm (superfinished to
+    rough-milled flanks), η_s in (0, 1e6] mm⁻², β in (0, 1000] µm, f_c in [0, 1],
+    v_slip in (0, 1000] mm/s.
     """
-    check_positive("sigma", sigma_um, "um")
-    check_positive("asperity density", density_per_mm2, "1/mm^2")
-    check_positive("asperity radius", beta_um, "um")
+    check_range("sigma", sigma_um, 0.0, SIGMA_MAX_UM, lo_open=True, unit="um")
+    check_range("asperity density", density_per_mm2, 0.0, 1e6, lo_open=True, unit="1/mm^2")
+    check_range("asperity radius", beta_um, 0.0, 1000.0, lo_open=True, unit="um")
     check_range("f_c", f_c, 0.0, 1.0)
-    check_positive("v_slip", v_slip_mm_s, "mm/s")
+    check_range("v_slip", v_slip_mm_s, 0.0, 1000.0, lo_open=True, unit="mm/s")
     ebs = float(density_per_mm2) * float(beta_um) * float(sigma_um) * 1e-6
     if not (0.005 <= ebs <= 0.2):
         warnings.warn(f"Greenwood-Tripp asperity model: eta_s*beta*sigma = {ebs:g} is outside "
@@ -211,30 +217,38 @@ def friction_padded(F, u_e, u_s, Rx, Ry, oil, surface, E_prime, viscosity_model,
     return FrictionResult(*(jnp.reshape(v[:n], shape) for v in out))
 
 
-def _check_all(name, value, unit, allow_zero=False):
+def _check_all(name, value, unit, allow_zero=False, hi=None):
+    """Check every entry of ``value`` against (0, hi] (or [0, hi]); the first bad
+    entry is named in the ``ValueError``."""
     arr = np.asarray(value, dtype=float)
     bad = ~np.isfinite(arr) | ((arr < 0) if allow_zero else (arr <= 0))
+    if hi is not None:
+        bad |= arr > hi
     if np.any(bad):
-        v = arr[bad].ravel()[0]
-        if allow_zero:
-            check_range(name, v, 0.0, None, unit=unit)
-        check_positive(name, v, unit)
+        check_range(name, arr[bad].ravel()[0], 0.0, hi, lo_open=not allow_zero, unit=unit)
     return arr
 
 
 def validate_contact_inputs(F, u_e, u_s, Rx, Ry, E_prime, allow_signed_us=False):
-    """Boundary checks shared by the public entry points (raise ValueError)."""
-    _check_all("load", F, "N")
-    _check_all("u_e", u_e, "mm/s")
+    """Boundary checks shared by the public entry points (raise ValueError).
+
+    Ranges: load F in (0, 1e7] N, u_e in (0, 5e5] mm/s (500 m/s: above the
+    pitch-line speeds of the fastest turbo gears, about 200 m/s), u_s in
+    [0, 5e5] mm/s (signed: |u_s| <= 5e5 mm/s), Rx, Ry > 0 mm with Ry/Rx in
+    [1e-15, 1e15], E' in (0, 1e7] MPa.
+    """
+    _check_all("load", F, "N", hi=LOAD_MAX_N)
+    _check_all("u_e", u_e, "mm/s", hi=SPEED_MAX_MM_S)
     if allow_signed_us:
         arr = np.asarray(u_s, float)
-        if not np.all(np.isfinite(arr)):
-            raise ValueError("u_s must be finite")
+        bad = ~np.isfinite(arr) | (np.abs(arr) > SPEED_MAX_MM_S)
+        if np.any(bad):
+            check_range("u_s", arr[bad].ravel()[0], -SPEED_MAX_MM_S, SPEED_MAX_MM_S, unit="mm/s")
     else:
-        _check_all("u_s", u_s, "mm/s", allow_zero=True)
+        _check_all("u_s", u_s, "mm/s", allow_zero=True, hi=SPEED_MAX_MM_S)
     rx = _check_all("Rx", Rx, "mm")
     ry = _check_all("Ry", Ry, "mm")
-    _check_all("E_prime", E_prime, "MPa")
+    _check_all("E_prime", E_prime, "MPa", hi=E_PRIME_MAX_MPA)
     lr = np.abs(np.log(ry) - np.log(rx))
     if np.any(lr > MAX_LOG_RATIO):
         raise ValueError(f"Ry/Rx = {float(np.max(ry / rx)):g} is outside the allowed range "
@@ -278,13 +292,13 @@ def friction_coefficient(F, u_e, u_s, Rx, Ry, oil: Oil, surface: Surface, E_prim
 
     Parameters (arrays broadcast together)
     ----------
-    F : normal load, N (> 0).
-    u_e : entrainment speed (u1+u2)/2, mm/s (> 0).
-    u_s : sliding speed |u1-u2|, mm/s (≥ 0).
+    F : normal load, N (in (0, 1e7]).
+    u_e : entrainment speed (u1+u2)/2, mm/s (in (0, 5e5], i.e. up to 500 m/s).
+    u_s : sliding speed |u1-u2|, mm/s (in [0, 5e5]).
     Rx, Ry : relative radii of curvature in the rolling / transverse direction, mm.
     oil : :class:`gearjax.tribology.lubricant.Oil` (``get_oil`` / ``make_oil``).
     surface : :class:`Surface` (``make_surface``).
-    E_prime : reduced modulus E' = 2E*, MPa (default steel/steel 226 374 MPa).
+    E_prime : reduced modulus E' = 2E*, MPa (in (0, 1e7]; default steel/steel 226 374 MPa).
     viscosity_model : ``"roelands"`` (default) or ``"barus"``.
     film_method : ``"auto"`` (default), ``"point"`` or ``"line"`` (see
         :mod:`gearjax.tribology.film`).

@@ -37,7 +37,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax.errors import check_positive, check_range
+from gearjax.errors import check_range
 from gearjax.fields import float64_array
 
 __all__ = ["Oil", "make_oil", "get_oil", "OILS", "roelands_z", "roelands_viscosity",
@@ -48,6 +48,9 @@ P_ROELANDS_MPA = 1.0 / 5.1e-3   # 196.08 MPa  (5.1e-9 1/Pa)
 PA_S_TO_MPA_S = 1e-6            # 1 Pa·s = 1e-6 N·s/mm²
 _LN_ETA_INF = 9.67              # -ln(6.31e-5 Pa·s)
 _LN_ETA_CAP = 150.0             # overflow guard for ln(η/η0) at absurd pressures
+ETA0_MAX_PAS = 100.0            # highest accepted inlet viscosity, Pa·s
+ALPHA_MAX_PER_GPA = 100.0       # highest accepted pressure-viscosity coefficient, 1/GPa
+TAU0_MAX_MPA = 100.0            # highest accepted Eyring stress, MPa
 
 
 @dataclasses.dataclass(frozen=True)
@@ -81,25 +84,28 @@ jax.tree_util.register_dataclass(Oil, data_fields=["eta0", "z", "tau0", "rho0"],
 def make_oil(eta0, alpha_per_GPa=None, tau0_MPa=5.0, rho0=880.0, name="custom", *, z=None) -> Oil:
     """Validated :class:`Oil` from η0 (Pa·s), α at η0 (GPa⁻¹) *or* Roelands z, τ0 (MPa), ρ0 (kg/m³).
 
-    η0 must exceed 6.31e-5 Pa·s (Roelands' asymptotic viscosity; below it the
-    Roelands law is undefined); values below 1e-3 Pa·s or above 10 Pa·s warn,
-    as do α outside 5–40 GPa⁻¹ and z outside 0.3–1.0.
+    Accepted ranges (``ValueError`` naming the parameter otherwise): η0 in
+    (6.31e-5, 100] Pa·s (above Roelands' asymptotic viscosity, below which the
+    Roelands law is undefined, up to a hundred times the heaviest gear oils),
+    α in (0, 100] GPa⁻¹, z in (0, 3], τ0 in (0, 100] MPa, ρ0 in (0, 20000] kg/m³.
+    Values of η0 below 1e-3 Pa·s or above 10 Pa·s warn, as do α outside
+    5–40 GPa⁻¹ and z outside 0.3–1.0 (outside the fits, still computable).
     """
-    check_range("eta0", eta0, math_eta_inf(), None, lo_open=True, unit="Pa·s")
+    check_range("eta0", eta0, math_eta_inf(), ETA0_MAX_PAS, lo_open=True, unit="Pa·s")
     if (alpha_per_GPa is None) == (z is None):
         raise ValueError("give exactly one of alpha (1/GPa) and z (Roelands index)")
     if z is not None:
-        check_positive("z", z)
+        check_range("z", z, 0.0, 3.0, lo_open=True)
         z = float(z)
         alpha_per_GPa = z * (np.log(float(eta0)) + _LN_ETA_INF) / P_ROELANDS_MPA * 1e3
         if not (0.3 <= z <= 1.0):
             warnings.warn(f"Roelands index z = {z:g} is outside the usual range 0.3..1.0",
                           stacklevel=2)
     else:
-        check_positive("alpha", alpha_per_GPa, "1/GPa")
+        check_range("alpha", alpha_per_GPa, 0.0, ALPHA_MAX_PER_GPA, lo_open=True, unit="1/GPa")
         z = float(alpha_per_GPa) * 1e-3 * P_ROELANDS_MPA / (np.log(float(eta0)) + _LN_ETA_INF)
-    check_positive("tau0", tau0_MPa, "MPa")
-    check_positive("rho0", rho0, "kg/m^3")
+    check_range("tau0", tau0_MPa, 0.0, TAU0_MAX_MPA, lo_open=True, unit="MPa")
+    check_range("rho0", rho0, 0.0, 2.0e4, lo_open=True, unit="kg/m^3")
     if not (1e-3 <= float(eta0) <= 10.0):
         warnings.warn(f"eta0 = {float(eta0):g} Pa·s is outside the range 1e-3..10 Pa·s for "
                       "which the Roelands/Hamrock-Dowson correlations were established",

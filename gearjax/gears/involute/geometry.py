@@ -60,6 +60,14 @@ __all__ = ["InvolutePair", "rack_flank", "generated_flank", "pair_geometry", "Ra
            "involute_polar_angle", "wheel_flank_geometry", "path_table"]
 
 
+#: accepted tooth numbers of :meth:`InvolutePair.create` (6 .. 1000)
+MAX_TEETH = 1000
+#: accepted normal module (mm): watch gears (0.05 mm) to mill gears (50 mm), with margin
+MODULE_RANGE_MM = (0.01, 100.0)
+#: highest pinion speed accepted by :func:`path_kinematics` (rad/s; 1e5 rpm)
+MAX_OMEGA1 = 1e5 * 2.0 * math.pi / 60.0
+
+
 def _inv(a):
     return jnp.tan(a) - a
 
@@ -87,10 +95,16 @@ class InvolutePair:
 
     @classmethod
     def create(cls, z1, z2, module, pressure_angle_deg, helix_deg=0.0, x1=0.0, x2=0.0):
-        """Validated constructor taking degrees; raises ``ValueError`` naming the parameter."""
-        z1 = check_int("z1", z1, lo=6)
-        z2 = check_int("z2", z2, lo=6)
-        m = check_range("module", module, 0.0, None, lo_open=True, unit="mm")
+        """Validated constructor taking degrees; raises ``ValueError`` naming the parameter.
+
+        Ranges: tooth numbers 6..1000 (integers), normal module 0.01..100 mm,
+        normal pressure angle (0, 45) deg, helix angle [0, 60] deg, profile
+        shifts [-3, 3] and free of undercut, pointed teeth and interference.
+        Traced values (inside ``jax.grad``) pass through unchecked.
+        """
+        z1 = check_int("z1", z1, lo=6, hi=MAX_TEETH)
+        z2 = check_int("z2", z2, lo=6, hi=MAX_TEETH)
+        m = check_range("module", module, MODULE_RANGE_MM[0], MODULE_RANGE_MM[1], unit="mm")
         a = check_range("pressure_angle", pressure_angle_deg, 0.0, 45.0, lo_open=True,
                         hi_open=True, unit="deg")
         b = check_range("helix", helix_deg, 0.0, 60.0, unit="deg")
@@ -142,6 +156,21 @@ def _check_tooth_form(pair: InvolutePair) -> None:
                          "(no path of contact); reduce the profile shifts")
 
 
+def _check_pair_fields(pair: InvolutePair) -> None:
+    """Range check of a pair's fields (internal units mm, rad); traced fields skip it."""
+    vals = (pair.module, pair.pressure_angle, pair.helix, pair.x1, pair.x2)
+    if any(is_traced(v) for v in vals) or any(np.ndim(v) for v in vals):
+        return                      # traced, or a batch of pairs (vmap data): not checked here
+    check_int("z1", pair.z1, lo=6, hi=MAX_TEETH)
+    check_int("z2", pair.z2, lo=6, hi=MAX_TEETH)
+    check_range("module", pair.module, MODULE_RANGE_MM[0], MODULE_RANGE_MM[1], unit="mm")
+    check_range("pressure_angle", pair.pressure_angle, 0.0, math.pi / 4, lo_open=True,
+                hi_open=True, unit="rad")
+    check_range("helix", pair.helix, 0.0, math.pi / 3, unit="rad")
+    check_range("x1", pair.x1, -3.0, 3.0)
+    check_range("x2", pair.x2, -3.0, 3.0)
+
+
 def _pointed_limit(z, m, an, b):
     """Profile shift at which the tip thickness vanishes (bisection, concrete)."""
     def sa(x):
@@ -162,7 +191,12 @@ def _pointed_limit(z, m, an, b):
 def pair_geometry(pair: InvolutePair) -> dict:
     """Transverse geometry of the pair (traceable).  Keys: m_t, alpha_t, beta_b, r1, r2,
     rb1, rb2, ra1, ra2, alpha_wt, a_w, rho_A, rho_E, rho_P (pitch point), contact_ratio.
+
+    A pair with concrete (untraced) fields is range-checked first (the ranges of
+    :meth:`InvolutePair.create`, in mm and rad), so a pair built directly with
+    out-of-range numbers gets a ``ValueError`` instead of NaN geometry.
     """
+    _check_pair_fields(pair)
     m_t, alpha_t, r1, rb1 = _gear_basics(pair.module, pair.pressure_angle, pair.helix, pair.z1)
     _, _, r2, rb2 = _gear_basics(pair.module, pair.pressure_angle, pair.helix, pair.z2)
     target = _inv(alpha_t) + 2 * jnp.tan(pair.pressure_angle) * (pair.x1 + pair.x2) / (pair.z1 + pair.z2)
@@ -382,13 +416,16 @@ _path_jit = jax.jit(path_kinematics_traced, static_argnames=("side",))
 def path_kinematics(pair: InvolutePair, points: int = 21, side: int = -1, omega1: float = 1.0,
                     strict: bool = True, t=None) -> PathResult:
     """Eigenfunction kinematics at ``points`` equally spaced positions on the path of contact
-    (or at the path fractions ``t`` in [0, 1] when given).
+    (or at the path fractions ``t`` in [0, 1] when given).  ``omega1`` is the pinion
+    speed in rad/s, in (0, 10472] (up to 1e5 rpm); velocities come out in mm/s.
 
     Raises :class:`~gearjax.errors.ConvergenceError` if any contact solve failed
     (``strict=False`` returns the result with its ``converged`` mask instead).
     """
     if side not in (-1, 1):
         raise ValueError(f"side = {side!r} must be -1 or +1")
+    if not is_traced(omega1):
+        check_range("omega1", omega1, 0.0, MAX_OMEGA1, lo_open=True, unit="rad/s")
     if t is None:
         points = check_int("points", points, lo=2, hi=100000)
         t = np.linspace(0.0, 1.0, points)
