@@ -37,11 +37,14 @@ JSON_KEYS_DOC = """JSON keys:
                    to "input"); the exit status is then 3
   ellipses         {semi_major_mm, semi_minor_mm}: contact ellipse (elastic approach
                    0.00632 mm; null = infinite, line contact)
-  flags            {converged, on_flank, edge}: per grid point (edge: converged but
-                   outside a flank boundary)
-  quality          {converged, reference_on_flank, edge_contact, low_contact_ratio}:
-                   contact-quality flags of the side (each raised one is also a
-                   warning on stderr)
+  flags            per grid point: converged, on_flank (the flanks touch inside both
+                   flank boundaries), edge (pair 0 touches at a face end: edge contact,
+                   no ellipse and no kinematics there), edge_end (null, or which face end:
+                   "pinion toe", "pinion heel", "gear toe", "gear heel"), off_flank
+                   (converged but outside a flank boundary: no contact of pair 0)
+  quality          {converged, reference_on_flank, edge_contact, face_end_contact,
+                   low_contact_ratio, large_te}: contact-quality flags of the side (each
+                   raised one is also a warning on stderr; large_te: TE p-t-p > 60 arcsec)
   kinematics       with --kinematics: {u1_mm_s, u2_mm_s, u_e_mm_s, u_s_mm_s, srr, r_x_mm,
                    r_y_mm} per grid point (pinion = 1; per rad/s of pinion speed;
                    rolling direction across the contact ellipse; null off the flank)"""
@@ -135,9 +138,14 @@ def _hypoid_side(design, mis, m, side_name, half, kin):
 def _side_json(res):
     from gearjax import ARCSEC
     path, margin, multi = res.path, res.margin, res.multi
+    from gearjax.edge_contact import EDGE_NAMES
     conv = np.asarray(path.converged)
-    on = (np.asarray(margin) >= 0.0) & conv
-    te = np.where(on, np.asarray(path.te), np.nan) / ARCSEC
+    on = np.asarray(res.on_flank)
+    edge = np.asarray(res.edge_points)
+    touch = on | edge
+    kinds = (np.full(conv.shape, -1) if path.edge_kind is None
+             else np.asarray(path.edge_kind))
+    te = np.where(touch, np.asarray(path.te), np.nan) / ARCSEC
     pth = {k: _nan_list(getattr(path, k[:-3])) for k in
            ("axial1_mm", "radial1_mm", "axial2_mm", "radial2_mm")}
     if res.family == "hypoid":
@@ -155,7 +163,8 @@ def _side_json(res):
         "ellipses": {"semi_major_mm": _nan_list(path.semi_major),
                      "semi_minor_mm": _nan_list(path.semi_minor)},
         "flags": {"converged": conv.tolist(), "on_flank": on.tolist(),
-                  "edge": (conv & ~on).tolist()},
+                  "edge": edge.tolist(), "off_flank": (conv & ~touch).tolist(),
+                  "edge_end": [EDGE_NAMES[k] if e else None for k, e in zip(kinds, edge)]},
         "quality": res.flags(),
     }
     if res.kinematics is not None:
@@ -250,6 +259,7 @@ def run(args) -> int:
         out = outs[sd]
         conv = np.asarray(out["flags"]["converged"])
         on = np.asarray(out["flags"]["on_flank"])
+        edge = np.asarray(out["flags"]["edge"])
         te = np.array([np.nan if v is None else v for v in out["te_arcsec"]])
         sm = np.asarray(path.semi_major)
         print(f"# TCA {args.design} ({sd}); misalign {mis_kv or 'none'}")
@@ -257,7 +267,8 @@ def run(args) -> int:
         print(f"{'phi1[deg]':>10s} {'TE[arcsec]':>11s} {'axial1':>9s} {'radius1':>9s} "
               f"{'2a[mm]':>8s} {'2b[mm]':>8s} flag")
         for i in range(n):
-            flag = "ok" if on[i] else ("edge" if conv[i] else "no-conv")
+            flag = ("ok" if on[i] else "edge" if edge[i] else "off" if conv[i]
+                    else "no-conv")
             print(f"{math.degrees(float(path.phi1[i])):10.4f} {te[i]:11.5f} "
                   f"{float(path.axial1[i]):9.4f} {float(path.radial1[i]):9.4f} "
                   f"{2 * sm[i]:8.4f} {2 * float(path.semi_minor[i]):8.4f} {flag}")
