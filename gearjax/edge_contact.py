@@ -43,7 +43,11 @@ contact (valid where it lies inside both flanks) and the four face-end contacts
 tip, root -- and the point of flank ``j`` inside flank ``j``).  The contact made
 is the candidate furthest ahead in the sense of the load, ``max s TE`` with
 ``s = +1`` on the drive side and ``-1`` on the coast side -- the rule of the TE
-envelope of consecutive pairs (:func:`gearjax.tca.multi_pair`).  Where the
+envelope of consecutive pairs (:func:`gearjax.tca.multi_pair`).  Where the surface
+contact lies off the flanks, an edge contact of pair 0 is kept only where it carries
+the load, i.e. is not behind the neighbouring pairs (pair 0 shifted by whole
+pitches); one far behind them would touch only under a load that closes that gap,
+and is reported in :class:`EdgeContact` but not taken into the path.  Where the
 face-width section ``z`` touches at ``f(z)`` (the TE of the profile section at
 ``z``), this is ``max f`` over the face: the interior tangency where ``f`` peaks
 inside, an end where it peaks there.  The surface contact is kept unless an edge
@@ -170,7 +174,7 @@ def _continue(F, z0, thetas, fresh, n_homotopy, tol, max_steps):
 
 def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, margin,
                      margin_parts: Callable, g1: Callable, g2: Callable, *, drive,
-                     line_contact: bool = False, tol: float = 1e-11, max_steps: int = 30, n_homotopy: int = 8):
+                     steps_per_pitch: int, line_contact: bool = False, tol: float = 1e-11, max_steps: int = 30, n_homotopy: int = 8):
     """Face-end contacts beside ``path`` and the contact actually made (traceable).
 
     ``path``, ``margin`` : the surface contact path and its boundary margin (mm).
@@ -178,6 +182,8 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
     margins (mm, >= 0 inside) of each member's face width and of its other boundaries
     (tip, root) at body-frame points (N, 3).  ``g1, g2`` : face-end functions of pinion
     and gear (module docstring).  ``drive`` : True on the drive side (may be traced).
+    ``steps_per_pitch`` : grid steps per angular pitch (the neighbouring tooth pairs
+    are pair 0 shifted by that many steps).
     ``line_contact`` : ``path`` was solved in line-contact mode (one face-width section):
     a face-end contact with the TE of that section lies on its contact line and is
     not an edge contact.
@@ -250,12 +256,27 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
     key_e = jnp.where(valid, sgn * te, -jnp.inf)
     best = jnp.argmax(key_e, axis=0)
     lead = jnp.max(key_e, axis=0)
-    use = jnp.isfinite(lead) & (lead > key_s + EDGE_LEAD)
+    # (a) an edge ahead of the surface contact on the flanks replaces it
+    use = surf_ok & jnp.isfinite(lead) & (lead > key_s + EDGE_LEAD)
     if line_contact:
         # a face-end point on the line contact of the section solved (same TE): part
         # of the line contact, not an edge contact, wherever that section lies
         same = path.converged & (jnp.abs(lead - sgn * path.te) <= EDGE_LEAD)
         use = use & ~same
+    else:
+        same = jnp.zeros_like(use)
+    # (b) where the surface contact is off the flanks, an edge contact counts where it
+    # carries the load: not behind the neighbouring tooth pairs (pair 0 shifted by
+    # whole pitches, with the contacts of (a))
+    key_a = jnp.where(use, lead, key_s)
+    idx = np.arange(n)
+    others = jnp.full((n,), -jnp.inf)
+    for k in range(1, n // max(steps_per_pitch, 1) + 1):
+        for src in (idx - k * steps_per_pitch, idx + k * steps_per_pitch):
+            ok = (src >= 0) & (src < n)
+            others = jnp.maximum(others, jnp.where(ok, key_a[np.clip(src, 0, n - 1)], -jnp.inf))
+    carries = lead >= others - EDGE_LEAD
+    use = use | (~surf_ok & ~same & jnp.isfinite(lead) & carries)
     kind = jnp.where(use, best, -1)
     cols = jnp.arange(n)
 

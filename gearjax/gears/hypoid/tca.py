@@ -263,7 +263,8 @@ def hypoid_tca_traced(pair: HypoidPair, mis: Misalignment, x_ref, phi1_ref, *,
     if face_ends:
         parts, g1, g2 = hypoid_face_ends(pair)
         path, margin, _ = face_end_contact(r1, r2, asm, mis, path, margin, parts, g1, g2,
-                                           drive=drive, line_contact=line_contact)
+                                           drive=drive, line_contact=line_contact,
+                                           steps_per_pitch=steps_per_pitch)
         _, coords = hypoid_margin(pair, path)
     multi = multi_pair(path, margin, steps_per_pitch, pair.z1, drive=drive, n_pairs=n_pairs)
     return HypoidTCA(path, margin, multi, coords)

@@ -229,7 +229,8 @@ def involute_tca_traced(des: InvoluteTCA, mis: Misalignment, *, side: int = -1,
     if face_ends:
         parts, g1, g2 = involute_face_ends(des)
         path, margin, _ = face_end_contact(r1, r2, asm, mis, path, margin, parts, g1, g2,
-                                           drive=side < 0, line_contact=line_contact)
+                                           drive=side < 0, line_contact=line_contact,
+                                           steps_per_pitch=steps_per_pitch)
     multi = multi_pair(path, margin, steps_per_pitch, p.z1, drive=(side < 0), n_pairs=n_pairs)
     return path, margin, multi
 
