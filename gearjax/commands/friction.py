@@ -178,7 +178,9 @@ def run_stribeck(args) -> int:
         if not os.path.isdir(d):
             raise ValueError(f"--plot = {args.plot!r}: directory {d!r} does not exist")
     ue = np.logspace(np.log10(args.ue_min), np.log10(args.ue_max), n) * 1e3
-    with warnings.catch_warnings(record=True) as caught:
+    from gearjax.progress import Progress
+    with warnings.catch_warnings(record=True) as caught, \
+            Progress(1, "stribeck") as bar, bar.phase(f"{n} speeds"):
         warnings.simplefilter("always")
         c = stribeck_curve(args.load_N, args.rx_mm, args.ry_mm, args.srr, ue, oil, surf, Ep,
                            viscosity_model=args.viscosity, film_method=args.film)

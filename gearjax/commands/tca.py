@@ -161,6 +161,7 @@ def _side_json(res):
 def run(args) -> int:
     from gearjax import ConvergenceError, Misalignment, NoContactError
     from gearjax.errors import check_int, check_range
+    from gearjax.progress import Progress
 
     mis_kv = _parse_kv(args.misalign, {"dE", "dP", "dG", "dSigma"}, "misalign")
     mis = Misalignment.create(mis_kv.get("dE", 0.0), mis_kv.get("dP", 0.0),
@@ -179,15 +180,19 @@ def run(args) -> int:
         design = load_design(args.design)
         solve = lambda side: _hypoid_side(design, mis, m, side, half, args.kinematics)
     results = {}
-    for side in sides:
-        try:
-            results[side] = solve(side)
-        except NoContactError as exc:
-            sys.stderr.write(f"gearjax: error: {side} side: the flanks do not touch: {exc}\n")
-            return 3
-        except ConvergenceError as exc:
-            sys.stderr.write(f"gearjax: error: {side} side: the contact solve failed: {exc}\n")
-            return 3
+    what = "contact solve" + (" + kinematics" if args.kinematics else "")
+    with Progress(len(sides), "tca") as bar:    # stderr, terminals only
+        for side in sides:
+            try:
+                with bar.phase(f"{side} side: {what}"):
+                    results[side] = solve(side)
+            except NoContactError as exc:
+                sys.stderr.write(f"gearjax: error: {side} side: the flanks do not touch: {exc}\n")
+                return 3
+            except ConvergenceError as exc:
+                sys.stderr.write(f"gearjax: error: {side} side: the contact solve failed: {exc}\n")
+                return 3
+            bar.update()
     if args.plot:
         from gearjax.plot.tca import save_tca_plot
         save_tca_plot(args.plot, [(sd, r[0].path, r[0].margin, r[0].multi)
