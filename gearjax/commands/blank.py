@@ -23,8 +23,10 @@ def register(sub):
 
 def run(args) -> int:
     from gearjax import blank_geometry, load_design
+    from gearjax.progress import Progress
     design = load_design(args.design)
-    data = blank_geometry(design.blank_input())
+    with Progress(1, "blank") as bar, bar.phase("blank solve"):
+        data = blank_geometry(design.blank_input())
     if args.json:
         sys.stdout.write(json.dumps(data.to_dict(), indent=2) + "\n")
         return 0

@@ -214,7 +214,9 @@ def run_stribeck(args) -> int:
     if args.plot is not None:
         check_output_path(args.plot, "--plot", PLOT_SUFFIXES)
     ue = np.logspace(np.log10(args.ue_min), np.log10(args.ue_max), n) * 1e3
-    with warnings.catch_warnings(record=True) as caught:
+    from gearjax.progress import Progress
+    with warnings.catch_warnings(record=True) as caught, \
+            Progress(1, "stribeck") as bar, bar.phase(f"{n} speeds"):
         warnings.simplefilter("always")
         oil, surf, Ep = _materials(args)
         c = stribeck_curve(args.load_N, args.rx_mm, args.ry_mm, args.srr, ue, oil, surf, Ep,

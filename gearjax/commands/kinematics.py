@@ -53,6 +53,7 @@ def run(args) -> int:
     from gearjax.io import check_output_path
     from gearjax.studies import cutter_radius as hk
     from gearjax import load_design
+    from gearjax.progress import Progress
     shape = _grid(args.grid)
     # the ranges of StudySettings.make, checked before the design is read
     check_range("--blade-angle-delta (blade_angle_delta_deg)", args.blade_angle_delta,
@@ -65,7 +66,8 @@ def run(args) -> int:
     if inp.method == "iso23509-method0" or float(inp.offset) <= 0.0:
         raise ValueError("blank.offset_mm must be > 0: the seed-000 model is for hypoid pairs")
     st = hk.StudySettings.make(float(inp.cutter_radius), args.blade_angle_delta, args.cutter_shift)
-    s, f = hk.flank_fields(inp, st, args.flank, shape)
+    with Progress(1, "kinematics") as bar, bar.phase(f"{shape[0]}x{shape[1]} grid"):
+        s, f = hk.flank_fields(inp, st, args.flank, shape)
     stats = hk.field_stats(f, _FIELDS)
     lim = hk.limit_report(f)
     out = {"design": design.name or args.design, "flank": args.flank, "grid": list(shape),

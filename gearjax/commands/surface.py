@@ -50,9 +50,10 @@ def run(args) -> int:
     design = load_design(args.design)
     flanks = ["convex", "concave"] if args.tooth else [args.flank]
     grids = {}
-    with Progress(len(flanks), f"{args.member} flank") as bar:
+    with Progress(len(flanks), f"surface {args.member}") as bar:
         for f in flanks:
-            grids[f] = flank_surface(design.flank(args.member, f), n_xi, n_s)
+            with bar.phase(f"{f}: {n_xi}x{n_s} points"):
+                grids[f] = flank_surface(design.flank(args.member, f), n_xi, n_s)
             bar.update()
     if args.tooth:
         teeth = design.member_blank(args.member).teeth

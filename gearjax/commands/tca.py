@@ -207,6 +207,7 @@ def run(args) -> int:
     from gearjax.commands import print_json
     from gearjax.errors import check_int, check_range
     from gearjax.io import check_output_path
+    from gearjax.progress import Progress
 
     mis_kv = _parse_kv(args.misalign, {"dE", "dP", "dG", "dSigma"}, "misalign")
     mis = Misalignment.create(mis_kv.get("dE", 0.0), mis_kv.get("dP", 0.0),
@@ -227,12 +228,17 @@ def run(args) -> int:
         design = load_design(args.design)
         solve = lambda side: _hypoid_side(design, mis, m, side, half, args.kinematics)
     results, failed = {}, {}
-    for side in sides:
-        try:
-            results[side] = solve(side)
-        except ConvergenceError as exc:          # NoContactError is a ConvergenceError
-            failed[side] = _failure(side, exc, args)
-            sys.stderr.write(f"gearjax: error: {failed[side]}\n")
+    what = "contact solve" + (" + kinematics" if args.kinematics else "")
+    with Progress(len(sides), "tca") as bar:    # stderr, terminals only
+        for side in sides:
+            try:
+                with bar.phase(f"{side} side: {what}"):
+                    results[side] = solve(side)
+            except ConvergenceError as exc:      # NoContactError is a ConvergenceError
+                failed[side] = _failure(side, exc, args)
+            bar.update()
+    for side, msg in failed.items():
+        sys.stderr.write(f"gearjax: error: {msg}\n")
     status = FAILED_SIDE_STATUS if failed else 0
     if not results and not args.json:
         return status

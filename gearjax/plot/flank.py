@@ -5,7 +5,8 @@ pitch apex along the work axis, mm) against radius ``R_A`` (mm) -- the projectio
 gear engineers use for tooth contact and blank drawings.  Grid lines along the face
 width (s = const) and along the height (xi = const) are drawn, the blank's face and
 root cones and the toe/heel limits are overlaid when a blank is given, and toe,
-heel, root and tip are labelled.  Nothing is shown on screen.
+heel, root and tip are labelled.  Report size (7.5 x 5.5 in, fonts >= 9 pt, 150 dpi;
+:mod:`gearjax.plot.style`).  Nothing is shown on screen.
 """
 
 from __future__ import annotations
@@ -14,6 +15,8 @@ import io as _io
 from pathlib import Path
 
 import numpy as np
+
+from gearjax.plot.style import DPI, MIN_WIDTH_IN, report_style
 
 __all__ = ["axial_projection", "plot_flank_axial", "save_flank_plot"]
 
@@ -31,12 +34,17 @@ def plot_flank_axial(grid, blank=None, ax=None, label: str = "flank", color="C0"
     root cones and the toe/heel lines (normal to the pitch generatrix at
     ``A_o - F`` and ``A_o``).  Returns the matplotlib Axes.
     """
+    with report_style():
+        return _draw_flank(grid, blank, ax, label, color)
+
+
+def _draw_flank(grid, blank, ax, label, color):
     import matplotlib
     matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt
 
     if ax is None:
-        _, ax = plt.subplots(figsize=(7, 5))
+        _, ax = plt.subplots(figsize=(MIN_WIDTH_IN + 0.5, 5.5))
     x, R = axial_projection(grid.points)
     for j in range(x.shape[1]):
         ax.plot(x[:, j], R[:, j], color=color, lw=0.6, alpha=0.8)
@@ -69,7 +77,7 @@ def plot_flank_axial(grid, blank=None, ax=None, label: str = "flank", color="C0"
     ax.set_ylabel("radius R_A (mm)")
     ax.set_aspect("equal", adjustable="datalim")
     ax.grid(True, lw=0.3)
-    ax.legend(loc="best", fontsize=8)
+    ax.legend(loc="best")
     return ax
 
 
@@ -82,13 +90,16 @@ def save_flank_plot(path, grid, blank=None, title: str | None = None, label: str
     from gearjax.io import atomic_write
 
     path = Path(path)
-    fig, ax = plt.subplots(figsize=(7, 5))
+    with report_style():
+        fig, ax = plt.subplots(figsize=(MIN_WIDTH_IN + 0.5, 5.5))
     try:
         plot_flank_axial(grid, blank, ax=ax, label=label)
-        if title:
-            ax.set_title(title)
-        buf = _io.BytesIO()
-        fig.savefig(buf, format=path.suffix.lstrip(".") or "png", dpi=130, bbox_inches="tight")
+        with report_style():
+            if title:
+                ax.set_title(title)
+            buf = _io.BytesIO()
+            fig.savefig(buf, format=path.suffix.lstrip(".") or "png", dpi=DPI,
+                        bbox_inches="tight")
     finally:
         plt.close(fig)
     return atomic_write(path, buf.getvalue())
