@@ -44,6 +44,7 @@ from gearjax.newton import NewtonResult, newton_solve  # noqa: E402
 from gearjax.surfaces import GeneratedSurface, local_geometry  # noqa: E402
 from gearjax.kinematics import (Kinematics, Mesh, crossed_axes, eigen_kinematics,  # noqa: E402
                                 parallel_axes)
+from gearjax.edge_contact import EDGE_NAMES  # noqa: E402
 from gearjax.tca import ARCSEC, ContactPath, Misalignment, MultiPair, NoContactError  # noqa: E402
 from gearjax.tca_result import (SIDES, ContactKinematics, TCAResult,  # noqa: E402
                                 contact_kinematics, family_of)
@@ -148,7 +149,7 @@ __all__ = [
     "flank_surface", "generated_flank", "GeneratedSurface", "local_geometry",
     # tooth contact analysis
     "run_tca", "tca_function", "tca_sensitivity", "TCAResult", "ContactPath", "MultiPair",
-    "Misalignment", "SIDES", "ARCSEC", "NoContactError", "family_of",
+    "Misalignment", "SIDES", "ARCSEC", "NoContactError", "EDGE_NAMES", "family_of",
     # kinematics
     "ContactKinematics", "contact_kinematics", "Kinematics", "Mesh", "eigen_kinematics",
     "parallel_axes", "crossed_axes", "involute_path_kinematics", "involute_path_table",

@@ -138,7 +138,7 @@ def _hypoid_side(design, mis, m, side_name, half, kin):
 def _side_json(res):
     from gearjax import ARCSEC
     path, margin, multi = res.path, res.margin, res.multi
-    from gearjax.edge_contact import EDGE_NAMES
+    from gearjax import EDGE_NAMES
     conv = np.asarray(path.converged)
     on = np.asarray(res.on_flank)
     edge = np.asarray(res.edge_points)
