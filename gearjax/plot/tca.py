@@ -95,14 +95,19 @@ def _pattern_panel(ax, label, path, margin, lim):
     o = flank_outline(lim)
     ax1 = np.where(on, np.asarray(path.axial1, float), np.nan)   # gaps where off the flank
     rd1 = np.where(on, np.asarray(path.radial1, float), np.nan)
+    edge = (np.zeros(np.shape(on), bool) if path.edge_kind is None
+            else on & (np.asarray(path.edge_kind) >= 0))
     drawn = []
-    for i in np.nonzero(on)[0][::3]:
+    for i in np.nonzero(on & ~edge)[0][::3]:     # no ellipse at an edge contact
         e = ellipse_outline_axial(path, i)
         drawn += ax.plot(e[:, 0], e[:, 1], color="C0", lw=0.8)
     if drawn:
-        line = np.any(~np.isfinite(np.asarray(path.semi_major))[on])
+        line = np.any(np.isinf(np.asarray(path.semi_major))[on & ~edge])
         drawn[0].set_label("contact lines (line contact)" if line else "contact ellipses")
     drawn += ax.plot(ax1, rd1, "r.-", lw=1.2, ms=4, label="path of contact")
+    if edge.any():
+        drawn += ax.plot(np.asarray(path.axial1, float)[edge], np.asarray(path.radial1, float)[edge],
+                         "kx", ms=6, mew=1.5, label="edge contact (face end)")
     if o is not None:
         clip_to(drawn, o, ax)
         ax.plot(o[:, 0], o[:, 1], "k-", lw=1.2)
