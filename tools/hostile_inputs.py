@@ -1,0 +1,1159 @@
+"""Hostile-input harness: run the ``gearjax`` command on inputs a careless or curious
+user might give it and classify what happens.
+
+Usage (from the repository root; standard library only, plus this checkout's
+``gearjax`` for the command itself)::
+
+    python tools/hostile_inputs.py [--jobs 2] [--only REGEX] [--timeout 300]
+                                   [--md OUT.md] [--json OUT.json] [--list]
+                                   [--cache-dir DIR] [--keep]
+
+Each case of :data:`CASES` is an argument list for ``python -m gearjax.cli`` (run
+in a subprocess with this checkout first on ``PYTHONPATH``), an optional setup that
+makes files in the case's own temporary directory (a corrupted design file, a
+read-only directory, ...), and the class of answer the project's standards call for:
+
+``refuse``  exit status 2 and exactly one stderr line ``gearjax: error: ...`` (bad
+            input is refused before any work, naming the parameter, value and range);
+``flag``    the run may go on but the user must be told: a ``gearjax: warning:``
+            line, or a non-zero exit with one clean ``gearjax: error:`` line (a
+            refusal is accepted too);
+``ok``      a valid run: exit 0, no warning, output free of NaN/inf (and valid
+            strict JSON where ``--json`` is given).
+
+A case may accept further observed classes (``also``; e.g. a tiny but positive
+speed may be refused or give a finite answer).  Observed classes:
+
+``refusal``   exit 2 and exactly one stderr line, starting ``gearjax: error:``;
+``flagged``   exit 0 with a ``gearjax: warning:`` line, or a non-zero exit whose
+              stderr is only ``gearjax:`` lines with exactly one ``gearjax: error:``
+              (e.g. exit 3 "the flanks do not touch");
+``traceback`` ``Traceback`` in stderr;
+``silent``    exit 0 and no warning although the case expects a refusal or a flag;
+``nan``       exit 0 and a NaN/inf in stdout (a ``NaN``/``Infinity`` JSON constant,
+              or a bare ``nan``/``inf`` token in a table; in a ``gearjax tca`` table,
+              rows marked ``edge``/``no-conv`` are exempt -- they print ``nan`` for "no
+              value" by design and say so in their flag column -- and so is ``inf``
+              on ``ok`` rows: the 2a column of a line contact, ``null`` in the JSON);
+``badjson``   exit 0 with ``--json`` but stdout is not one JSON document;
+``ok``        exit 0, no warning, clean output;
+``unclean``   non-zero exit without a traceback whose stderr is not one clean line
+              (argparse usage text, stray library warnings, a signal);
+``timeout``   ran past ``--timeout``;
+``setup_error`` the case's setup failed (a harness problem, not a gearjax one).
+
+The table is robust to the command set changing: a case whose flag or command no
+longer exists is simply classified by what happens (usually a refusal).
+
+All runs share one JAX compilation cache (``GEARJAX_CACHE_DIR``; a temporary
+directory unless ``--cache-dir`` is given) so that the TCA programs compile once;
+the expensive cases are started first.  Kept out of CI (it takes tens of minutes);
+``tests/test_hostile_harness.py`` checks only that the table is well formed and that
+the classifier separates the classes.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+import tomllib
+from concurrent.futures import ThreadPoolExecutor, as_completed
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+ROOT = Path(__file__).resolve().parent.parent
+EXAMPLES_DIR = ROOT / "gearjax" / "examples"
+
+EXPECTED = ("refuse", "flag", "ok")
+OBSERVED = ("refusal", "flagged", "traceback", "silent", "nan", "badjson", "ok", "unclean",
+            "timeout", "setup_error")
+#: observed classes that satisfy each expected class (a case may add more with ``also``)
+ACCEPT = {"refuse": {"refusal"}, "flag": {"flagged", "refusal"}, "ok": {"ok"}}
+
+#: the packaged example designs (names of gearjax/examples/*.toml)
+EXAMPLES = sorted(p.stem for p in EXAMPLES_DIR.glob("*.toml"))
+HYPOID_EXAMPLES = [n for n in EXAMPLES if not n.startswith("spiral_bevel")]
+
+
+# ======================================================================================
+# cases
+
+
+@dataclass(frozen=True)
+class Case:
+    """One hostile input.
+
+    ``argv`` may contain the placeholders ``{tmp}`` (the case's own temporary
+    directory) and any key returned by ``setup(tmp)`` (e.g. ``{design}``, ``{ro}``).
+    """
+
+    id: str
+    argv: tuple
+    expect: str
+    why: str
+    setup: Callable | None = None
+    also: frozenset = frozenset()
+    heavy: bool = False            # compiles/runs a TCA or similar: started first
+
+    @property
+    def command(self) -> str:
+        """The sub-command the case exercises: the first part of its id ('top': none)."""
+        return self.id.split(".", 1)[0]
+
+    @property
+    def accepted(self) -> set:
+        return ACCEPT[self.expect] | set(self.also)
+
+
+# --------------------------------------------------------------------------------------
+# setups (run in the harness process before the case's subprocess)
+
+
+def _toml_value(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        if math.isnan(v):
+            return "nan"
+        if math.isinf(v):
+            return "inf" if v > 0 else "-inf"
+        return repr(v)
+    if isinstance(v, str):
+        return json.dumps(v)           # a JSON string is a valid TOML basic string
+    if isinstance(v, list):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    if isinstance(v, dict):
+        return "{ " + ", ".join(f"{_toml_key(k)} = {_toml_value(x)}" for k, x in v.items()) + " }"
+    raise TypeError(f"cannot write {type(v).__name__} to TOML")
+
+
+def _toml_key(k: str) -> str:
+    return k if re.fullmatch(r"[A-Za-z0-9_-]+", k) else json.dumps(k)
+
+
+def dumps_toml(data: dict) -> str:
+    """Small TOML writer for design files (nested tables as ``[a.b]``)."""
+    out: list[str] = []
+
+    def emit(tbl, prefix):
+        scalars = [(k, v) for k, v in tbl.items() if not isinstance(v, dict)]
+        tables = [(k, v) for k, v in tbl.items() if isinstance(v, dict)]
+        if prefix and (scalars or not tables):
+            out.append("[" + ".".join(_toml_key(p) for p in prefix) + "]")
+        for k, v in scalars:
+            out.append(f"{_toml_key(k)} = {_toml_value(v)}")
+        if prefix and (scalars or not tables):
+            out.append("")
+        for k, v in tables:
+            emit(v, prefix + [k])
+
+    emit(data, [])
+    return "\n".join(out) + "\n"
+
+
+_DELETE = object()
+
+
+def design_file(example: str, *edits, name: str = "design.toml"):
+    """Setup: the packaged ``example`` with ``edits`` ``(dotted.path, value)`` applied
+    (value ``_DELETE`` removes the key), written to ``{tmp}/name`` -> ``{design}``."""
+
+    def setup(tmp: Path) -> dict:
+        data = tomllib.loads((EXAMPLES_DIR / f"{example}.toml").read_text(encoding="utf-8"))
+        for path, value in edits:
+            *parents, last = path.split(".")
+            d = data
+            for p in parents:
+                d = d.setdefault(p, {})
+            if value is _DELETE:
+                if last not in d:
+                    raise KeyError(f"{example}: no key {path!r} to delete")
+                del d[last]
+            else:
+                d[last] = value
+        p = tmp / name
+        p.write_text(dumps_toml(data), encoding="utf-8")
+        return {"design": str(p)}
+
+    return setup
+
+
+def raw_file(content: bytes, name: str = "design.toml"):
+    """Setup: a file with exactly ``content`` -> ``{design}``."""
+
+    def setup(tmp: Path) -> dict:
+        p = tmp / name
+        p.write_bytes(content)
+        return {"design": str(p)}
+
+    return setup
+
+
+def a_directory(name: str = "design.toml"):
+    """Setup: a directory named like a file -> ``{dir}`` (also ``{design}``)."""
+
+    def setup(tmp: Path) -> dict:
+        p = tmp / name
+        p.mkdir()
+        return {"dir": str(p), "design": str(p)}
+
+    return setup
+
+
+def _cannot_create_in(d: Path) -> bool:
+    probe = d / ".gearjax-hostile-probe"
+    try:
+        fd = os.open(probe, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o600)
+    except OSError:
+        return True
+    os.close(fd)
+    os.unlink(probe)
+    return False
+
+
+def readonly_dir(tmp: Path) -> dict:
+    """Setup: a directory in which no file can be created -> ``{ro}``.
+
+    A mode-0555 directory; when that does not stop this user (root), a system
+    directory that refuses new files (``/sys`` on Linux) -- nothing is written there.
+    """
+    d = tmp / "readonly"
+    d.mkdir()
+    os.chmod(d, 0o555)
+    if _cannot_create_in(d):
+        return {"ro": str(d)}
+    for cand in (Path("/sys"),):
+        if cand.is_dir() and _cannot_create_in(cand):
+            return {"ro": str(cand)}
+    raise RuntimeError("no read-only directory available to this user")
+
+
+def plain_file(name: str = "afile"):
+    """Setup: a regular file, to be used as if it were a directory -> ``{file}``."""
+
+    def setup(tmp: Path) -> dict:
+        p = tmp / name
+        p.write_text("not a directory\n")
+        return {"file": str(p)}
+
+    return setup
+
+
+# --------------------------------------------------------------------------------------
+# the table
+
+
+def _argv(base: list, over: dict | None = None, extra=()) -> tuple:
+    """``base`` = [(flag, value)...]; ``over`` replaces values (None drops the flag)."""
+    over = dict(over or {})
+    out = []
+    for flag, value in base:
+        if flag in over:
+            value = over.pop(flag)
+            if value is None:
+                continue
+        out += [flag, value]
+    for flag, value in over.items():
+        if value is not None:
+            out += [flag, value]
+    return tuple(out) + tuple(extra)
+
+
+def _slug(v: str) -> str:
+    s = re.sub(r"[^A-Za-z0-9.+-]+", "_", v).strip("_") or "empty"
+    return s.replace("+", "p")
+
+
+INV = [("--z1", "20"), ("--z2", "40"), ("--module", "4"), ("--pressure-angle", "20")]
+FRI = [("--load-N", "1000"), ("--rx-mm", "10"), ("--ry-mm", "300"), ("--ue", "5"), ("--us", "1"),
+       ("--oil", "mineral_vg100"), ("--sigma-um", "0.4")]
+STR = [("--load-N", "1000"), ("--rx-mm", "10"), ("--ry-mm", "300"), ("--oil", "mineral_vg100"),
+       ("--sigma-um", "0.4")]
+TCA_INV = "involute:z1=20,z2=40,m=4,alpha=20,b=30"
+
+# out-of-range and non-numbers for a parameter that must be a finite positive number
+_BAD_POSITIVE = ("0", "-1", "nan", "inf", "-inf", "1e300", "abc")
+
+
+def _has_flanks(example: str) -> bool:
+    data = tomllib.loads((EXAMPLES_DIR / f"{example}.toml").read_text(encoding="utf-8"))
+    return "pinion" in data and "gear" in data
+
+
+def build_cases() -> list[Case]:
+    cs: list[Case] = []
+
+    def add(id, argv, expect, why, setup=None, also=(), heavy=False):
+        cs.append(Case(id, tuple(argv), expect, why, setup, frozenset(also), heavy))
+
+    # ---------------------------------------------------------------- top level
+    add("top.no_args", [], "refuse", "no sub-command")
+    add("top.unknown_command", ["frobnicate"], "refuse", "unknown sub-command")
+    add("top.unknown_option", ["--frobnicate"], "refuse", "unknown global option")
+    add("top.help", ["--help"], "ok", "help text, exit 0")
+
+    # ---------------------------------------------------------------- involute
+    add("involute.ok.table", ["involute", *_argv(INV)], "ok", "README example, table")
+    add("involute.ok.json", ["involute", *_argv(INV), "--json"], "ok", "README example, JSON")
+    add("involute.ok.helical_json",
+        ["involute", *_argv(INV, {"--helix": "15", "--x1": "0.2", "--x2": "0"}), "--json"],
+        "ok", "helical pair with profile shift")
+    add("involute.ok.coast_json", ["involute", *_argv(INV, {"--side": "coast"}), "--json"],
+        "ok", "coast side")
+    add("involute.ok.points2_json", ["involute", *_argv(INV, {"--points": "2"}), "--json"],
+        "ok", "smallest allowed number of points")
+    numeric = {
+        "--z1": ("0", "-20", "5", "20.5", "abc", "0x14", "nan", "inf", "1e300"),
+        "--z2": ("0", "5", "nan", "-inf", "1e300"),
+        "--module": ("0", "-4", "nan", "inf", "1e300", "4mm"),
+        "--pressure-angle": ("0", "45", "90", "-20", "nan", "inf", "20deg"),
+        "--helix": ("-15", "61", "90", "nan", "inf"),
+        "--x1": ("5", "-3", "nan", "inf"),
+        "--x2": ("5", "nan"),
+        "--points": ("0", "1", "2.5", "-3", "nan", "1e300", "1e9"),
+        "--rpm": ("0", "-1000", "nan", "inf", "1e300"),
+    }
+    for flag, values in numeric.items():
+        for v in values:
+            add(f"involute.{flag[2:]}={_slug(v)}", ["involute", *_argv(INV, {flag: v}), "--json"],
+                "refuse", f"{flag} {v}: out of range or not a number")
+    add("involute.module=1e-300", ["involute", *_argv(INV, {"--module": "1e-300"}), "--json"],
+        "refuse", "tiny module: refuse, or a finite valid result", also={"ok"})
+    add("involute.rpm=1e-300", ["involute", *_argv(INV, {"--rpm": "1e-300"}), "--json"],
+        "refuse", "tiny speed: refuse, or a finite valid result", also={"ok"})
+    add("involute.side=left", ["involute", *_argv(INV, {"--side": "left"})], "refuse",
+        "unknown choice")
+    add("involute.missing_z1", ["involute", *_argv(INV, {"--z1": None})], "refuse",
+        "required flag missing")
+    add("involute.missing_module", ["involute", *_argv(INV, {"--module": None})], "refuse",
+        "required flag missing")
+    add("involute.no_flags", ["involute"], "refuse", "every required flag missing")
+    add("involute.flag_without_value", ["involute", "--z1", *_argv(INV[1:])], "refuse",
+        "--z1 followed by another flag")
+    add("involute.unknown_option", ["involute", *_argv(INV), "--colour", "red"], "refuse",
+        "unknown option")
+    add("involute.positional", ["involute", *_argv(INV), "extra"], "refuse",
+        "stray positional argument")
+
+    # ---------------------------------------------------------------- example
+    add("example.list", ["example", "list"], "ok", "list the packaged designs")
+    add("example.show", ["example", "show", "hft_8x43"], "ok", "print a design")
+    add("example.show_alias", ["example", "show", "seed000_6x39_7p5in"], "ok",
+        "former name still accepted")
+    add("example.no_action", ["example"], "refuse", "missing action")
+    add("example.unknown_action", ["example", "frobnicate"], "refuse", "unknown action")
+    add("example.show_missing_name", ["example", "show"], "refuse", "missing name")
+    add("example.show_unknown", ["example", "show", "nope_3x7"], "refuse", "unknown example")
+    add("example.show_empty", ["example", "show", ""], "refuse", "empty name")
+    add("example.show_traversal", ["example", "show", "../cli"], "refuse",
+        "path traversal out of the examples")
+    add("example.show_suffix", ["example", "show", "hft_8x43.toml"], "refuse",
+        "name with its file extension")
+
+    # ---------------------------------------------------------------- design-file troubles
+    # (setup, why) of files that are no design at all, shared by blank/surface/kinematics/tca
+    broken_files = {
+        "missing_file": (None, "design file does not exist"),
+        "directory": (a_directory(), "design path is a directory"),
+        "empty_file": (raw_file(b""), "empty design file"),
+        "binary_file": (raw_file(b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR\x00\xff\xfe"),
+                        "binary file"),
+        "non_utf8": (raw_file(b"# r\xe9glage\n[design]\nname = \"x\"\n"), "non-UTF-8 text"),
+        "invalid_toml": (raw_file(b"[design\nname = 'x'\n"), "not TOML"),
+        "only_design_table": (raw_file(b"[design]\nname = \"x\"\nkind = \"hypoid\"\n"),
+                              "a design without blank, summaries or flanks"),
+    }
+    design_arg = lambda key: "{tmp}/missing.toml" if key == "missing_file" else "{design}"
+
+    # corrupted copies of the packaged examples: id -> (example, edits, why)
+    H = "hft_8x43"
+    corrupt = {
+        "missing_sliding_base": (H, [("pinion.concave.machine.sliding_base", _DELETE)],
+                                 "pinion concave sliding_base deleted (the convex flank has one)"),
+        "missing_ratio_of_roll": (H, [("pinion.convex.machine.ratio_of_roll", _DELETE)],
+                                  "generated pinion without ratio of roll"),
+        "missing_blank_offset": (H, [("pinion.concave.machine.blank_offset", _DELETE)],
+                                 "hypoid pinion flank without blank offset"),
+        "missing_point_radius": (H, [("pinion.convex.cutter.point_radius", _DELETE)],
+                                 "cutter without point radius"),
+        "missing_summary_face_angle": (H, [("blank_summary.gear.face_angle", _DELETE)],
+                                       "gear summary without face angle"),
+        "missing_gear_concave": (H, [("gear.concave", _DELETE)], "gear concave flank deleted"),
+        "missing_summary_gear": (H, [("blank_summary.gear", _DELETE)],
+                                 "[blank_summary.gear] deleted"),
+        "teeth_gear_41_vs_blank_43": (H, [("blank_summary.gear.teeth", 41)],
+                                      "[blank] z2 = 43 but [blank_summary.gear] teeth = 41"),
+        "teeth_pinion_9_vs_blank_8": (H, [("blank_summary.pinion.teeth", 9)],
+                                      "[blank] z1 = 8 but [blank_summary.pinion] teeth = 9"),
+        "teeth_swapped": (H, [("blank_summary.gear.teeth", 8), ("blank_summary.pinion.teeth", 43)],
+                          "pinion and gear tooth numbers swapped"),
+        "hand_same_both": (H, [("blank_summary.gear.hand", "left")],
+                           "pinion and gear both left hand"),
+        "hand_blank_vs_summary": (H, [("blank.hand", "right")],
+                                  "[blank] hand right, [blank_summary.pinion] left"),
+        "hand_invalid": (H, [("blank_summary.pinion.hand", "up")], "hand 'up'"),
+        "unknown_top_table": (H, [("extra.key", 1)], "unknown table [extra]"),
+        "unknown_machine_key": (H, [("pinion.convex.machine.sliding_bas", 28.8)],
+                                "misspelt machine key"),
+        "unknown_blank_key": (H, [("blank.z3", 5)], "unknown key in [blank]"),
+        "string_point_radius": (H, [("pinion.convex.cutter.point_radius", "117.475")],
+                                "number given as a string"),
+        "string_sliding_base": (H, [("pinion.concave.machine.sliding_base", "26.07")],
+                                "machine setting given as a string"),
+        "bool_blank_offset": (H, [("pinion.concave.machine.blank_offset", True)],
+                              "machine setting given as a boolean"),
+        "list_sliding_base": (H, [("pinion.concave.machine.sliding_base", [26.0, 1.0])],
+                              "machine setting given as an array"),
+        "table_ratio_of_roll": (H, [("pinion.convex.machine.ratio_of_roll", {"value": 5.36})],
+                                "machine setting given as a table"),
+        "int_type_machine": (H, [("pinion.convex.machine.type", 5)], "machine type 5"),
+        "unknown_machine_type": (H, [("pinion.convex.machine.type", "hobbed")],
+                                 "machine type 'hobbed'"),
+        "blank_z1_string": (H, [("blank.z1", "8")], "[blank] z1 as a string"),
+        "blank_z1_float": (H, [("blank.z1", 8.5)], "[blank] z1 = 8.5"),
+        "blank_z1_zero": (H, [("blank.z1", 0)], "[blank] z1 = 0"),
+        "blank_missing_z2": (H, [("blank.z2", _DELETE)], "[blank] without z2"),
+        "blank_method_unknown": (H, [("blank.method", "iso99")], "unknown blank method"),
+        "blank_shaft_angle_0": (H, [("blank.shaft_angle_deg", 0.0)], "shaft angle 0"),
+        "blank_shaft_angle_180": (H, [("blank.shaft_angle_deg", 180.0)], "shaft angle 180"),
+        "blank_spiral_angle_90": (H, [("blank.spiral_angle_deg", 90.0)], "spiral angle 90"),
+        "blank_cutter_radius_neg": (H, [("blank.cutter_radius_mm", -114.3)],
+                                    "negative cutter radius"),
+        "blank_diameter_1e300": (H, [("blank.gear_outer_pitch_diameter_mm", 1e300)],
+                                 "gear diameter 1e300 mm"),
+        "blank_offset_huge": (H, [("blank.offset_mm", 1e6)], "offset far beyond the gear"),
+        "blank_offset_nan": (H, [("blank.offset_mm", float("nan"))], "NaN offset"),
+        "blank_pressure_angle_0": (H, [("blank.pressure_angle_drive_deg", 0.0)],
+                                   "drive pressure angle 0"),
+        "design_kind_worm": (H, [("design.kind", "worm")], "design kind 'worm'"),
+        "nan_ratio_of_roll": (H, [("pinion.convex.machine.ratio_of_roll", float("nan"))],
+                              "NaN ratio of roll"),
+        "nan_sliding_base": (H, [("pinion.concave.machine.sliding_base", float("nan"))],
+                             "NaN sliding base"),
+        "inf_blade_angle": (H, [("pinion.concave.cutter.blade_angle", float("inf"))],
+                            "infinite blade angle"),
+        "nan_radial_distance": (H, [("gear.convex.machine.radial_distance", float("nan"))],
+                                "NaN gear radial distance"),
+        "nan_summary_face_width": (H, [("blank_summary.gear.face_width", float("nan"))],
+                                   "NaN face width"),
+        "nan_machine_root_angle": (H, [("pinion.convex.machine.machine_root_angle",
+                                        float("nan"))], "NaN machine root angle"),
+        "neg_point_radius": (H, [("pinion.convex.cutter.point_radius", -117.475)],
+                             "negative cutter radius"),
+        "neg_edge_radius": (H, [("pinion.convex.cutter.edge_radius", -1.0)],
+                            "negative edge radius"),
+        "blade_angle_95": (H, [("pinion.convex.cutter.blade_angle", 95.0)], "blade angle 95"),
+        "eccentric_zero": (H, [("pinion.convex.machine.no116.eccentric", 0.0)],
+                           "No. 116 eccentric 0"),
+        "tilt_200": (H, [("pinion.convex.machine.no116.tilt", 200.0)], "No. 116 tilt 200"),
+        "ratio_of_roll_zero": (H, [("pinion.convex.machine.ratio_of_roll", 0.0)],
+                               "generated flank with ratio of roll 0"),
+        "ratio_of_roll_huge": (H, [("pinion.convex.machine.ratio_of_roll", 1e300)],
+                               "ratio of roll 1e300"),
+        "summary_face_width_0": (H, [("blank_summary.pinion.face_width", 0.0)], "face width 0"),
+        "summary_face_width_huge": (H, [("blank_summary.pinion.face_width", 1e300)],
+                                    "face width 1e300"),
+        "summary_pitch_angle_95": (H, [("blank_summary.pinion.pitch_angle", 95.0)],
+                                   "pitch angle 95"),
+        "summary_root_above_face": (H, [("blank_summary.pinion.root_angle", 20.0)],
+                                    "root angle above pitch and face angle"),
+        "summary_teeth_float": (H, [("blank_summary.gear.teeth", 43.5)], "43.5 teeth"),
+        "mean_cone_inconsistent": (H, [("blank_summary.gear.mean_cone_distance", 100.0)],
+                                   "mean cone distance not A_o - F/2"),
+        "no116_and_geometric": (H, [("pinion.convex.machine.radial_distance", 120.0)],
+                                "dials and geometric settings both given"),
+        "formate_with_no116": (H, [("gear.convex.machine.no116",
+                                    {"cradle": 1.0, "eccentric": 1.0, "swivel": 1.0,
+                                     "tilt": 1.0})], "No. 116 dials on a formate gear"),
+        "no_blank_table": (H, [("blank", _DELETE)], "no [blank] table"),
+    }
+
+    def corrupt_case(cmd, key, extra, expect="refuse", heavy=False, also=()):
+        ex, edits, why = corrupt[key]
+        add(f"{cmd}.design.{key}", [cmd, "{design}", *extra], expect, why,
+            setup=design_file(ex, *edits), heavy=heavy, also=also)
+
+    # ---------------------------------------------------------------- blank
+    for name in EXAMPLES:
+        add(f"blank.example.{name}", ["blank", f"example:{name}", "--json"], "ok",
+            "packaged example")
+    add("blank.example_table", ["blank", "example:hft_8x43"], "ok", "table output")
+    add("blank.unknown_example", ["blank", "example:nope_3x7"], "refuse", "unknown example")
+    add("blank.empty_example", ["blank", "example:"], "refuse", "empty example name")
+    add("blank.missing_design_arg", ["blank"], "refuse", "DESIGN missing")
+    for key, (setup, why) in broken_files.items():
+        add(f"blank.file.{key}", ["blank", design_arg(key), "--json"], "refuse", why,
+            setup=setup)
+    for key in ("missing_sliding_base", "teeth_gear_41_vs_blank_43", "teeth_pinion_9_vs_blank_8",
+                "hand_same_both", "hand_blank_vs_summary", "unknown_top_table",
+                "unknown_blank_key", "blank_z1_string", "blank_z1_float", "blank_z1_zero",
+                "blank_missing_z2", "blank_method_unknown", "blank_shaft_angle_0",
+                "blank_shaft_angle_180", "blank_spiral_angle_90", "blank_cutter_radius_neg",
+                "blank_diameter_1e300", "blank_offset_huge", "blank_offset_nan",
+                "blank_pressure_angle_0", "design_kind_worm", "no_blank_table",
+                "list_sliding_base"):
+        corrupt_case("blank", key, ["--json"])
+
+    # ---------------------------------------------------------------- surface
+    def srf(member="pinion", flank="convex", grid="11x7", out="{tmp}/flank.csv", extra=()):
+        a = ["surface", "example:hft_8x43"]
+        for f, v in (("--member", member), ("--flank", flank), ("--grid", grid), ("--out", out)):
+            if v is not None:
+                a += [f, v]
+        return a + list(extra)
+
+    add("surface.ok.csv", srf(), "ok", "flank grid to CSV")
+    add("surface.ok.stl_tooth", srf(member="gear", out="{tmp}/tooth.stl", extra=["--tooth"]),
+        "ok", "closed gear tooth to STL")
+    add("surface.ok.xyz_plot", srf(flank="concave", out="{tmp}/f.xyz",
+                                   extra=["--plot", "{tmp}/f.png"]), "ok", "XYZ and a plot")
+    for g in ("0x5", "1x5", "5x", "axb", "3000x3", "-5x5", "5.5x5", "41x21x3", ""):
+        add(f"surface.grid={_slug(g)}", srf(grid=g), "refuse", f"--grid {g!r}")
+    add("surface.out.missing_dir", srf(out="{tmp}/no/such/dir/f.csv"), "refuse",
+        "--out in a missing directory")
+    add("surface.out.readonly_dir", srf(out="{ro}/f.csv"), "refuse",
+        "--out in a read-only directory", setup=readonly_dir)
+    add("surface.out.is_directory", srf(out="{dir}"), "refuse", "--out names a directory",
+        setup=a_directory("out.csv"))
+    add("surface.out.parent_is_file", srf(out="{file}/f.csv"), "refuse",
+        "--out below a regular file", setup=plain_file())
+    add("surface.out.bad_extension", srf(out="{tmp}/f.txt"), "refuse", "--out .txt")
+    add("surface.out.no_extension", srf(out="{tmp}/flank"), "refuse", "--out without extension")
+    add("surface.out.tooth_csv", srf(extra=["--tooth"]), "refuse", "--tooth with a CSV file")
+    add("surface.plot.bad_extension", srf(extra=["--plot", "{tmp}/f.jpg2"]), "refuse",
+        "--plot with an unsupported extension")
+    add("surface.plot.missing_dir", srf(extra=["--plot", "{tmp}/no/dir/f.png"]), "refuse",
+        "--plot in a missing directory")
+    add("surface.plot.readonly_dir", srf(extra=["--plot", "{ro}/f.png"]), "refuse",
+        "--plot in a read-only directory", setup=readonly_dir)
+    add("surface.plot.is_directory", srf(extra=["--plot", "{dir}"]), "refuse",
+        "--plot names a directory", setup=a_directory("p.png"))
+    add("surface.member=wheel", srf(member="wheel"), "refuse", "unknown member")
+    add("surface.flank=inner", srf(flank="inner"), "refuse", "unknown flank")
+    add("surface.missing_member", srf(member=None), "refuse", "--member missing")
+    add("surface.missing_out", srf(out=None), "refuse", "--out missing")
+    add("surface.unknown_example", ["surface", "example:nope", "--member", "pinion", "--flank",
+                                    "convex", "--out", "{tmp}/f.csv"], "refuse",
+        "unknown example")
+    for key in ("empty_file", "binary_file", "directory"):
+        setup, why = broken_files[key]
+        add(f"surface.file.{key}", ["surface", "{design}", "--member", "pinion", "--flank",
+                                    "convex", "--grid", "11x7", "--out", "{tmp}/f.csv"],
+            "refuse", why, setup=setup)
+    surface_corrupt = {  # key -> member, flank the corruption affects
+        "missing_sliding_base": ("pinion", "concave"),
+        "missing_ratio_of_roll": ("pinion", "convex"),
+        "missing_blank_offset": ("pinion", "concave"),
+        "missing_point_radius": ("pinion", "convex"),
+        "missing_summary_face_angle": ("gear", "convex"),
+        "missing_gear_concave": ("gear", "concave"),
+        "missing_summary_gear": ("gear", "convex"),
+        "hand_invalid": ("pinion", "convex"),
+        "unknown_machine_key": ("pinion", "convex"),
+        "string_point_radius": ("pinion", "convex"),
+        "string_sliding_base": ("pinion", "concave"),
+        "bool_blank_offset": ("pinion", "concave"),
+        "table_ratio_of_roll": ("pinion", "convex"),
+        "int_type_machine": ("pinion", "convex"),
+        "unknown_machine_type": ("pinion", "convex"),
+        "nan_ratio_of_roll": ("pinion", "convex"),
+        "nan_summary_face_width": ("gear", "convex"),
+        "nan_machine_root_angle": ("pinion", "convex"),
+        "neg_point_radius": ("pinion", "convex"),
+        "neg_edge_radius": ("pinion", "convex"),
+        "blade_angle_95": ("pinion", "convex"),
+        "eccentric_zero": ("pinion", "convex"),
+        "tilt_200": ("pinion", "convex"),
+        "ratio_of_roll_zero": ("pinion", "convex"),
+        "ratio_of_roll_huge": ("pinion", "convex"),
+        "summary_face_width_0": ("pinion", "convex"),
+        "summary_face_width_huge": ("pinion", "convex"),
+        "summary_pitch_angle_95": ("pinion", "convex"),
+        "summary_root_above_face": ("pinion", "convex"),
+        "summary_teeth_float": ("gear", "convex"),
+        "mean_cone_inconsistent": ("gear", "convex"),
+        "no116_and_geometric": ("pinion", "convex"),
+        "formate_with_no116": ("gear", "convex"),
+        "teeth_swapped": ("gear", "convex"),
+    }
+    for key, (member, flank) in surface_corrupt.items():
+        corrupt_case("surface", key, ["--member", member, "--flank", flank, "--grid", "11x7",
+                                      "--out", "{tmp}/f.csv"])
+
+    # ---------------------------------------------------------------- friction
+    add("friction.ok.table", ["friction", *_argv(FRI)], "ok", "README example")
+    add("friction.ok.json", ["friction", *_argv(FRI), "--json"], "ok", "README example, JSON")
+    add("friction.ok.eta0_json", ["friction", *_argv(FRI, {"--oil": None, "--eta0": "0.1"}),
+                                  "--json"], "ok", "custom oil")
+    fnum = {
+        "--load-N": _BAD_POSITIVE,
+        "--rx-mm": ("0", "-10", "nan", "inf", "1e300"),
+        "--ry-mm": ("0", "nan", "-inf"),
+        "--ue": ("0", "-5", "nan", "inf", "1e300", "fast"),
+        "--us": ("-1", "nan", "inf", "1e300"),
+        "--sigma-um": ("0", "-0.4", "nan", "inf", "1e300"),
+        "--asperity-density-per-mm2": ("0", "nan", "-1e4"),
+        "--asperity-radius-um": ("0", "inf"),
+        "--fc": ("-0.1", "1.5", "nan"),
+        "--E-prime-MPa": ("0", "nan", "-1"),
+    }
+    for flag, values in fnum.items():
+        for v in values:
+            add(f"friction.{flag[2:]}={_slug(v)}", ["friction", *_argv(FRI, {flag: v}), "--json"],
+                "refuse", f"{flag} {v}")
+    for flag, values in {"--eta0": ("0", "1e-5", "nan", "inf", "-1"),
+                         "--alpha-per-GPa": ("0", "nan", "-20"),
+                         "--tau0-MPa": ("0", "nan")}.items():
+        for v in values:
+            over = {"--oil": None, "--eta0": "0.1", flag: v}
+            add(f"friction.{flag[2:]}={_slug(v)}", ["friction", *_argv(FRI, over), "--json"],
+                "refuse", f"{flag} {v} (custom oil)")
+    add("friction.load-N=1e-300", ["friction", *_argv(FRI, {"--load-N": "1e-300"}), "--json"],
+        "refuse", "tiny load: refuse, or a finite valid result", also={"ok"})
+    add("friction.ue=1e-300", ["friction", *_argv(FRI, {"--ue": "1e-300"}), "--json"],
+        "refuse", "tiny entrainment speed: refuse, or a finite valid result", also={"ok"})
+    add("friction.oil=olive", ["friction", *_argv(FRI, {"--oil": "olive"})], "refuse",
+        "unknown oil")
+    add("friction.oil_and_eta0", ["friction", *_argv(FRI, {"--eta0": "0.1"})], "refuse",
+        "--oil and --eta0 together")
+    add("friction.no_oil", ["friction", *_argv(FRI, {"--oil": None})], "refuse",
+        "neither --oil nor --eta0")
+    add("friction.film=ellipse", ["friction", *_argv(FRI, {"--film": "ellipse"})], "refuse",
+        "unknown film formula")
+    add("friction.viscosity=newton", ["friction", *_argv(FRI, {"--viscosity": "newton"})],
+        "refuse", "unknown viscosity model")
+    add("friction.missing_load", ["friction", *_argv(FRI, {"--load-N": None})], "refuse",
+        "required flag missing")
+
+    # ---------------------------------------------------------------- stribeck
+    add("stribeck.ok.table", ["stribeck", *_argv(STR)], "ok", "default sweep")
+    add("stribeck.ok.json", ["stribeck", *_argv(STR), "--json"], "ok", "default sweep, JSON")
+    add("stribeck.ok.plot", ["stribeck", *_argv(STR), "--plot", "{tmp}/s.png"], "ok",
+        "with a plot")
+    snum = {
+        "--srr": ("-0.1", "2.5", "nan", "inf"),
+        "--ue-min": ("0", "-1", "nan"),
+        "--ue-max": ("0.001", "inf", "1e300", "nan"),
+        "--points": ("0", "1", "2.5", "1e6", "nan"),
+        "--load-N": ("0", "nan"),
+        "--sigma-um": ("inf",),
+    }
+    for flag, values in snum.items():
+        for v in values:
+            add(f"stribeck.{flag[2:]}={_slug(v)}", ["stribeck", *_argv(STR, {flag: v}), "--json"],
+                "refuse", f"{flag} {v}")
+    add("stribeck.plot.missing_dir", ["stribeck", *_argv(STR), "--plot", "{tmp}/no/dir/s.png"],
+        "refuse", "--plot in a missing directory")
+    add("stribeck.plot.readonly_dir", ["stribeck", *_argv(STR), "--plot", "{ro}/s.png"],
+        "refuse", "--plot in a read-only directory", setup=readonly_dir)
+    add("stribeck.plot.is_directory", ["stribeck", *_argv(STR), "--plot", "{dir}"], "refuse",
+        "--plot names a directory", setup=a_directory("s.png"))
+    add("stribeck.plot.bad_extension", ["stribeck", *_argv(STR), "--plot", "{tmp}/s.txt2"],
+        "refuse", "--plot with an unsupported extension")
+
+    # ---------------------------------------------------------------- kinematics
+    K = "example:hypoid_6x39_7p5in"
+    add("kinematics.ok.json", ["kinematics", K, "--json"], "ok", "README example")
+    add("kinematics.ok.hft_table", ["kinematics", "example:hft_8x43", "--grid", "11x7"], "ok",
+        "another hypoid, small grid")
+    add("kinematics.spiral_bevel", ["kinematics", "example:spiral_bevel_10x30"], "refuse",
+        "the model needs an offset (hypoid) pair")
+    for g in ("0x5", "2x5", "202x5", "5x", "axb"):
+        add(f"kinematics.grid={_slug(g)}", ["kinematics", K, "--grid", g], "refuse",
+            f"--grid {g!r}")
+    add("kinematics.flank=inner", ["kinematics", K, "--flank", "inner"], "refuse",
+        "unknown flank")
+    for v in ("nan", "inf", "90", "-90", "1e300"):
+        add(f"kinematics.blade-angle-delta={_slug(v)}",
+            ["kinematics", K, "--blade-angle-delta", v, "--json"], "refuse",
+            f"blade angle change {v} deg")
+    for v in ("nan", "inf", "1e300", "-1e6"):
+        add(f"kinematics.cutter-shift={_slug(v)}", ["kinematics", K, "--cutter-shift", v,
+                                                    "--json"], "refuse",
+            f"cutter shift {v} mm")
+    add("kinematics.plot.pdf", ["kinematics", K, "--plot", "{tmp}/k.pdf"], "refuse",
+        "--plot extension not .png")
+    add("kinematics.plot.missing_dir", ["kinematics", K, "--plot", "{tmp}/no/dir/k.png"],
+        "refuse", "--plot in a missing directory")
+    add("kinematics.plot.readonly_dir", ["kinematics", K, "--plot", "{ro}/k.png"], "refuse",
+        "--plot in a read-only directory", setup=readonly_dir)
+    add("kinematics.plot.is_directory", ["kinematics", K, "--plot", "{dir}"], "refuse",
+        "--plot names a directory", setup=a_directory("k.png"))
+    for key in ("non_utf8", "missing_file"):
+        setup, why = broken_files[key]
+        add(f"kinematics.file.{key}", ["kinematics", design_arg(key)], "refuse", why,
+            setup=setup)
+    for key in ("no_blank_table", "blank_offset_nan", "blank_cutter_radius_neg",
+                "blank_offset_huge"):
+        corrupt_case("kinematics", key, ["--json"])
+
+    # ---------------------------------------------------------------- tca
+    def tca_inv(spec=TCA_INV, *extra, expect="refuse", why="", also=(), heavy=False, id=None):
+        add(id or f"tca.inv.{_slug(spec[len('involute:'):])}", ["tca", spec, *extra],
+            expect, why, also=also, heavy=heavy)
+
+    tca_inv(TCA_INV, "--json", expect="ok", why="README involute pair", id="tca.ok.involute_json")
+    tca_inv(TCA_INV + ",helix=15,crown=0.0005", "--side", "both", "--kinematics", "--json",
+            expect="ok", why="crowned helical pair, both sides, kinematics",
+            id="tca.ok.involute_both_kin")
+    tca_inv(TCA_INV, "--plot", "{tmp}/t.png", expect="ok", why="table and plot",
+            id="tca.ok.involute_plot")
+    for spec, why in (
+            ("involute:z1=..", "malformed value"), ("involute:", "empty spec"),
+            ("involute:z1=20", "missing keys"),
+            (TCA_INV + ",q=1", "unknown key"), (TCA_INV + ",z1=21", "duplicate key"),
+            ("involute:z1=abc,z2=40,m=4,alpha=20,b=30", "letters"),
+            ("involute:z1=20.5,z2=40,m=4,alpha=20,b=30", "fractional teeth"),
+            ("involute:z1=nan,z2=40,m=4,alpha=20,b=30", "NaN teeth"),
+            ("involute:z1=20,z2=40,m=inf,alpha=20,b=30", "infinite module"),
+            ("involute:z1=20,z2=40,m=0,alpha=20,b=30", "zero module"),
+            ("involute:z1=20,z2=40,m=4,alpha=0,b=30", "zero pressure angle"),
+            ("involute:z1=20,z2=40,m=4,alpha=20,b=0", "zero face width"),
+            ("involute:z1=20,z2=40,m=4,alpha=20,b=-30", "negative face width"),
+            ("involute:z1=20,z2=40,m=4,alpha=20,b=nan", "NaN face width"),
+            ("involute:z1=20,z2=40,m=4,alpha=20,b=1e300", "face width 1e300"),
+            (TCA_INV + ",crown=-1", "negative crowning"), (TCA_INV + ",crown=nan", "NaN crown"),
+            (TCA_INV + ",lead_crown=inf", "infinite lead crown"),
+            (TCA_INV + ",helix=nan", "NaN helix"), (TCA_INV + ",dalpha=nan", "NaN dalpha"),
+            (TCA_INV + ",dalpha=90", "pressure angle change 90 deg"),
+            (TCA_INV + ",x1=nan", "NaN profile shift"),
+            ("involute:z1=3,z2=40,m=4,alpha=20,b=30", "3 teeth")):
+        tca_inv(spec, "--json", why=why)
+    tca_inv("involute:z1=20;z2=40;m=4;alpha=20;b=30", "--json", why="semicolons",
+            id="tca.inv.semicolons")
+    tca_inv("involute:z1 20,z2 40,m 4,alpha 20,b 30", "--json", why="no '='",
+            id="tca.inv.no_equals")
+    tca_inv("involute-z1=20", why="unknown design form (no such file)",
+            id="tca.design.not_a_spec")
+    for v in ("dE=abc", "dE", "dX=1", "dE=nan", "dSigma=inf", "dE=1e300", "dSigma=90",
+              "dE=0.05;dP=0", "dE=0.05,,dP=", "dE=0.05,dE=0.1"):
+        add(f"tca.misalign={_slug(v)}", ["tca", TCA_INV, "--misalign", v, "--json"], "refuse",
+            f"--misalign {v!r}")
+    for v in ("2", "0", "-61", "60", "61.5", "nan", "inf", "1e300", "2001", "abc"):
+        add(f"tca.positions={_slug(v)}", ["tca", TCA_INV, "--positions", v, "--json"], "refuse",
+            f"--positions {v}")
+    for v in ("0", "0.5", "5", "nan", "inf", "-1"):
+        add(f"tca.pitches={_slug(v)}", ["tca", TCA_INV, "--pitches", v, "--json"], "refuse",
+            f"--pitches {v}")
+    add("tca.side=left", ["tca", TCA_INV, "--side", "left"], "refuse", "unknown side")
+    add("tca.missing_design", ["tca", "--json"], "refuse", "DESIGN missing")
+    add("tca.plot.missing_dir", ["tca", TCA_INV, "--plot", "{tmp}/no/dir/t.png"], "refuse",
+        "--plot in a missing directory (must be refused before the solve)")
+    add("tca.plot.readonly_dir", ["tca", TCA_INV, "--plot", "{ro}/t.png"], "refuse",
+        "--plot in a read-only directory", setup=readonly_dir)
+    add("tca.plot.is_directory", ["tca", TCA_INV, "--plot", "{dir}"], "refuse",
+        "--plot names a directory", setup=a_directory("t.png"))
+    add("tca.plot.bad_extension", ["tca", TCA_INV, "--plot", "{tmp}/t.txt2"], "refuse",
+        "--plot with an unsupported extension")
+    # physically poor: must be flagged
+    add("tca.poor.uncrowned_dSigma", ["tca", TCA_INV + ",crown=0", "--misalign", "dSigma=0.05",
+                                      "--json"], "flag",
+        "misaligned uncrowned involute pair: edge contact")
+    add("tca.poor.uncrowned_dSigma_table", ["tca", TCA_INV + ",crown=0", "--misalign",
+                                            "dSigma=0.2"], "flag",
+        "misaligned uncrowned involute pair (table output): edge contact")
+    add("tca.poor.dalpha_uncrowned", ["tca", TCA_INV + ",dalpha=1", "--json"], "flag",
+        "pressure-angle mismatch without crowning: contact at the tip or root edge")
+    add("tca.poor.involute_dE_huge", ["tca", TCA_INV, "--misalign", "dE=100", "--json"], "flag",
+        "pinion moved 100 mm: the flanks do not touch")
+    add("tca.poor.narrow_face", ["tca", "involute:z1=20,z2=40,m=4,alpha=20,b=0.001", "--json"],
+        "flag", "1 um face width: not a gear; refuse or flag", also={"ok"})
+    add("tca.poor.hypoid_dE", ["tca", "example:hft_8x43_synthesised", "--pitches", "2",
+                               "--misalign", "dE=5", "--json"], "flag",
+        "hypoid pinion moved 5 mm: bearing off the flank", heavy=True)
+    add("tca.poor.hypoid_dSigma", ["tca", "example:spiral_bevel_10x30_synthesised",
+                                   "--misalign", "dSigma=3", "--json"], "flag",
+        "shaft angle error 3 deg", heavy=True)
+    # packaged examples, default options, both sides: a clean run (a warning or a clean
+    # refusal is an honest answer too, and is reported as such)
+    for name in EXAMPLES:
+        if _has_flanks(name):
+            add(f"tca.example.{name}", ["tca", f"example:{name}", "--side", "both", "--json"],
+                "ok", "packaged example, default options, both sides", also={"flagged"},
+                heavy=True)
+        else:
+            add(f"tca.example.{name}", ["tca", f"example:{name}", "--side", "both", "--json"],
+                "refuse", "packaged example without machine settings (a blank only)")
+    add("tca.example.spiral_bevel_kinematics",
+        ["tca", "example:spiral_bevel_10x30_synthesised", "--kinematics", "--json"], "ok",
+        "packaged example with kinematics", heavy=True)
+    add("tca.unknown_example", ["tca", "example:nope_3x7"], "refuse", "unknown example")
+    for key in ("missing_file", "directory", "empty_file", "binary_file", "non_utf8",
+                "only_design_table"):
+        setup, why = broken_files[key]
+        add(f"tca.file.{key}", ["tca", design_arg(key), "--json"], "refuse", why, setup=setup)
+    for key, side in (("missing_sliding_base", "drive"), ("missing_ratio_of_roll", "coast"),
+                      ("teeth_gear_41_vs_blank_43", "drive"), ("teeth_pinion_9_vs_blank_8",
+                                                               "drive"),
+                      ("hand_same_both", "drive"), ("missing_gear_concave", "both"),
+                      ("nan_sliding_base", "drive"), ("inf_blade_angle", "drive"),
+                      ("nan_radial_distance", "drive"), ("list_sliding_base", "drive"),
+                      ("string_sliding_base", "drive"), ("blank_offset_nan", "drive")):
+        corrupt_case("tca", key, ["--side", side, "--json"], heavy=True)
+    return cs
+
+
+CASES = build_cases()
+
+
+# ======================================================================================
+# running and classifying
+
+
+_NAN_TOKEN = re.compile(r"(?<![A-Za-z0-9_.])[-+]?(nan|inf|infinity)(?![A-Za-z0-9_])", re.I)
+_NAN_ONLY = re.compile(r"(?<![A-Za-z0-9_.])[-+]?nan(?![A-Za-z0-9_])|(?<![A-Za-z0-9_.])-inf"
+                       r"(?![A-Za-z0-9_])", re.I)
+_TCA_NO_VALUE_ROW = re.compile(r"\s(edge|no-conv)\s*$")
+_TCA_OK_ROW = re.compile(r"\sok\s*$")
+
+
+class _BareConstant(ValueError):
+    pass
+
+
+def _reject_constant(name):
+    raise _BareConstant(name)
+
+
+def nan_locations(stdout: str, wants_json: bool, limit: int = 5) -> list[str]:
+    """Where stdout holds a NaN/inf: JSON key paths (``drive.contact_ratio``) or text
+    lines.  Exempt in a ``gearjax tca`` table: rows flagged ``edge``/``no-conv`` (no
+    value by design) and ``inf`` on ``ok`` rows (the 2a column of a line contact, an
+    infinitely long contact ellipse -- ``null`` in the JSON output)."""
+    found: list[str] = []
+    if wants_json:
+        bad = object()
+        try:
+            doc = json.loads(stdout, parse_constant=lambda name: bad)
+        except ValueError:
+            return []
+
+        def walk(x, path):
+            if len(found) >= limit:
+                return
+            if x is bad:
+                found.append(path or "(top)")
+            elif isinstance(x, dict):
+                for k, v in x.items():
+                    walk(v, f"{path}.{k}" if path else k)
+            elif isinstance(x, list):
+                for i, v in enumerate(x):
+                    walk(v, f"{path}[{i}]")
+
+        walk(doc, "")
+        return found
+    for line in stdout.splitlines():
+        if _TCA_NO_VALUE_ROW.search(line):
+            continue
+        pattern = _NAN_ONLY if _TCA_OK_ROW.search(line) else _NAN_TOKEN
+        if pattern.search(line):
+            found.append(line.strip())
+            if len(found) >= limit:
+                break
+    return found
+
+
+def _stdout_problem(stdout: str, wants_json: bool) -> str | None:
+    """'nan' / 'badjson' / None for the stdout of a run that exited 0."""
+    if wants_json:
+        try:
+            json.loads(stdout, parse_constant=_reject_constant)
+        except _BareConstant:
+            return "nan"
+        except ValueError:
+            return "badjson"
+        return None
+    return "nan" if nan_locations(stdout, False, 1) else None
+
+
+def _lines(text: str) -> list[str]:
+    return [ln for ln in text.splitlines() if ln.strip()]
+
+
+def classify(rc, stdout: str, stderr: str, wants_json: bool, expect: str) -> str:
+    """Observed class of one run (see the module docstring); ``rc`` None = timeout."""
+    if rc is None:
+        return "timeout"
+    if "Traceback (most recent call last)" in stderr:
+        return "traceback"
+    lines = _lines(stderr)
+    warned = any(ln.startswith("gearjax: warning") for ln in lines)
+    if rc == 0:
+        problem = _stdout_problem(stdout, wants_json)
+        if problem:
+            return problem
+        if warned:
+            return "flagged"
+        return "ok" if expect == "ok" else "silent"
+    errors = [ln for ln in lines if ln.startswith("gearjax: error:")]
+    if rc == 2 and len(lines) == 1 and len(errors) == 1:
+        return "refusal"
+    if len(errors) == 1 and all(ln.startswith("gearjax: ") for ln in lines):
+        return "flagged"
+    return "unclean"
+
+
+def key_stderr_line(stderr: str) -> str:
+    """The stderr line that tells what happened: the exception line of a traceback,
+    else the first ``gearjax:`` line, else the first line."""
+    lines = _lines(stderr)
+    if not lines:
+        return ""
+    if "Traceback (most recent call last)" in stderr:
+        for ln in reversed(lines):
+            if not ln.startswith(" "):
+                return ln.strip()
+    for ln in lines:
+        if ln.startswith("gearjax:"):
+            return ln.strip()
+    return lines[0].strip()
+
+
+@dataclass
+class Result:
+    case: Case
+    observed: str
+    rc: int | None
+    seconds: float
+    argv: list = field(default_factory=list)
+    stderr: str = ""
+    stdout_head: str = ""
+    nan_at: list = field(default_factory=list)
+
+    @property
+    def passed(self) -> bool:
+        return self.observed in self.case.accepted
+
+    def to_dict(self) -> dict:
+        lines = _lines(self.stderr)
+        return {"id": self.case.id, "command": self.case.command, "argv": self.argv,
+                "why": self.case.why, "expected": self.case.expect,
+                "also_accepted": sorted(self.case.also), "observed": self.observed,
+                "pass": self.passed, "exit": self.rc, "seconds": round(self.seconds, 2),
+                "stderr_first": lines[0] if lines else "",
+                "stderr_key": key_stderr_line(self.stderr),
+                "stderr_lines": len(lines),
+                "stderr_tail": "\n".join(lines[-6:])[-1500:],
+                "stdout_head": self.stdout_head, "nan_at": self.nan_at}
+
+
+def _subst(arg: str, mapping: dict) -> str:
+    for k, v in mapping.items():
+        arg = arg.replace("{" + k + "}", v)
+    return arg
+
+
+def run_case(case: Case, workdir: Path, env: dict, timeout: float) -> Result:
+    tmp = workdir / re.sub(r"[^A-Za-z0-9._-]+", "_", case.id)
+    tmp.mkdir(parents=True, exist_ok=True)
+    mapping = {"tmp": str(tmp)}
+    t0 = time.monotonic()
+    if case.setup is not None:
+        try:
+            mapping.update(case.setup(tmp))
+        except Exception as exc:  # a harness problem, reported as such
+            return Result(case, "setup_error", None, 0.0, list(case.argv),
+                          stderr=f"setup failed: {type(exc).__name__}: {exc}")
+    argv = [_subst(a, mapping) for a in case.argv]
+    cmd = [sys.executable, "-m", "gearjax.cli", *argv]
+    proc = subprocess.Popen(cmd, cwd=tmp, env=env, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, start_new_session=True)
+    try:
+        out, err = proc.communicate(timeout=timeout)
+        rc = proc.returncode
+    except subprocess.TimeoutExpired:
+        try:
+            os.killpg(proc.pid, 9)       # the case's own process group only
+        except ProcessLookupError:
+            pass
+        out, err = proc.communicate()
+        rc = None
+    dt = time.monotonic() - t0
+    stdout = out.decode("utf-8", "replace")
+    stderr = err.decode("utf-8", "replace")
+    observed = classify(rc, stdout, stderr, "--json" in argv, case.expect)
+    nan_at = nan_locations(stdout, "--json" in argv) if observed == "nan" else []
+    return Result(case, observed, rc, dt, argv, stderr, stdout[:400], nan_at)
+
+
+def _make_writable(root: Path):
+    for dirpath, dirnames, _ in os.walk(root):
+        for d in dirnames:
+            try:
+                os.chmod(os.path.join(dirpath, d), 0o755)
+            except OSError:
+                pass
+
+
+# ======================================================================================
+# reports
+
+
+def summary(results: list[Result]) -> dict:
+    cross = {e: {o: 0 for o in OBSERVED} for e in EXPECTED}
+    for r in results:
+        cross[r.case.expect][r.observed] += 1
+    by_obs = {o: sum(cross[e][o] for e in EXPECTED) for o in OBSERVED}
+    return {"cases": len(results), "passed": sum(r.passed for r in results),
+            "failed": sum(not r.passed for r in results),
+            "observed": {o: n for o, n in by_obs.items() if n},
+            "expected_x_observed": {e: {o: n for o, n in row.items() if n}
+                                    for e, row in cross.items()}}
+
+
+def _cell(s: str, n: int = 140) -> str:
+    s = s.replace("|", "\\|").replace("\n", " ")
+    return s if len(s) <= n else s[: n - 1] + "…"
+
+
+def _used_observed(results):
+    return [o for o in OBSERVED if any(r.observed == o for r in results)]
+
+
+def markdown(results: list[Result], meta: dict) -> str:
+    s = summary(results)
+    obs = _used_observed(results)
+    out = [f"# Hostile inputs to the `gearjax` command ({meta['label']})", "",
+           f"`python tools/hostile_inputs.py` on commit `{meta['commit']}`, {meta['date']}; "
+           f"{s['cases']} cases, {meta['jobs']} parallel jobs, per-case timeout "
+           f"{meta['timeout_s']:g} s, wall time {meta['wall_s']:.0f} s.  Expected classes and "
+           "observed classes are defined in the docstring of `tools/hostile_inputs.py`; "
+           "`pass` means the observed class is one the case accepts.", "",
+           f"**{s['passed']} of {s['cases']} cases pass; {s['failed']} do not.**", "",
+           "## Expected x observed", "",
+           "| expected \\ observed | " + " | ".join(obs) + " | total |",
+           "|---|" + "---:|" * (len(obs) + 1)]
+    for e in EXPECTED:
+        row = s["expected_x_observed"][e]
+        out.append(f"| {e} | " + " | ".join(str(row.get(o, 0)) for o in obs)
+                   + f" | {sum(row.values())} |")
+    out.append("| total | " + " | ".join(str(s["observed"].get(o, 0)) for o in obs)
+               + f" | {s['cases']} |")
+    bad = [r for r in results if not r.passed]
+    out += ["", "## Cases that do not pass", "",
+            "| case | expected | observed | exit | stderr (first line; traceback: exception) |",
+            "|---|---|---|---:|---|"]
+    for r in sorted(bad, key=lambda r: (OBSERVED.index(r.observed), r.case.id)):
+        extra = f" (NaN/inf at: {', '.join(r.nan_at)})" if r.nan_at else ""
+        out.append(f"| `{r.case.id}` | {r.case.expect} | **{r.observed}** | {r.rc} | "
+                   f"{_cell(key_stderr_line(r.stderr) + extra, 260)} |")
+    out += ["", "## All cases", "",
+            "| case | argv | expected | observed | exit | s | stderr (first line; "
+            "traceback: exception) |", "|---|---|---|---|---:|---:|---|"]
+    for r in results:
+        mark = r.observed if r.passed else f"**{r.observed}**"
+        out.append(f"| `{r.case.id}` | `{_cell(' '.join(r.argv), 90)}` | {r.case.expect} | "
+                   f"{mark} | {r.rc} | {r.seconds:.0f} | {_cell(key_stderr_line(r.stderr))} |")
+    return "\n".join(out) + "\n"
+
+
+def print_table(results: list[Result], file=sys.stdout):
+    w = max(len(r.case.id) for r in results)
+    print(f"{'case':<{w}s}  {'expected':8s} {'observed':10s} {'exit':>4s}  stderr", file=file)
+    for r in results:
+        flag = " " if r.passed else "!"
+        print(f"{r.case.id:<{w}s}  {r.case.expect:8s} {r.observed:10s} {str(r.rc):>4s} {flag}"
+              f"{key_stderr_line(r.stderr)[:120]}", file=file)
+    s = summary(results)
+    print(f"\n{s['cases']} cases: {s['passed']} pass, {s['failed']} do not", file=file)
+    print("observed: " + ", ".join(f"{k} {v}" for k, v in s["observed"].items()), file=file)
+    for e, row in s["expected_x_observed"].items():
+        if row:
+            print(f"  expected {e:7s}: " + ", ".join(f"{k} {v}" for k, v in row.items()),
+                  file=file)
+
+
+def _git_commit() -> str:
+    try:
+        res = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT,
+                             capture_output=True, text=True, timeout=20)
+        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"],
+                               cwd=ROOT, capture_output=True, text=True, timeout=20).stdout
+        return res.stdout.strip() + ("+dirty" if dirty.strip() else "")
+    except (OSError, subprocess.SubprocessError):
+        return "unknown"
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--jobs", type=int, default=2, help="cases run at once (default 2)")
+    ap.add_argument("--only", default=None, help="run only cases whose id matches this regex")
+    ap.add_argument("--timeout", type=float, default=300.0, help="seconds per case (default 300)")
+    ap.add_argument("--md", default=None, help="write the markdown report here")
+    ap.add_argument("--json", default=None, help="write the JSON report here")
+    ap.add_argument("--label", default="baseline", help="title of the report (default baseline)")
+    ap.add_argument("--cache-dir", default=None,
+                    help="JAX compilation cache shared by the runs (default: a temporary one)")
+    ap.add_argument("--list", action="store_true", help="list the cases and exit")
+    ap.add_argument("--keep", action="store_true", help="keep the temporary directory")
+    args = ap.parse_args(argv)
+    if args.jobs < 1:
+        ap.error("--jobs must be >= 1")
+
+    cases = [c for c in CASES if args.only is None or re.search(args.only, c.id)]
+    if not cases:
+        print(f"no case matches {args.only!r}", file=sys.stderr)
+        return 2
+    if args.list:
+        for c in cases:
+            print(f"{c.id:55s} {c.expect:7s} {' '.join(c.argv)}")
+        print(f"{len(cases)} cases")
+        return 0
+
+    workdir = Path(tempfile.mkdtemp(prefix="gearjax-hostile-"))
+    cache = Path(args.cache_dir) if args.cache_dir else workdir / "jax-cache"
+    cache.mkdir(parents=True, exist_ok=True)
+    env = dict(os.environ)
+    env["PYTHONPATH"] = str(ROOT) + (os.pathsep + env["PYTHONPATH"] if env.get("PYTHONPATH")
+                                     else "")
+    env["GEARJAX_CACHE_DIR"] = str(cache.resolve())
+    order = sorted(range(len(cases)), key=lambda i: (not cases[i].heavy, i))
+    results: dict[int, Result] = {}
+    t0 = time.monotonic()
+    try:
+        with ThreadPoolExecutor(max_workers=args.jobs) as pool:
+            futs = {pool.submit(run_case, cases[i], workdir, env, args.timeout): i
+                    for i in order}
+            for fut in as_completed(futs):
+                i = futs[fut]
+                r = results[i] = fut.result()
+                print(f"[{len(results):3d}/{len(cases)}] {r.case.id}: {r.observed} "
+                      f"(exit {r.rc}, {r.seconds:.0f} s)", file=sys.stderr, flush=True)
+    finally:
+        if args.keep:
+            print(f"kept {workdir}", file=sys.stderr)
+        else:
+            _make_writable(workdir)
+            shutil.rmtree(workdir, ignore_errors=True)
+    wall = time.monotonic() - t0
+    ordered = [results[i] for i in range(len(cases))]
+    print_table(ordered)
+    meta = {"label": args.label, "commit": _git_commit(),
+            "date": time.strftime("%Y-%m-%d %H:%M %Z"), "jobs": args.jobs,
+            "timeout_s": args.timeout, "wall_s": wall, "python": sys.version.split()[0],
+            "cpu_count": os.cpu_count(), "only": args.only}
+    if args.md:
+        Path(args.md).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.md).write_text(markdown(ordered, meta), encoding="utf-8")
+    if args.json:
+        Path(args.json).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.json).write_text(json.dumps({"meta": meta, "summary": summary(ordered),
+                                               "cases": [r.to_dict() for r in ordered]},
+                                              indent=1) + "\n", encoding="utf-8")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
