@@ -117,6 +117,8 @@ def _enable_compilation_cache() -> None:
 
 
 def main(argv=None) -> int:
+    from gearjax import ConvergenceError
+
     parser = build_parser()
     args = parser.parse_args(argv)
     if argv is None:  # a real command-line run, not an in-process call
@@ -130,6 +132,10 @@ def main(argv=None) -> int:
     except ValueError as exc:
         sys.stderr.write(f"gearjax: error: {exc}\n")
         return 2
+    except ConvergenceError as exc:   # a solve failed on valid input: one line, status 3
+        msg = str(exc).split("; pass strict=False")[0]
+        sys.stderr.write(f"gearjax: error: {msg}\n")
+        return 3
     except OSError as exc:  # a write (or read) failed: disk full, permissions, size limit
         sys.stderr.write(f"gearjax: error: {_os_error_line(exc)}\n")
         return 1

@@ -91,6 +91,8 @@ def _parse_kv(text, allowed, what):
         k, v = (s.strip() for s in item.split("=", 1))
         if k not in allowed:
             raise ValueError(f"{what}: unknown key {k!r} (allowed: {', '.join(sorted(allowed))})")
+        if k in out:
+            raise ValueError(f"{what}: {k} is given twice")
         try:
             out[k] = float(v)
         except ValueError:
