@@ -445,3 +445,37 @@ def test_both_sides_keep_the_good_side(capsys, monkeypatch):
     out = capsys.readouterr().out.splitlines()
     assert out[0].startswith("# TCA involute:") and "(drive)" in out[0]
     assert out[-1].startswith("# TCA") and "(coast): FAILED" in out[-1]
+
+
+@pytest.mark.parametrize("argv, key", [
+    (["tca", "involute:z1=20,z1=21,z2=40,m=4,alpha=20,b=30"], "z1"),
+    (["tca", "involute:z1=20,z2=40,m=4,alpha=20,b=30", "--misalign", "dE=0.05,dE=0.1"], "dE"),
+])
+def test_tca_spec_key_given_twice_is_refused(capsys, argv, key):
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"{key} is given twice" in err[0]
+
+
+def test_a_failed_solve_on_valid_input_is_one_line_and_status_3(capsys, monkeypatch):
+    def boom(args):
+        raise ConvergenceError("friction solve: 3 of 40 solves did not converge; "
+                               "pass strict=False to get masks instead")
+    parser_argv = ["friction", "--load-N", "1000", "--rx-mm", "10", "--ry-mm", "300",
+                   "--ue", "5", "--us", "1"]
+    from gearjax import cli
+    p = cli.build_parser()
+    args = p.parse_args(parser_argv)
+    monkeypatch.setattr(cli, "build_parser", lambda: _FixedParser(args, boom))
+    assert main(parser_argv) == 3
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "did not converge" in err[0] and "strict" not in err[0]
+
+
+class _FixedParser:
+    def __init__(self, args, func):
+        args.func = func
+        self.args = args
+
+    def parse_args(self, argv):
+        return self.args
