@@ -458,24 +458,13 @@ def test_tca_spec_key_given_twice_is_refused(capsys, argv, key):
 
 
 def test_a_failed_solve_on_valid_input_is_one_line_and_status_3(capsys, monkeypatch):
+    import gearjax.commands.involute as inv
+
     def boom(args):
-        raise ConvergenceError("friction solve: 3 of 40 solves did not converge; "
+        raise ConvergenceError("involute path of contact: 3 of 21 solves did not converge; "
                                "pass strict=False to get masks instead")
-    parser_argv = ["friction", "--load-N", "1000", "--rx-mm", "10", "--ry-mm", "300",
-                   "--ue", "5", "--us", "1"]
-    from gearjax import cli
-    p = cli.build_parser()
-    args = p.parse_args(parser_argv)
-    monkeypatch.setattr(cli, "build_parser", lambda: _FixedParser(args, boom))
-    assert main(parser_argv) == 3
+    monkeypatch.setattr(inv, "run", boom)
+    assert main(["involute", "--z1", "20", "--z2", "40", "--module", "4",
+                 "--pressure-angle", "20"]) == 3
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "did not converge" in err[0] and "strict" not in err[0]
-
-
-class _FixedParser:
-    def __init__(self, args, func):
-        args.func = func
-        self.args = args
-
-    def parse_args(self, argv):
-        return self.args
