@@ -124,7 +124,8 @@ INLINE = {"z1": (6, 1000, False, False, True, "z1"),
           "lead_crown": (0.0, 0.1, False, False, False, "lead_crown")}
 INLINE_BASE = {"z1": "20", "z2": "40", "m": "4", "alpha": "20", "b": "30"}
 
-NOT_A_NUMBER = ["abc", "", "1,5", "0x10", "1e", "--", "five", "2..0", "1 2"]
+# ("--" as a value is a gap, pinned below: test_gap_double_dash_value)
+NOT_A_NUMBER = ["abc", "", "1,5", "0x10", "1e", "five", "2..0", "1 2"]
 KV_TOKENS = ["abc", "", "0x10", "1e", "five", "2..0", "1 2"]     # no ',' or '='
 
 
@@ -180,6 +181,8 @@ def _cli_case(draw):
     if kind == "flag":
         base, flag, lo, hi, lo_open, hi_open, integer, needle = draw(st.sampled_from(FLAGS))
         value = draw(_bad_number(lo, hi, lo_open, hi_open, integer))
+        if value in NOT_A_NUMBER:     # refused by argparse: "argument --flag: invalid float"
+            needle = flag
         return _replace(base, flag, value), needle
     if kind == "misalign":
         key = draw(st.sampled_from(sorted(MISALIGN)))
@@ -409,3 +412,13 @@ def test_gap_huge_length_accepted(ctor, name):
 def test_gap_oil_flags_ignored_with_named_oil(flag):
     rc, _, err = _run(FRICTION + [f"{flag}=nan"])
     assert rc == 2 and flag in err
+
+
+@pytest.mark.xfail(strict=True, reason="argparse turns '--flag=--' into an empty list (not "
+                                       "a float): check_int (integer flags) raises TypeError, "
+                                       "a traceback instead of exit 2")
+@pytest.mark.parametrize("argv", [_replace(INVOLUTE, "--z1", "--"),
+                                  _replace(INVOLUTE, "--points", "--")])
+def test_gap_double_dash_value(argv):
+    rc, _, err = _run(argv)
+    assert rc == 2 and len(err.splitlines()) == 1 and "Traceback" not in err
