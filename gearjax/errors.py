@@ -41,6 +41,8 @@ def check_range(name: str, value: Any, lo: float | None = None, hi: float | None
     """
     if is_traced(value) or is_traced(lo) or is_traced(hi):
         return value
+    if isinstance(value, (bool, np.bool_, str, bytes)):
+        raise ValueError(f"{name} must be a number, got {value!r}")
     try:
         v = float(value)
     except (TypeError, ValueError):
@@ -68,9 +70,16 @@ def check_positive(name: str, value: Any, unit: str = "") -> float:
 
 def check_int(name: str, value: Any, lo: int | None = None, hi: int | None = None) -> int:
     """Return ``int(value)`` or raise ``ValueError`` if not an integer in [lo, hi]."""
-    if isinstance(value, bool) or not float(np.asarray(value)).is_integer():
-        raise ValueError(f"{name} = {value!r} must be an integer"
-                         + (f" >= {lo}" if lo is not None else ""))
+    bad = ValueError(f"{name} = {value!r} must be an integer"
+                     + (f" >= {lo}" if lo is not None else ""))
+    if isinstance(value, (bool, np.bool_, str, bytes)):
+        raise bad
+    try:
+        f = float(np.asarray(value))
+    except (TypeError, ValueError):
+        raise bad from None
+    if not f.is_integer():
+        raise bad
     v = int(np.asarray(value))
     if (lo is not None and v < lo) or (hi is not None and v > hi):
         rng = f"[{lo if lo is not None else '-inf'}, {hi if hi is not None else 'inf'}]"

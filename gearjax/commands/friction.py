@@ -77,9 +77,9 @@ def _add_common(p):
     g = p.add_mutually_exclusive_group(required=True)
     g.add_argument("--oil", help="example oil: mineral_vg100 | mineral_vg220 | pao_vg100")
     g.add_argument("--eta0", type=float, help="inlet viscosity (Pa·s, in (6.31e-5, 100])")
-    p.add_argument("--alpha-per-GPa", type=float, default=20.0,
+    p.add_argument("--alpha-per-GPa", type=float, default=None,
                    help="pressure-viscosity coefficient with --eta0 (1/GPa, in (0, 100], default 20)")
-    p.add_argument("--tau0-MPa", type=float, default=5.0,
+    p.add_argument("--tau0-MPa", type=float, default=None,
                    help="Eyring stress with --eta0 (MPa, in (0, 100], default 5)")
     p.add_argument("--sigma-um", type=float, required=True,
                    help="composite RMS roughness sqrt(s1^2+s2^2) (um, in (0, 10])")
@@ -138,8 +138,16 @@ def _materials(args):
         raise ValueError(f"--ry-mm / --rx-mm = {args.ry_mm / args.rx_mm:g} is outside the "
                          "allowed range [1e-15, 1e15]")
     if args.oil is not None:
+        for flag in ("--alpha-per-GPa", "--tau0-MPa"):
+            if getattr(args, flag[2:].replace("-", "_")) is not None:
+                raise ValueError(f"{flag} applies with --eta0 only: --oil {args.oil} brings its "
+                                 "own pressure-viscosity coefficient and Eyring stress")
         oil = get_oil(args.oil)
     else:
+        if args.alpha_per_GPa is None:
+            args.alpha_per_GPa = 20.0
+        if args.tau0_MPa is None:
+            args.tau0_MPa = 5.0
         for flag in ("--eta0", "--alpha-per-GPa", "--tau0-MPa"):
             _check(flag, getattr(args, flag[2:].replace("-", "_")))
         oil = make_oil(args.eta0, args.alpha_per_GPa, args.tau0_MPa)

@@ -46,7 +46,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax.errors import check_positive, check_range, is_traced
+from gearjax.errors import check_range, is_traced
 
 __all__ = ["FaceMillCutter", "make_cutter", "cutter_point", "cutter_normal",
            "cutter_tangents", "fillet_start", "fillet_point", "fillet_normal",
@@ -90,7 +90,7 @@ def make_cutter(point_radius, blade_angle_deg, edge_radius, flank: str) -> FaceM
     """Validated constructor (file units: mm and degrees).
 
     ``flank`` is "convex" (inside blade, sgn = +1) or "concave" (outside blade,
-    sgn = -1).  Allowed: point_radius > 0 mm, blade_angle in (0, 45) deg,
+    sgn = -1).  Allowed: point_radius in (0, 1e4] mm, blade_angle in (0, 45) deg,
     edge_radius >= 0 mm and small enough for the blade tip (the fillet ends inside
     the point radius), all finite numbers (not bool or str).  Raises ValueError
     naming the parameter, the value and the allowed range; traced values (inside
@@ -101,7 +101,7 @@ def make_cutter(point_radius, blade_angle_deg, edge_radius, flank: str) -> FaceM
     for name, v in (("point_radius", point_radius), ("blade_angle", blade_angle_deg),
                     ("edge_radius", edge_radius)):
         _reject_non_number(name, v)
-    R = check_positive("point_radius", point_radius, "mm")
+    R = check_range("point_radius", point_radius, 0.0, 1e4, lo_open=True, unit="mm")
     a = check_range("blade_angle", blade_angle_deg, 0.0, 45.0, lo_open=True, hi_open=True,
                     unit="deg")
     rho = check_range("edge_radius", edge_radius, 0.0, None, unit="mm")

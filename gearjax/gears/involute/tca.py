@@ -85,7 +85,7 @@ class InvoluteTCA:
                lead_crown=0.0):
         """Validated constructor (degrees for ``dalpha_deg``); traced values (inside
         ``jax.grad``) pass through unchecked."""
-        b = check_range("face_width", face_width, 0.0, None, lo_open=True, unit="mm")
+        b = check_range("face_width", face_width, 0.0, 1000.0, lo_open=True, unit="mm")
         da = check_range("dalpha", dalpha_deg, -5.0, 5.0, unit="deg")
         a = check_range("profile_crown", profile_crown, 0.0, 0.1, unit="1/mm")
         c = check_range("lead_crown", lead_crown, 0.0, 0.1, unit="1/mm")
