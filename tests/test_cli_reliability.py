@@ -468,3 +468,17 @@ def test_a_failed_solve_on_valid_input_is_one_line_and_status_3(capsys, monkeypa
                  "--pressure-angle", "20"]) == 3
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "did not converge" in err[0] and "strict" not in err[0]
+
+
+def test_blank_without_a_solution_prints_none_and_warns(capsys):
+    """[HFT-hypoid]'s seed formula for the cutter tilt has no solution for the 8/43 set:
+    no `nan` in the table (a `none` and a warning line), strict JSON (null)."""
+    assert main(["blank", "example:hft_8x43"]) == 0
+    out = capsys.readouterr()
+    assert "nan" not in out.out.lower().replace("none", "")
+    line = [ln for ln in out.out.splitlines() if ln.strip().startswith("machine_tilt ")][0]
+    assert "none" in line and "no solution" in line
+    assert "machine_tilt" in out.err and "warning" in out.err
+    assert main(["blank", "example:hft_8x43", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out, parse_constant=lambda c: 1 / 0)
+    assert data["machine_tilt"] is None

@@ -9,8 +9,10 @@ the blank data only."""
 
 from __future__ import annotations
 
-import json
+import math
 import sys
+
+from gearjax.commands import print_json, warn_nonfinite
 
 
 def register(sub):
@@ -28,13 +30,19 @@ def run(args) -> int:
     with Progress(1, "blank") as bar, bar.phase("blank solve"):
         data = blank_geometry(design.blank_input())
     if args.json:
-        sys.stdout.write(json.dumps(data.to_dict(), indent=2) + "\n")
+        print_json(data.to_dict(), indent=2)     # strict JSON: a NaN is null + a warning
         return 0
     rows = data.to_table()
     w = max(len(r[0]) for r in rows)
     sys.stdout.write(f"blank of {design.name or args.design}\n")
+    bad = []
     for name, value, unit in rows:
-        sys.stdout.write(f"  {name:<{w}s}  {value:14.6f}  {unit}\n")
+        if math.isfinite(value):
+            sys.stdout.write(f"  {name:<{w}s}  {value:14.6f}  {unit}\n")
+        else:
+            bad.append(name)
+            sys.stdout.write(f"  {name:<{w}s}  {'none':>14s}  {unit}   (no solution)\n")
+    warn_nonfinite(bad)
     lines = design.defaults_lines()
     sys.stdout.write("defaults applied (keys not in the design file):" + ("" if lines else " none")
                      + "\n")
