@@ -482,3 +482,19 @@ def test_blank_without_a_solution_prints_none_and_warns(capsys):
     assert main(["blank", "example:hft_8x43", "--json"]) == 0
     data = json.loads(capsys.readouterr().out, parse_constant=lambda c: 1 / 0)
     assert data["machine_tilt"] is None
+
+
+@pytest.mark.parametrize("argv, name", [
+    (["involute", "--z1", "20", "--z2", "40", "--module", "4", "--pressure-angle", "20",
+      "--rpm", "1e-300"], "rpm"),
+    (["friction", "--load-N", "1e-300", "--rx-mm", "10", "--ry-mm", "300", "--ue", "5",
+      "--us", "1", "--oil", "mineral_vg100", "--sigma-um", "0.4"], "--load-N"),
+    (["friction", "--load-N", "1000", "--rx-mm", "10", "--ry-mm", "300", "--ue", "1e-300",
+      "--us", "1", "--oil", "mineral_vg100", "--sigma-um", "0.4"], "--ue"),
+    (["tca", "involute:z1=20,z2=40,m=4,alpha=20,b=0.001"], "face_width"),
+])
+def test_vanishing_operating_values_are_refused(capsys, argv, name):
+    """Tiny positive values that made the solves fail (a traceback before): refused."""
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and name in err[0]

@@ -44,7 +44,7 @@ plus p_max_MPa, a_mm, b_mm (constant along the sweep), input, and plot (the PNG 
 #: accepted ranges of the operating inputs, (low, high, low bound excluded, unit); the
 #: library validates the same quantities (gearjax.contact, gearjax.tribology)
 RANGES = {
-    "--load-N": (0.0, 1e7, True, "N"),
+    "--load-N": (1e-3, 1e7, False, "N"),
     "--rx-mm": (0.0, 1e6, True, "mm"),
     "--ry-mm": (0.0, 1e6, True, "mm"),
     "--eta0": (math.exp(-9.67), 100.0, True, "Pa·s"),
@@ -55,10 +55,10 @@ RANGES = {
     "--asperity-radius-um": (0.0, 1000.0, True, "um"),
     "--fc": (0.0, 1.0, False, ""),
     "--E-prime-MPa": (0.0, 1e7, True, "MPa"),
-    "--ue": (0.0, 500.0, True, "m/s"),
+    "--ue": (1e-6, 500.0, False, "m/s"),
     "--us": (0.0, 500.0, False, "m/s"),
-    "--ue-min": (0.0, 500.0, True, "m/s"),
-    "--ue-max": (0.0, 500.0, True, "m/s"),
+    "--ue-min": (1e-6, 500.0, False, "m/s"),
+    "--ue-max": (1e-6, 500.0, False, "m/s"),
     "--srr": (0.0, 2.0, False, ""),
 }
 
@@ -69,7 +69,7 @@ def _check(flag, value):
 
 
 def _add_common(p):
-    p.add_argument("--load-N", type=float, required=True, help="normal load F_n (N, in (0, 1e7])")
+    p.add_argument("--load-N", type=float, required=True, help="normal load F_n (N, in [1e-3, 1e7])")
     p.add_argument("--rx-mm", type=float, required=True,
                    help="relative radius of curvature in the rolling direction (mm, in (0, 1e6])")
     p.add_argument("--ry-mm", type=float, required=True,
@@ -105,7 +105,7 @@ def register(sub):
                        epilog=FRICTION_KEYS_DOC, formatter_class=argparse.RawDescriptionHelpFormatter)
     _add_common(p)
     p.add_argument("--ue", type=float, required=True,
-                   help="entrainment speed (u1+u2)/2 (m/s, in (0, 500])")
+                   help="entrainment speed (u1+u2)/2 (m/s, in [1e-6, 500])")
     p.add_argument("--us", type=float, required=True,
                    help="sliding speed |u1-u2| (m/s, in [0, 500])")
     p.set_defaults(func=run_friction)
@@ -117,9 +117,9 @@ def register(sub):
     _add_common(s)
     s.add_argument("--srr", type=float, default=0.2, help="slide-to-roll ratio u_s/u_e (in [0, 2])")
     s.add_argument("--ue-min", type=float, default=0.01,
-                   help="lowest entrainment speed (m/s, in (0, 500])")
+                   help="lowest entrainment speed (m/s, in [1e-6, 500])")
     s.add_argument("--ue-max", type=float, default=30.0,
-                   help="highest entrainment speed (m/s, in (0, 500], > --ue-min)")
+                   help="highest entrainment speed (m/s, in [1e-6, 500], > --ue-min)")
     s.add_argument("--points", type=float, default=40, help="number of speeds (integer 2..2000)")
     s.add_argument("--plot", default=None,
                    help="write the Stribeck curve to this file (.png, .pdf or .svg)")

@@ -7,6 +7,8 @@ import math
 
 import numpy as np
 
+#: lowest accepted pinion speed (rpm): far below it the path solve loses its scale
+MIN_RPM = 1e-3
 #: highest accepted pinion speed (rpm)
 MAX_RPM = 1e5
 
@@ -55,7 +57,7 @@ def register(sub):
     p.add_argument("--x2", type=float, default=0.0, help="wheel profile shift coefficient (as --x1)")
     p.add_argument("--points", type=float, default=21,
                    help="points on the path (integer 2..100000)")
-    p.add_argument("--rpm", type=float, default=1000.0, help="pinion speed (rpm, in (0, 1e5])")
+    p.add_argument("--rpm", type=float, default=1000.0, help="pinion speed (rpm, in [1e-3, 1e5])")
     p.add_argument("--side", choices=["drive", "coast"], default="drive",
                    help="pinion flank (drive: the flank leading in counter-clockwise rotation)")
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
@@ -72,7 +74,7 @@ def run(args) -> int:
     pair = InvolutePair.create(args.z1, args.z2, args.module, args.pressure_angle, args.helix,
                                args.x1, args.x2)
     points = check_int("points", args.points, lo=2, hi=100000)
-    rpm = check_range("rpm", args.rpm, 0.0, MAX_RPM, lo_open=True, unit="rpm")
+    rpm = check_range("rpm", args.rpm, MIN_RPM, MAX_RPM, unit="rpm")
     omega1 = rpm * 2 * math.pi / 60.0
     res = path_kinematics(pair, points, side=-1 if args.side == "drive" else 1, omega1=omega1)
     table = path_table(res)

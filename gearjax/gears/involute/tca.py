@@ -47,7 +47,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from gearjax.edge_contact import face_end_contact
-from gearjax.errors import check_range
+from gearjax.errors import check_range, is_traced
 from gearjax.fields import float64_array
 from gearjax.gears.involute.geometry import (InvolutePair, generated_flank, pair_geometry,
                                              rack_family, rack_family_data, rack_psi0)
@@ -86,6 +86,10 @@ class InvoluteTCA:
         """Validated constructor (degrees for ``dalpha_deg``); traced values (inside
         ``jax.grad``) pass through unchecked."""
         b = check_range("face_width", face_width, 0.0, 1000.0, lo_open=True, unit="mm")
+        m = pair.module
+        if not (is_traced(b) or is_traced(m)) and b < 0.1 * float(m):
+            raise ValueError(f"face_width = {b:g} mm is below 0.1 module ({0.1 * float(m):g} mm): "
+                             f"allowed [{0.1 * float(m):g}, 1000] mm")
         da = check_range("dalpha", dalpha_deg, -5.0, 5.0, unit="deg")
         a = check_range("profile_crown", profile_crown, 0.0, 0.1, unit="1/mm")
         c = check_range("lead_crown", lead_crown, 0.0, 0.1, unit="1/mm")
