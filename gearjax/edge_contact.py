@@ -260,9 +260,9 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
     use = surf_ok & jnp.isfinite(lead) & (lead > key_s + EDGE_LEAD)
     if line_contact:
         # a face-end point on the line contact of the section solved (same TE): part
-        # of the line contact, not an edge contact, wherever that section lies
+        # of the line contact, not an edge contact, also where that section lies off
+        # the flanks (on the flanks, (a)'s lead tolerance already keeps it)
         same = path.converged & (jnp.abs(lead - sgn * path.te) <= EDGE_LEAD)
-        use = use & ~same
     else:
         same = jnp.zeros_like(use)
     # (b) where the surface contact is off the flanks, an edge contact counts where it
