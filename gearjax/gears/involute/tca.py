@@ -144,6 +144,21 @@ def involute_margin(des: InvoluteTCA, path: ContactPath):
     return jnp.min(parts, axis=0), parts
 
 
+def default_line_contact(des: InvoluteTCA) -> bool:
+    """Whether the flanks touch along lines (the default contact mode; concrete).
+
+    Without lead crown the pinion is a screw surface of the gear's lead; its transverse
+    sections are one section turned by the screw motion, so the section at axial
+    position z touches at ``TE(phi1 + z tan(beta)/r)``.  That is the same for every z
+    -- a line contact -- for a spur pair, or a helical pair whose section TE is constant
+    (no profile crown).  A profile-crowned helical pinion has a parabolic section TE,
+    so the pair touches at one point (where the parabola peaks, or at a face end): point
+    contact.  A lead crown always gives point contact."""
+    if float(des.lead_crown) != 0.0:
+        return False
+    return float(des.profile_crown) == 0.0 or float(des.pair.helix) == 0.0
+
+
 def involute_face_ends(des: InvoluteTCA):
     """``(margin_parts, g1, g2)`` of :func:`gearjax.edge_contact.face_end_contact`: the
     boundary margins (face width, and tip/form circle) of each member at body points,
@@ -258,8 +273,8 @@ def involute_tca(des: InvoluteTCA, mis: Misalignment | None = None, *, side: int
                  approach: float = DEFAULT_APPROACH, strict: bool = True):
     """Jitted involute TCA with validation.  Returns ``(path, margin, multi)``.
 
-    ``line_contact`` defaults to True unless the pinion has a lead crown (point
-    contact).  ``strict`` raises :class:`~gearjax.errors.ConvergenceError` when a
+    ``line_contact`` defaults to :func:`default_line_contact` (True unless the pinion
+    has a lead crown, or a profile crown on a helical pair: point contact).  ``strict`` raises :class:`~gearjax.errors.ConvergenceError` when a
     contact solve failed at a grid point between the first and last on-flank points
     of the pair (or at the reference); ``strict=False`` returns the masks.
     """
@@ -268,7 +283,7 @@ def involute_tca(des: InvoluteTCA, mis: Misalignment | None = None, *, side: int
     if mis is None:
         mis = Misalignment.zero()
     if line_contact is None:
-        line_contact = float(des.lead_crown) == 0.0
+        line_contact = default_line_contact(des)
     out = _involute_tca_jit(strong_float64(des), strong_float64(mis), float(side),
                             int(steps_per_pitch),
                             float(half_pitches), bool(line_contact), int(n_pairs), float(approach))
@@ -324,7 +339,7 @@ def misalignment_sensitivity(des: InvoluteTCA, mis: Misalignment | None = None, 
     if mis is None:
         mis = Misalignment.zero()
     if line_contact is None:
-        line_contact = float(des.lead_crown) == 0.0
+        line_contact = default_line_contact(des)
     vals, (jac_des, jac) = _sensitivity_jit(strong_float64(des), strong_float64(mis), float(side),
                                             int(steps_per_pitch), float(half_pitches),
                                             bool(line_contact))
@@ -406,7 +421,7 @@ class _Adapter:
 
     @staticmethod
     def _options(des, line_contact):
-        return float(des.lead_crown) == 0.0 if line_contact is None else bool(line_contact)
+        return default_line_contact(des) if line_contact is None else bool(line_contact)
 
     def run(self, des, mis=None, *, side="drive", steps_per_pitch=24, half_pitches=1.25,
             n_pairs=3, line_contact=None, approach=DEFAULT_APPROACH, kinematics=True,
