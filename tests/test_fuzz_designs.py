@@ -45,7 +45,7 @@ gradient is finite.
 Hypothesis: ``derandomize=True`` (the same cases on every run), ``max_examples`` 8
 per hypoid example, 15 per involute tooth pair; the
 environment variable ``GEARJAX_FUZZ_EXAMPLES`` multiplies the first two (10 for the
-figures of docs/reliability_fuzz.md).  ``GEARJAX_FUZZ_REPORT=path`` writes the
+figures of docs/reliability.md (property fuzzing)).  ``GEARJAX_FUZZ_REPORT=path`` writes the
 outcome counts (valid / flagged / refused) there as JSON.  Cost: five TCA programs
 and two gradient programs compiled, about 90 s on two idle cores; a case after the
 compile is ~0.1 s.

@@ -22,7 +22,7 @@ NaN, +-inf, a value outside its documented range or an object that is not a numb
 Hypothesis settings: ``derandomize=True`` (the cases are a fixed function of the test
 code: the same on every run), ``max_examples`` = 300 (CLI) and 300 (constructors) by
 default; the environment variable ``GEARJAX_FUZZ_EXAMPLES`` multiplies both (e.g. 10
-for the figures of docs/reliability_fuzz.md).  Each case is a refusal without
+for the figures of docs/reliability.md (property fuzzing)).  Each case is a refusal without
 computation: the two properties take about 5 s together.
 
 Gaps the fuzzing found (the library accepted or mis-reported these inputs; fixed
