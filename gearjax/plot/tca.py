@@ -95,8 +95,9 @@ def _pattern_panel(ax, label, path, margin, lim):
     o = flank_outline(lim)
     ax1 = np.where(on, np.asarray(path.axial1, float), np.nan)   # gaps where off the flank
     rd1 = np.where(on, np.asarray(path.radial1, float), np.nan)
-    edge = (np.zeros(np.shape(on), bool) if path.edge_kind is None
-            else on & (np.asarray(path.edge_kind) >= 0))
+    kinds = getattr(path, "edge_kind", None)     # paths built by hand may lack it
+    edge = (np.zeros(np.shape(on), bool) if kinds is None
+            else on & (np.asarray(kinds) >= 0))
     drawn = []
     for i in np.nonzero(on & ~edge)[0][::3]:     # no ellipse at an edge contact
         e = ellipse_outline_axial(path, i)
