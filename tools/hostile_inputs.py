@@ -118,48 +118,11 @@ class Case:
 # setups (run in the harness process before the case's subprocess)
 
 
-def _toml_value(v) -> str:
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, int):
-        return str(v)
-    if isinstance(v, float):
-        if math.isnan(v):
-            return "nan"
-        if math.isinf(v):
-            return "inf" if v > 0 else "-inf"
-        return repr(v)
-    if isinstance(v, str):
-        return json.dumps(v)           # a JSON string is a valid TOML basic string
-    if isinstance(v, list):
-        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
-    if isinstance(v, dict):
-        return "{ " + ", ".join(f"{_toml_key(k)} = {_toml_value(x)}" for k, x in v.items()) + " }"
-    raise TypeError(f"cannot write {type(v).__name__} to TOML")
-
-
-def _toml_key(k: str) -> str:
-    return k if re.fullmatch(r"[A-Za-z0-9_-]+", k) else json.dumps(k)
-
-
 def dumps_toml(data: dict) -> str:
-    """Small TOML writer for design files (nested tables as ``[a.b]``)."""
-    out: list[str] = []
-
-    def emit(tbl, prefix):
-        scalars = [(k, v) for k, v in tbl.items() if not isinstance(v, dict)]
-        tables = [(k, v) for k, v in tbl.items() if isinstance(v, dict)]
-        if prefix and (scalars or not tables):
-            out.append("[" + ".".join(_toml_key(p) for p in prefix) + "]")
-        for k, v in scalars:
-            out.append(f"{_toml_key(k)} = {_toml_value(v)}")
-        if prefix and (scalars or not tables):
-            out.append("")
-        for k, v in tables:
-            emit(v, prefix + [k])
-
-    emit(data, [])
-    return "\n".join(out) + "\n"
+    """TOML text of a (corrupted) design: gearjax's own writer (it writes NaN and inf
+    as TOML's ``nan``/``inf``, and a table where a number belongs as a sub-table)."""
+    from gearjax.io import dumps_toml as gearjax_dumps_toml
+    return gearjax_dumps_toml(data)
 
 
 _DELETE = object()
