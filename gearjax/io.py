@@ -167,6 +167,15 @@ def check_output_path(path, flag: str, allowed_suffixes=None) -> Path:
         raise ValueError(f"{flag} = {text!r}: {str(parent)!r} is not a directory")
     if not os.access(parent, os.W_OK | os.X_OK):
         raise ValueError(f"{flag} = {text!r}: directory {str(parent)!r} is not writable")
+    # permission bits do not tell everything (a superuser, a read-only mount, sysfs):
+    # create and remove a probe file where the output's temporary file will go
+    try:
+        fd, probe = tempfile.mkstemp(prefix=".gearjax-probe-", dir=parent)
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as exc:
+        raise ValueError(f"{flag} = {text!r}: directory {str(parent)!r} is not writable "
+                         f"({exc.strerror or exc})") from None
     if p.exists() and not os.access(p, os.W_OK):
         raise ValueError(f"{flag} = {text!r}: the existing file is not writable")
     return p

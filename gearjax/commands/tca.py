@@ -178,6 +178,14 @@ def _side_json(res):
     return out
 
 
+def _cell(v, width, digits):
+    """A table cell: the number, ``inf`` (a line contact's length), or ``-`` where there
+    is no value (no contact of pair 0 there, or no ellipse at an edge contact)."""
+    if np.isnan(v):
+        return f"{'-':>{width}s}"
+    return f"{v:{width}.{digits}f}"
+
+
 #: exit status when the TCA of a requested side failed (the other side, if any, is printed)
 FAILED_SIDE_STATUS = 3
 
@@ -277,9 +285,9 @@ def run(args) -> int:
         for i in range(n):
             flag = ("ok" if on[i] else "edge" if edge[i] else "off" if conv[i]
                     else "no-conv")
-            print(f"{math.degrees(float(path.phi1[i])):10.4f} {te[i]:11.5f} "
+            print(f"{math.degrees(float(path.phi1[i])):10.4f} {_cell(te[i], 11, 5)} "
                   f"{float(path.axial1[i]):9.4f} {float(path.radial1[i]):9.4f} "
-                  f"{2 * sm[i]:8.4f} {2 * float(path.semi_minor[i]):8.4f} {flag}")
+                  f"{_cell(2 * sm[i], 8, 4)} {_cell(2 * float(path.semi_minor[i]), 8, 4)} {flag}")
     for sd, msg in failed.items():
         print(f"# TCA {args.design} ({sd}): FAILED, no result: {msg}")
     return status
