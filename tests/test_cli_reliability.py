@@ -498,3 +498,20 @@ def test_vanishing_operating_values_are_refused(capsys, argv, name):
     assert main(argv) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and name in err[0]
+
+
+def test_output_directory_that_refuses_a_file_is_caught_before_work(capsys, monkeypatch,
+                                                                      tmp_path):
+    """Permission bits can say 'writable' (a superuser, a read-only mount): the check
+    creates a probe file; when that fails the command stops before any work."""
+    import tempfile as tf
+
+    def refuse(*a, **k):
+        raise PermissionError(13, "Permission denied")
+    monkeypatch.setattr(tf, "mkstemp", refuse)
+    argv = ["stribeck", "--load-N", "1000", "--rx-mm", "10", "--ry-mm", "300", "--oil",
+            "mineral_vg100", "--sigma-um", "0.4", "--plot", str(tmp_path / "s.png")]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--plot" in err[0] and "not writable" in err[0]
+    assert not (tmp_path / "s.png").exists()
