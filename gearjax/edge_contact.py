@@ -150,10 +150,10 @@ def edge_contact_system(r1: Callable, r2: Callable, asm, mis, g1: Callable, g2: 
 def _continue(F, z0, thetas, fresh, n_homotopy, tol, max_steps):
     """Solve ``F(z, theta_i) = 0`` along the scanned ``thetas`` (lax.scan), each solve
     from the linear predictor of the two previous solutions (uniform steps of the
-    homotopy level, then of the angle); a constant predictor where ``fresh`` (the
-    first angle step after the homotopy, the first ``n_homotopy`` steps).  A failed step keeps the previous
-    solution.  Where the homotopy has not reached its end (its last solve failed) the
-    angle steps are marked not converged."""
+    homotopy level, then of the angle) -- a constant predictor where ``fresh`` (the
+    first angle step after the ``n_homotopy`` homotopy steps).  A failed step keeps the
+    previous solution.  Where the homotopy has not reached its end (its last solve
+    failed) the angle steps are marked not converged."""
 
     def step(carry, inp):
         x_prev, x_prev2, ok_h = carry
@@ -174,7 +174,8 @@ def _continue(F, z0, thetas, fresh, n_homotopy, tol, max_steps):
 
 def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, margin,
                      margin_parts: Callable, g1: Callable, g2: Callable, *, drive,
-                     steps_per_pitch: int, line_contact: bool = False, tol: float = 1e-11, max_steps: int = 30, n_homotopy: int = 8):
+                     steps_per_pitch: int, line_contact: bool = False, tol: float = 1e-11,
+                     max_steps: int = 30, n_homotopy: int = 8):
     """Face-end contacts beside ``path`` and the contact actually made (traceable).
 
     ``path``, ``margin`` : the surface contact path and its boundary margin (mm).
@@ -203,7 +204,7 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
     s_levels = jnp.linspace(1.0, 0.0, n_homotopy + 1)[1:]
     # each direction away from the reference: the homotopy s = 1 -> 0 at the reference
     # angle, then the continuation along the grid -- one scan, one Newton in the program
-    k = s_levels.shape[0]
+    k = n_homotopy
     phis = jnp.stack([jnp.concatenate([jnp.full((k,), ph_mid), path.phi1[mid + 1:]]),
                       jnp.concatenate([jnp.full((k,), ph_mid), path.phi1[:mid][::-1]])])
     levels = jnp.concatenate([s_levels, jnp.zeros(mid)])

@@ -248,23 +248,27 @@ def flank_coordinates(fl: FlankSpec, crossing, p_body):
     return xi, root_cone_gap(b, r), face_cone_gap(b, r)   # face_cone_gap > 0 below the tip
 
 
+def _member_margins(fl: FlankSpec, crossing, p_body):
+    """Boundary margins (mm, >= 0 inside) of one member at a body point: of its face
+    width ``F (1 - |xi|)/2`` and of its other boundaries (below the face cone, above the
+    fillet); also ``xi`` and the height above the root cone."""
+    xi, above_root, tip_gap = flank_coordinates(fl, crossing, p_body)
+    c = fl.cutter
+    h_fillet = c.edge_radius * (1.0 - jnp.sin(c.blade_angle))
+    return (0.5 * fl.blank.face_width * (1.0 - jnp.abs(xi)),
+            jnp.minimum(tip_gap, above_root - h_fillet), xi, above_root)
+
+
 def hypoid_face_ends(pair: HypoidPair):
     """``(margin_parts, g1, g2)`` of :func:`gearjax.edge_contact.face_end_contact`: each
-    member's boundary margins (mm) -- face width ``F (1 - |xi|)/2`` and the others
-    (below the face cone, above the fillet) -- at body points, and the face-end
-    functions ``g(q, e) = (F/2) (xi(q) - e)`` (toe ``e = -1``, heel ``e = +1``)."""
+    member's boundary margins (mm) -- face width and the others (:func:`_member_margins`)
+    -- at body points, and the face-end functions ``g(q, e) = (F/2) (xi(q) - e)`` (toe
+    ``e = -1``, heel ``e = +1``)."""
     members = ((pair.pinion, pair.pinion_crossing), (pair.gear, pair.gear_crossing))
 
-    def parts_of(fl, t, q):
-        xi, above_root, tip_gap = flank_coordinates(fl, t, q)
-        c = fl.cutter
-        h_fillet = c.edge_radius * (1.0 - jnp.sin(c.blade_angle))
-        return (0.5 * fl.blank.face_width * (1.0 - jnp.abs(xi)),
-                jnp.minimum(tip_gap, above_root - h_fillet))
-
     def margin_parts(q1, q2):
-        f1, r1 = jax.vmap(lambda q: parts_of(*members[0], q))(q1)
-        f2, r2 = jax.vmap(lambda q: parts_of(*members[1], q))(q2)
+        f1, r1 = jax.vmap(lambda q: _member_margins(*members[0], q)[:2])(q1)
+        f2, r2 = jax.vmap(lambda q: _member_margins(*members[1], q)[:2])(q2)
         return f1, r1, f2, r2
 
     def end(fl, t):
@@ -282,12 +286,8 @@ def hypoid_margin(pair: HypoidPair, path: ContactPath):
     margins = []
     for k, fl, t, pb in ((1, pair.pinion, pair.pinion_crossing, path.p1_body),
                          (2, pair.gear, pair.gear_crossing, path.p2_body)):
-        xi, above_root, tip_gap = jax.vmap(lambda p: flank_coordinates(fl, t, p))(pb)
-        c = fl.cutter
-        h_fillet = c.edge_radius * (1.0 - jnp.sin(c.blade_angle))
-        m = jnp.minimum(jnp.minimum(0.5 * fl.blank.face_width * (1.0 - jnp.abs(xi)), tip_gap),
-                        above_root - h_fillet)
-        margins.append(m)
+        face, rest, xi, above_root = jax.vmap(lambda p: _member_margins(fl, t, p))(pb)
+        margins.append(jnp.minimum(face, rest))
         out[f"xi{k}"] = xi
         out[f"h{k}"] = above_root
     return jnp.minimum(margins[0], margins[1]), out

@@ -132,15 +132,21 @@ def _form_radius(m_n, alpha_n, beta, x, z):
     return jnp.sqrt(rb ** 2 + rho_f ** 2)
 
 
-def involute_margin(des: InvoluteTCA, path: ContactPath):
-    """Boundary margin (mm, >= 0 inside both flanks) along the path, and its parts."""
+def _flank_limits(des: InvoluteTCA):
+    """``(ra1, rf1, ra2, rf2, b/2)``: tip and form radii of pinion and gear and the half
+    face width (mm), the boundaries of both working flanks."""
     p = des.pair
     geo = pair_geometry(p)
     rf1 = _form_radius(p.module, p.pressure_angle + des.dalpha, p.helix, p.x1, p.z1)
     rf2 = _form_radius(p.module, p.pressure_angle, p.helix, p.x2, p.z2)
-    hb = 0.5 * des.face_width
-    parts = jnp.stack([geo["ra1"] - path.radial1, path.radial1 - rf1, hb - jnp.abs(path.axial1),
-                       geo["ra2"] - path.radial2, path.radial2 - rf2, hb - jnp.abs(path.axial2)])
+    return geo["ra1"], rf1, geo["ra2"], rf2, 0.5 * des.face_width
+
+
+def involute_margin(des: InvoluteTCA, path: ContactPath):
+    """Boundary margin (mm, >= 0 inside both flanks) along the path, and its parts."""
+    ra1, rf1, ra2, rf2, hb = _flank_limits(des)
+    parts = jnp.stack([ra1 - path.radial1, path.radial1 - rf1, hb - jnp.abs(path.axial1),
+                       ra2 - path.radial2, path.radial2 - rf2, hb - jnp.abs(path.axial2)])
     return jnp.min(parts, axis=0), parts
 
 
@@ -163,17 +169,13 @@ def involute_face_ends(des: InvoluteTCA):
     """``(margin_parts, g1, g2)`` of :func:`gearjax.edge_contact.face_end_contact`: the
     boundary margins (face width, and tip/form circle) of each member at body points,
     and the face-end functions ``g(q, e) = q_z - e b/2`` of pinion and gear (mm)."""
-    p = des.pair
-    geo = pair_geometry(p)
-    rf1 = _form_radius(p.module, p.pressure_angle + des.dalpha, p.helix, p.x1, p.z1)
-    rf2 = _form_radius(p.module, p.pressure_angle, p.helix, p.x2, p.z2)
-    hb = 0.5 * des.face_width
+    ra1, rf1, ra2, rf2, hb = _flank_limits(des)
 
     def margin_parts(q1, q2):
         r1 = jnp.linalg.norm(q1[..., :2], axis=-1)
         r2 = jnp.linalg.norm(q2[..., :2], axis=-1)
-        return (hb - jnp.abs(q1[..., 2]), jnp.minimum(geo["ra1"] - r1, r1 - rf1),
-                hb - jnp.abs(q2[..., 2]), jnp.minimum(geo["ra2"] - r2, r2 - rf2))
+        return (hb - jnp.abs(q1[..., 2]), jnp.minimum(ra1 - r1, r1 - rf1),
+                hb - jnp.abs(q2[..., 2]), jnp.minimum(ra2 - r2, r2 - rf2))
 
     def g(q, e):
         return q[2] - e * hb
