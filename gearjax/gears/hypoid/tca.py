@@ -490,6 +490,13 @@ class _Adapter:
         f.pair = prep.pair
         return f
 
+    def mesh(self, design, *, side=None, **_):
+        """``teeth(pair, res) -> MeshTeeth`` of the loaded-contact models (concrete set-up)."""
+        from gearjax.gears.hypoid.mesh import hypoid_mesh_teeth
+        prep, _ = self._prepared(design, side)
+        drive = bool(prep.drive)
+        return lambda pair, res: hypoid_mesh_teeth(pair, res, drive)
+
     def sensitivity(self, design, mis=None, *, side=None, steps_per_pitch=16, half_pitches=2.0,
                     n_pairs=5, approach=DEFAULT_APPROACH, **_):
         prep, _ = self._prepared(design, side)

@@ -455,6 +455,14 @@ class _Adapter:
                            n_pairs=int(n_pairs), kinematics=bool(kinematics))
         return f
 
+    def mesh(self, des, *, side="drive", line_contact=None, **_):
+        """``teeth(d, res) -> MeshTeeth`` of the loaded-contact models (concrete set-up)."""
+        from gearjax.gears.involute.mesh import check_mesh_supported, involute_mesh_teeth
+        lc = self._options(des, line_contact)
+        check_mesh_supported(des, lc)
+        drive = check_side(side) == "drive"
+        return lambda d, res: involute_mesh_teeth(d, res, lc, drive)
+
     def sensitivity(self, des, mis=None, *, side="drive", steps_per_pitch=24,
                     half_pitches=1.25, line_contact=None, **_):
         values, table, _ = misalignment_sensitivity(

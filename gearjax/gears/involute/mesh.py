@@ -1,0 +1,62 @@
+"""The involute pair as the loaded-contact models see it (:class:`~gearjax.loaded_contact.MeshTeeth`).
+
+Each member is the spur gear of its normal section, ``z_n = z / (cos^2(beta_b)
+cos(beta))`` with the normal module and pressure angle ([ISO6336-1] virtual gear);
+the contact radius ``r`` (transverse) maps onto it at the same height above the
+reference circle, ``r_v = z_n m_n / 2 + (r - z m_n / (2 cos beta))``.  Rack-generated
+teeth: addendum ``(1 + x) m_n`` of the pinion/gear tip circles, dedendum 1.25 m_n.
+
+Load-carrying width: a line contact (spur pair) carries its load along the whole
+face width ``b``; a point contact (crowned pinion) over the major axis of its
+contact ellipse at the elastic approach of the TCA (0.00632 mm, the bearing
+length of Gleason practice), at most ``b``.  A helical pair in *line* contact is
+not supported (its contact lines leave the transverse section of the TCA: give
+the pinion a lead crown, which every helical pinion carries in practice).
+
+Units: mm, rad.  References (docs/references.md): [ISO6336-1].
+"""
+
+from __future__ import annotations
+
+import jax.numpy as jnp
+
+from gearjax.gears.involute.geometry import pair_geometry
+from gearjax.gears.involute.tca import InvoluteTCA
+from gearjax.loaded_contact import MeshTeeth
+from gearjax.tca_result import TCAResult
+
+__all__ = ["involute_mesh_teeth", "check_mesh_supported"]
+
+
+def check_mesh_supported(des: InvoluteTCA, line_contact: bool) -> None:
+    """Refuse a helical pair in line contact (concrete; module docstring)."""
+    if line_contact and float(des.pair.helix) != 0.0:
+        raise ValueError(f"helix = {float(des.pair.helix) * 180 / jnp.pi:g} deg in line contact: "
+                         "the loaded contact of a helical pair needs point contact "
+                         "(give the pinion a lead crown, e.g. lead_crown=1e-4 1/mm)")
+
+
+def involute_mesh_teeth(des: InvoluteTCA, res: TCAResult, line_contact: bool,
+                        drive: bool) -> MeshTeeth:
+    """:class:`~gearjax.loaded_contact.MeshTeeth` of the involute pair along the path of
+    ``res`` (traceable; module docstring)."""
+    p = des.pair
+    geo = pair_geometry(p)
+    beta = p.helix
+    cb = jnp.cos(geo["beta_b"]) ** 2 * jnp.cos(beta)
+    z = jnp.stack([p.z1 / cb, p.z2 / cb]).astype(float)
+    mn = p.module
+    r_ref = jnp.stack([0.5 * p.z1 * mn / jnp.cos(beta), 0.5 * p.z2 * mn / jnp.cos(beta)])
+    r_load = 0.5 * z[:, None] * mn + (jnp.stack([res.path.radial1, res.path.radial2]) - r_ref[:, None])
+    b = des.face_width
+    if line_contact:
+        width = jnp.full(res.path.phi1.shape, 1.0) * b
+        line = width
+    else:
+        width = jnp.minimum(2.0 * jnp.nan_to_num(res.path.semi_major, nan=0.0, posinf=1e9), b)
+        width = jnp.where(width > 0.0, width, b)
+        line = None
+    one = jnp.ones(2)
+    return MeshTeeth(z, mn, jnp.stack([p.pressure_angle + des.dalpha, p.pressure_angle]),
+                     beta, jnp.stack([p.x1, p.x2]), one, 1.25 * one, r_load, width, line,
+                     jnp.asarray(drive))

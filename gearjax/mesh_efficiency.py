@@ -1,0 +1,294 @@
+"""Mesh efficiency of a gear pair: loaded contact, friction along the path, losses.
+
+The chain, every step a JAX function of the design::
+
+    TCAResult (unloaded TE of each tooth pair, contact points, kinematics)
+      -> load sharing at each mesh position        gearjax.loaded_contact
+      -> at each loaded contact: entrainment and sliding vectors, R_x/R_y along and
+         across the entrainment, the load -> mixed-lubrication friction
+                                                   gearjax.tribology (mu, film, lambda)
+      -> P_f(phi) = sum_k mu_k F_k |u_s,k|,  eta_m(phi) = 1 - P_f/P_in, mean over a pitch
+
+**Positions.**  One mesh cycle = one angular pitch of the pinion: the
+``steps_per_pitch`` grid positions centred on the reference.  Tooth pair ``k`` at a
+position is pair 0 shifted by ``k`` pitches (:func:`gearjax.loaded_contact.pair_arrays`),
+exactly as the unloaded TE envelope of :func:`gearjax.tca.multi_pair`.
+
+**Velocities.**  ``ContactKinematics`` gives per rad/s of pinion speed the surface
+velocities relative to the contact point along the rolling direction ``t`` (across
+the ellipse) and the side components along the major axis.  The *entrainment
+vector* ``u_e = (w1 + w2)/2`` has the components ``(u_e, u_e tan(theta_e))`` in the
+``(t, e_major)`` frame (``theta_e`` the entrainment angle), the *sliding vector*
+``(u_s, u_s_side)``.  The friction model gets the magnitudes ``|u_e|`` and
+``|u_s|`` (the friction force opposes the sliding vector; its power is
+``mu F |u_s|``) and the radii along and across the entrainment,
+``1/R_x = cos^2(theta_e)/r_x + sin^2(theta_e)/r_y``, ``1/R_y = sin^2/r_x + cos^2/r_y``
+(the normal curvature of the relative curvature tensor in those directions; for
+entrainment along a principal direction these are the principal radii).  A line
+contact (``r_y = inf``) of length ``L`` is given to the elliptic friction model as the
+equivalent ellipse whose major semi-axis is ``L/2``:
+``R_y = R_x (k/1.0339)^(1/0.636)`` with ``k^2 = pi E' (L/2)^3 / (6 F R_x)``
+(Hamrock-Brewe ellipticity inverted, [HamrockBrewe1983]).
+
+**Losses.**  ``P_f = sum_k mu_k F_k |u_s,k|`` (W), ``P_in = T1 omega1``,
+``eta_m(phi) = 1 - P_f/P_in``, ``eta_bar = 1 - mean(P_f)/P_in`` over the cycle
+(positions equally spaced in time) [VH-CATT].
+
+Units: torque N m at the boundary (N mm inside), speed rpm at the boundary (rad/s
+inside), loads N, speeds mm/s, radii mm, power W.
+References (docs/references.md): [VH-CATT]; [Litvin2004]; [HamrockBrewe1983];
+[ISO6336-1]; [Ohlendorf1958].
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from gearjax.errors import check_range
+from gearjax.loaded_contact import (COMPLIANCE_MODELS, LoadedContact, MeshTeeth, contact_stress,
+                                    hertz_coefficient,
+                                    lever_arms, pair_arrays, pair_compliance, share_torque)
+from gearjax.tca_result import TCAResult, family_of
+from gearjax.tribology.friction import STEEL_E_PRIME, FrictionResult, Surface
+from gearjax.tribology.losses import mesh_losses_traced
+from gearjax.tribology.lubricant import Oil
+
+__all__ = ["MeshEfficiency", "mesh_efficiency", "efficiency_function", "mesh_efficiency_traced",
+           "efficiency_warnings", "cycle_window", "check_operating_point",
+           "TORQUE_RANGE_NM", "RPM_RANGE"]
+
+#: accepted pinion torque (N m) and speed (rpm)
+TORQUE_RANGE_NM = (1e-3, 1e6)
+RPM_RANGE = (1e-3, 1e6)
+
+
+class MeshEfficiency(NamedTuple):
+    """Efficiency of a pair over one mesh cycle (module docstring).
+
+    Shapes: (K, M) per tooth pair and position, (M,) per position.
+
+    phi1 : (M,) pinion angles of the positions (rad).
+    loaded : :class:`~gearjax.loaded_contact.LoadedContact` (loads, shares, p_max,
+        ellipses, loaded TE, balance).
+    u_e, u_s : magnitudes of the entrainment and sliding vectors (mm/s).
+    r_x, r_y : radii along and across the entrainment as given to the friction model (mm).
+    friction : :class:`~gearjax.tribology.friction.FrictionResult` (mu, lambda, film, ...).
+    power_loss : (M,) P_f (W).  efficiency : (M,) eta_m.  mean_efficiency : eta_bar.
+    mean_mu : load- and sliding-weighted mean mu, ``sum mu F |u_s| / sum F |u_s|``.
+    max_p_max : highest Hertz pressure over the cycle (MPa).
+    power_in : P_in (W).
+    valid : (M,) every loaded contact converged (load balance, Hertz, load sharing).
+    truncated : the grid or the number of pairs does not cover every pair in contact.
+    edge_loaded : (M,) an edge contact would be compressed under the load (its load
+        is not modelled: the result is then not valid).
+    """
+
+    phi1: jax.Array
+    loaded: LoadedContact
+    u_e: jax.Array
+    u_s: jax.Array
+    r_x: jax.Array
+    r_y: jax.Array
+    friction: FrictionResult
+    power_loss: jax.Array
+    efficiency: jax.Array
+    mean_efficiency: jax.Array
+    mean_mu: jax.Array
+    max_p_max: jax.Array
+    power_in: jax.Array
+    valid: jax.Array
+    truncated: jax.Array
+    edge_loaded: jax.Array
+
+
+def cycle_window(n_grid: int, steps_per_pitch: int) -> np.ndarray:
+    """Grid indices of one mesh cycle (one pitch) centred on the reference."""
+    mid = n_grid // 2
+    return np.arange(steps_per_pitch) + (mid - steps_per_pitch // 2)
+
+
+def check_operating_point(torque_Nm, rpm) -> tuple[float, float]:
+    """Validate the operating point (concrete): torque (N m) and speed (rpm) in range."""
+    T = check_range("torque", torque_Nm, *TORQUE_RANGE_NM, unit="N m")
+    n = check_range("speed", rpm, *RPM_RANGE, unit="rpm")
+    return T, n
+
+
+def _equivalent_ry(F, r_x, L, E_prime):
+    """R_y of the ellipse whose major semi-axis is L/2 under F (line contact)."""
+    k2 = jnp.pi * E_prime * (0.5 * L) ** 3 / (6.0 * F * r_x)
+    k = jnp.sqrt(jnp.maximum(k2, 1.0))
+    return r_x * (k / 1.0339) ** (1.0 / 0.636)
+
+
+def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, speed_rad_s, oil: Oil,
+                           surface: Surface, *, steps_per_pitch: int, n_pairs: int,
+                           E_prime=STEEL_E_PRIME, compliance: str = "iso6336",
+                           viscosity_model: str = "roelands",
+                           film_method: str = "auto") -> MeshEfficiency:
+    """Loaded contact, friction and efficiency of the pair over one mesh cycle
+    (traceable; no validation; module docstring).
+
+    ``res`` : the TCA result with kinematics; ``teeth`` : the family's
+    :class:`~gearjax.loaded_contact.MeshTeeth` for ``res``; ``steps_per_pitch`` and
+    ``n_pairs`` : those of the TCA.  Torque on the pinion (N m), pinion speed (rad/s).
+    """
+    path, kin = res.path, res.kinematics
+    n = path.phi1.shape[0]
+    win = cycle_window(n, steps_per_pitch)
+    K = n_pairs
+    on = res.on_flank & jnp.isfinite(kin.r_x) & jnp.isfinite(kin.u_e)
+    line = teeth.line_length is not None
+    # compliance and lever arms of pair 0 along the grid
+    r_x0 = jnp.where(on, kin.r_x, 1.0)
+    r_y0 = jnp.where(on, kin.r_y, jnp.inf) if line else jnp.where(on, kin.r_y, 1.0)
+    q0, c0 = pair_compliance(teeth, r_x0, r_y0, E_prime, compliance)
+    if not line and compliance != "iso6336":
+        c0 = c0 + hertz_coefficient(r_x0, r_y0, E_prime)
+    l1_0, l2_0 = lever_arms(path.point, path.normal, jnp.where(on, kin.gear_ratio, 1.0))
+
+    def pairs(a, fill):
+        return pair_arrays(a, steps_per_pitch, K, fill, win)
+
+    act = pairs(on, False)
+    te = pairs(jnp.where(on, path.te, 0.0), 0.0)
+    l1, l2, q, c = (pairs(jnp.where(on, a, 1.0), 1.0) for a in (l1_0, l2_0, q0, c0))
+    T1 = 1e3 * jnp.asarray(torque_Nm, float)
+    env, y, F, w, bal, conv = share_torque(te, act, l1, l2, q, c, T1, teeth.drive)
+    sgn = jnp.where(teeth.drive, 1.0, -1.0)
+
+    # kinematics of every pair at every position (speeds per rad/s -> mm/s)
+    omega = jnp.asarray(speed_rad_s, float)
+    th_e = pairs(jnp.where(on, kin.entrainment_angle, 0.0), 0.0)
+    ue_t = pairs(jnp.where(on, kin.u_e, 1.0), 1.0) * omega
+    us_t = pairs(jnp.where(on, kin.u_s, 0.0), 0.0) * omega
+    us_side = pairs(jnp.where(on, kin.u_s_side, 0.0), 0.0) * omega
+    rx_p = pairs(r_x0, 1.0)
+    ue = jnp.abs(ue_t) * jnp.sqrt(1.0 + jnp.tan(th_e) ** 2)
+    us = jnp.sqrt(us_t ** 2 + us_side ** 2 + 1e-300)
+    cs, sn = jnp.cos(th_e), jnp.sin(th_e)
+    if line:
+        L = pairs(jnp.where(on, teeth.line_length, 1.0), 1.0)
+        Fs = jnp.where(F > 0.0, F, 1.0)
+        R_x = rx_p
+        R_y = _equivalent_ry(Fs, R_x, L, E_prime)
+        p_max, a_ax, b_ax = contact_stress(F, R_x, jnp.inf, E_prime, line_length=L)
+    else:
+        ry_p = pairs(jnp.where(on, r_y0, 1.0), 1.0)
+        kx, ky = 1.0 / rx_p, 1.0 / ry_p
+        R_x = 1.0 / (cs ** 2 * kx + sn ** 2 * ky)
+        R_y = 1.0 / (sn ** 2 * kx + cs ** 2 * ky)
+        p_max, a_ax, b_ax = contact_stress(F, rx_p, ry_p, E_prime)
+
+    power_in = T1 * omega * 1e-3           # N mm * rad/s -> W
+    ml = mesh_losses_traced(F.T, us.T, ue.T, R_x.T, R_y.T, oil, surface, power_in, E_prime,
+                            viscosity_model=viscosity_model, film_method=film_method)
+    fr = FrictionResult(*(jnp.swapaxes(v, 0, 1) for v in ml.friction))
+    loaded_on = F > 0.0
+    w_loss = F * us * loaded_on
+    mean_mu = jnp.sum(fr.mu * w_loss) / jnp.sum(w_loss)
+    share = l1 * F / T1
+    lc = LoadedContact(F, share, w, p_max, a_ax, b_ax, y, env - sgn * y, bal, conv,
+                       jnp.sum(loaded_on, axis=0))
+    # coverage: pair 0 on the flank where no pair of the window sees it
+    ks = np.arange(K) - K // 2
+    seen = np.zeros(n, bool)
+    for k in ks:
+        src = win - k * steps_per_pitch
+        seen[src[(src >= 0) & (src < n)]] = True
+    inside0 = (res.margin >= 0.0) & path.converged
+    truncated = jnp.any(inside0 & ~seen) | inside0[0] | inside0[-1]
+    # edge contacts that the loaded gear would press on
+    edge = res.edge_points
+    e_te = pairs(jnp.where(edge, path.te, 0.0), 0.0)
+    e_act = pairs(edge, False)
+    edge_loaded = jnp.any(e_act & (sgn * (e_te - (env - sgn * y)) > 0.0), axis=0)
+    valid = conv & jnp.all(fr.converged | ~loaded_on, axis=0) & ~edge_loaded & ~truncated
+    return MeshEfficiency(path.phi1[win], lc, ue, us, R_x, R_y, fr, ml.power_loss, ml.efficiency,
+                          ml.mean_efficiency, mean_mu, jnp.max(p_max), power_in, valid, truncated,
+                          edge_loaded)
+
+
+def efficiency_function(design, *, side=None, compliance: str = "iso6336", E_prime=STEEL_E_PRIME,
+                        viscosity_model: str = "roelands", film_method: str = "auto",
+                        **tca_options):
+    """A pure, traceable ``f(pair, torque_Nm, speed_rad_s, oil, surface, mis=None) ->
+    (MeshEfficiency, TCAResult)`` of ``design`` for ``jax.grad``/``jit``/``vmap``.
+
+    The concrete set-up (reference guess, sense of rotation, contact mode) is done
+    once here, as for :func:`gearjax.tca_function`; ``f.pair`` is the design's pair
+    pytree (the natural point to differentiate at).  ``tca_options`` as for
+    :func:`gearjax.run_tca` (``steps_per_pitch``, ``half_pitches``, ``n_pairs``, ...).
+    """
+    ad = family_of(design)
+    opts = {**ad.defaults, **tca_options}
+    opts.pop("kinematics", None)
+    kw = {} if side is None else {"side": side}
+    f_tca = ad.traced(design, **kw, **opts)
+    teeth_of = ad.mesh(design, **kw, **opts)
+    spp, K = int(opts["steps_per_pitch"]), int(opts["n_pairs"])
+
+    def f(pair, torque_Nm, speed_rad_s, oil, surface, mis=None):
+        res = f_tca(pair, mis)
+        eff = mesh_efficiency_traced(res, teeth_of(pair, res), torque_Nm, speed_rad_s, oil,
+                                     surface, steps_per_pitch=spp, n_pairs=K, E_prime=E_prime,
+                                     compliance=compliance, viscosity_model=viscosity_model,
+                                     film_method=film_method)
+        return eff, res
+
+    f.pair = getattr(f_tca, "pair", design)
+    f.options = dict(opts, side=side, compliance=compliance)
+    return f
+
+
+def mesh_efficiency(design, torque_Nm, rpm, oil: Oil, surface: Surface, *, misalignment=None,
+                    side=None, compliance: str = "iso6336", E_prime=STEEL_E_PRIME,
+                    viscosity_model: str = "roelands", film_method: str = "auto",
+                    **tca_options):
+    """Loaded contact, friction along the path and mesh efficiency of ``design`` at
+    pinion torque ``torque_Nm`` (N m) and speed ``rpm`` (validated, jitted; module
+    docstring).  Returns ``(MeshEfficiency, TCAResult)``; check ``eff.valid`` and
+    ``res.flags()`` (:func:`efficiency_warnings` lists what to warn about)."""
+    T, n = check_operating_point(torque_Nm, rpm)
+    if compliance not in COMPLIANCE_MODELS:
+        raise ValueError(f"compliance = {compliance!r} must be one of {COMPLIANCE_MODELS}")
+    f = efficiency_function(design, side=side, compliance=compliance, E_prime=E_prime,
+                            viscosity_model=viscosity_model, film_method=film_method,
+                            **tca_options)
+    key = (id(design), side, compliance, viscosity_model, film_method,
+           tuple(sorted((k, repr(v)) for k, v in f.options.items())))
+    jf = _JITTED.get(key)
+    if jf is None:
+        jf = _JITTED[key] = jax.jit(f)
+    import dataclasses
+    oil = dataclasses.replace(oil, name="")
+    from gearjax.tca import Misalignment
+    mis = Misalignment.zero() if misalignment is None else misalignment
+    return jf(f.pair, jnp.asarray(T), jnp.asarray(n * math.pi / 30.0), oil, surface, mis)
+
+
+_JITTED: dict = {}
+
+
+def efficiency_warnings(eff: MeshEfficiency, res: TCAResult) -> list[str]:
+    """One line per problem of a concrete result: TCA quality flags, load balance or
+    friction solves not converged, grid too short, loaded edge contact."""
+    out = list(res.warnings())
+    valid = np.asarray(eff.valid)
+    if bool(np.asarray(eff.truncated)):
+        out.append("the TCA grid or the number of tooth pairs does not cover every pair in "
+                   "contact: widen --pitches / raise the number of pairs")
+    if np.any(np.asarray(eff.edge_loaded)):
+        out.append(f"edge contact under load at {int(np.sum(np.asarray(eff.edge_loaded)))} "
+                   "positions (its load is not modelled)")
+    if not np.all(np.asarray(eff.loaded.converged)):
+        out.append("load sharing did not converge at some positions")
+    if not np.all(valid):
+        out.append(f"{int(np.sum(~valid))} of {valid.size} positions are not valid "
+                   "(see the 'valid' flags)")
+    return out
