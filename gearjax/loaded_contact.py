@@ -50,7 +50,8 @@ import numpy as np
 from gearjax.contact import hertz_exact, hertz_line_traced
 from gearjax.newton import newton_solve
 
-__all__ = ["LoadedContact", "force_from_approach", "share_torque", "pair_arrays",
+__all__ = ["LoadedContact", "MeshTeeth", "TeethOf", "pair_compliance", "COMPLIANCE_MODELS",
+           "iso6336_single_stiffness", "force_from_approach", "share_torque", "pair_arrays",
            "lever_arms", "BALANCE_TOL"]
 
 #: relative tolerance of the torque balance sum_k l1_k F_k = T1
@@ -217,9 +218,24 @@ def lever_arms(point, normal, gear_ratio):
     return l1, l1 / jnp.abs(gear_ratio)
 
 
+def _elementwise(fn, *args):
+    """``fn`` of scalars mapped over the broadcast arrays ``args`` (vmap)."""
+    args = jnp.broadcast_arrays(*(jnp.asarray(a, float) for a in args))
+    shape = args[0].shape
+    out = jax.vmap(fn)(*(a.ravel() for a in args))
+    return jax.tree.map(lambda v: v.reshape(shape), out)
+
+
+def _hertz_pab(F, r_x, r_y, E_prime):
+    def one(F, rx, ry, E):
+        hz = hertz_exact(F, rx, ry, E)
+        return hz.p_max, hz.a, hz.b
+    return _elementwise(one, F, r_x, r_y, E_prime)
+
+
 def hertz_coefficient(r_x, r_y, E_prime):
     """Approach of a Hertz point contact at 1 N (mm/N^(2/3)); ``delta = c F^(2/3)``."""
-    return hertz_exact(1.0, r_x, r_y, E_prime).approach
+    return _elementwise(lambda rx, ry, E: hertz_exact(1.0, rx, ry, E).approach, r_x, r_y, E_prime)
 
 
 def contact_stress(F, r_x, r_y, E_prime, line_length=None):
@@ -231,14 +247,24 @@ def contact_stress(F, r_x, r_y, E_prime, line_length=None):
     on = F > 0.0
     Fs = jnp.where(on, F, 1.0)
     if line_length is None:
-        hz = hertz_exact(Fs, r_x, r_y, E_prime)
-        p, a, b = hz.p_max, hz.a, hz.b
+        p, a, b = _hertz_pab(Fs, r_x, r_y, E_prime)
     else:
         Ls = jnp.where(on, line_length, 1.0)
         b, p = hertz_line_traced(Fs / Ls, r_x, E_prime)
         a = 0.5 * Ls
     z = jnp.zeros_like(Fs)
     return jnp.where(on, p, z), jnp.where(on, a, z), jnp.where(on, b, z)
+
+
+class TeethOf(NamedTuple):
+    """``teeth(pair, res) -> MeshTeeth`` of a family with its concrete options (hashable
+    by value, so that jitted programs taking it as a static argument are reused)."""
+
+    fn: object
+    options: tuple = ()
+
+    def __call__(self, pair, res):
+        return self.fn(pair, res, **dict(self.options))
 
 
 class MeshTeeth(NamedTuple):

@@ -42,6 +42,8 @@ References (docs/references.md): [VH-CATT]; [Litvin2004]; [HamrockBrewe1983];
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 import math
 from typing import NamedTuple
 
@@ -64,6 +66,8 @@ __all__ = ["MeshEfficiency", "mesh_efficiency", "efficiency_function", "mesh_eff
 
 #: accepted pinion torque (N m) and speed (rpm)
 TORQUE_RANGE_NM = (1e-3, 1e6)
+#: largest accepted r_y / r_x of a point contact (beyond: degenerate, flagged)
+MAX_RADIUS_RATIO = 1e4
 RPM_RANGE = (1e-3, 1e6)
 
 
@@ -86,6 +90,9 @@ class MeshEfficiency(NamedTuple):
     truncated : the grid or the number of pairs does not cover every pair in contact.
     edge_loaded : (M,) an edge contact would be compressed under the load (its load
         is not modelled: the result is then not valid).
+    degenerate : (M,) a loaded point contact whose relative curvature along the
+        ellipse (nearly) vanishes, ``r_y > MAX_RADIUS_RATIO r_x`` (Hertz theory does
+        not apply; ``r_y`` is clamped there and the position is not valid).
     """
 
     phi1: jax.Array
@@ -104,6 +111,7 @@ class MeshEfficiency(NamedTuple):
     valid: jax.Array
     truncated: jax.Array
     edge_loaded: jax.Array
+    degenerate: jax.Array
 
 
 def cycle_window(n_grid: int, steps_per_pitch: int) -> np.ndarray:
@@ -146,7 +154,12 @@ def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, speed_ra
     line = teeth.line_length is not None
     # compliance and lever arms of pair 0 along the grid
     r_x0 = jnp.where(on, kin.r_x, 1.0)
-    r_y0 = jnp.where(on, kin.r_y, jnp.inf) if line else jnp.where(on, kin.r_y, 1.0)
+    # a point contact whose relative curvature (nearly) vanishes along the ellipse is
+    # degenerate (Hertz theory does not apply): clamp the radius ratio, flag it
+    degenerate0 = on & ~(kin.r_y < MAX_RADIUS_RATIO * kin.r_x) if not line else on & False
+    r_y0 = (jnp.where(on, kin.r_y, jnp.inf) if line
+            else jnp.where(on, jnp.minimum(jnp.nan_to_num(kin.r_y, posinf=jnp.inf),
+                                           MAX_RADIUS_RATIO * r_x0), 1.0))
     q0, c0 = pair_compliance(teeth, r_x0, r_y0, E_prime, compliance)
     if not line and compliance != "iso6336":
         c0 = c0 + hertz_coefficient(r_x0, r_y0, E_prime)
@@ -208,10 +221,12 @@ def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, speed_ra
     e_te = pairs(jnp.where(edge, path.te, 0.0), 0.0)
     e_act = pairs(edge, False)
     edge_loaded = jnp.any(e_act & (sgn * (e_te - (env - sgn * y)) > 0.0), axis=0)
-    valid = conv & jnp.all(fr.converged | ~loaded_on, axis=0) & ~edge_loaded & ~truncated
+    degenerate = jnp.any(pairs(degenerate0, False) & loaded_on, axis=0)
+    valid = (conv & jnp.all(fr.converged | ~loaded_on, axis=0) & ~edge_loaded & ~truncated
+             & ~degenerate)
     return MeshEfficiency(path.phi1[win], lc, ue, us, R_x, R_y, fr, ml.power_loss, ml.efficiency,
                           ml.mean_efficiency, mean_mu, jnp.max(p_max), power_in, valid, truncated,
-                          edge_loaded)
+                          edge_loaded, degenerate)
 
 
 def efficiency_function(design, *, side=None, compliance: str = "iso6336", E_prime=STEEL_E_PRIME,
@@ -230,7 +245,7 @@ def efficiency_function(design, *, side=None, compliance: str = "iso6336", E_pri
     opts.pop("kinematics", None)
     kw = {} if side is None else {"side": side}
     f_tca = ad.traced(design, **kw, **opts)
-    teeth_of = ad.mesh(design, **kw, **opts)
+    teeth_of = ad.mesh(design, **kw, **opts)[0]
     spp, K = int(opts["steps_per_pitch"]), int(opts["n_pairs"])
 
     def f(pair, torque_Nm, speed_rad_s, oil, surface, mis=None):
@@ -249,30 +264,44 @@ def efficiency_function(design, *, side=None, compliance: str = "iso6336", E_pri
 def mesh_efficiency(design, torque_Nm, rpm, oil: Oil, surface: Surface, *, misalignment=None,
                     side=None, compliance: str = "iso6336", E_prime=STEEL_E_PRIME,
                     viscosity_model: str = "roelands", film_method: str = "auto",
-                    **tca_options):
+                    strict: bool = True, **tca_options):
     """Loaded contact, friction along the path and mesh efficiency of ``design`` at
-    pinion torque ``torque_Nm`` (N m) and speed ``rpm`` (validated, jitted; module
-    docstring).  Returns ``(MeshEfficiency, TCAResult)``; check ``eff.valid`` and
-    ``res.flags()`` (:func:`efficiency_warnings` lists what to warn about)."""
+    pinion torque ``torque_Nm`` (N m) and speed ``rpm`` (validated; module docstring).
+
+    Runs :func:`gearjax.run_tca` (its compiled program is shared with every other
+    TCA of the same options) and then one jitted program for the loads, friction
+    and losses.  Returns ``(MeshEfficiency, TCAResult)``; check ``eff.valid`` and
+    :func:`efficiency_warnings`.  ``strict``: raise ConvergenceError when the TCA
+    fails on the working flank (as :func:`gearjax.run_tca`).
+    """
     T, n = check_operating_point(torque_Nm, rpm)
     if compliance not in COMPLIANCE_MODELS:
         raise ValueError(f"compliance = {compliance!r} must be one of {COMPLIANCE_MODELS}")
-    f = efficiency_function(design, side=side, compliance=compliance, E_prime=E_prime,
-                            viscosity_model=viscosity_model, film_method=film_method,
-                            **tca_options)
-    key = (id(design), side, compliance, viscosity_model, film_method,
-           tuple(sorted((k, repr(v)) for k, v in f.options.items())))
-    jf = _JITTED.get(key)
-    if jf is None:
-        jf = _JITTED[key] = jax.jit(f)
-    import dataclasses
+    ad = family_of(design)
+    opts = {**ad.defaults, **tca_options}
+    opts.pop("kinematics", None)
+    kw = {} if side is None else {"side": side}
+    teeth_of, pair, run_design = ad.mesh(design, **kw, **opts)
+    res = ad.run(run_design, misalignment, **kw, **opts, kinematics=True, strict=strict)
     oil = dataclasses.replace(oil, name="")
-    from gearjax.tca import Misalignment
-    mis = Misalignment.zero() if misalignment is None else misalignment
-    return jf(f.pair, jnp.asarray(T), jnp.asarray(n * math.pi / 30.0), oil, surface, mis)
+    eff = _post_jit(res, pair, jnp.asarray(T, float), jnp.asarray(n * math.pi / 30.0, float), oil,
+                    surface, jnp.asarray(E_prime, float), teeth_of=teeth_of,
+                    steps_per_pitch=int(opts["steps_per_pitch"]), n_pairs=int(opts["n_pairs"]),
+                    compliance=compliance, viscosity_model=viscosity_model,
+                    film_method=film_method)
+    return eff, res
 
 
-_JITTED: dict = {}
+@functools.partial(jax.jit, static_argnames=("teeth_of", "steps_per_pitch", "n_pairs", "compliance",
+                                             "viscosity_model", "film_method"))
+def _post_jit(res, pair, T, w, oil, surface, E_prime, *, teeth_of, steps_per_pitch, n_pairs,
+              compliance, viscosity_model, film_method):
+    return mesh_efficiency_traced(res, teeth_of(pair, res), T, w, oil, surface,
+                                  steps_per_pitch=steps_per_pitch, n_pairs=n_pairs,
+                                  E_prime=E_prime, compliance=compliance,
+                                  viscosity_model=viscosity_model, film_method=film_method)
+
+
 
 
 def efficiency_warnings(eff: MeshEfficiency, res: TCAResult) -> list[str]:
@@ -286,6 +315,10 @@ def efficiency_warnings(eff: MeshEfficiency, res: TCAResult) -> list[str]:
     if np.any(np.asarray(eff.edge_loaded)):
         out.append(f"edge contact under load at {int(np.sum(np.asarray(eff.edge_loaded)))} "
                    "positions (its load is not modelled)")
+    if np.any(np.asarray(eff.degenerate)):
+        out.append(f"degenerate contact (relative curvature along the ellipse ~ 0, r_y/r_x > "
+                   f"{MAX_RADIUS_RATIO:g}) under load at {int(np.sum(np.asarray(eff.degenerate)))} "
+                   "positions: Hertz theory does not apply there")
     if not np.all(np.asarray(eff.loaded.converged)):
         out.append("load sharing did not converge at some positions")
     if not np.all(valid):

@@ -37,6 +37,7 @@ from gearjax.gears.hypoid.pair import (SIDES, HypoidPair, complementary_pinion, 
 from gearjax.edge_contact import face_end_contact
 from gearjax.newton import newton_solve
 from gearjax.surfaces import GeneratedSurface
+from gearjax.loaded_contact import TeethOf
 from gearjax.tca_result import (TCAResult, check_side, contact_kinematics, register_family,
                                 strong_float64)
 from gearjax.tca import (DEFAULT_APPROACH, ContactPath, Misalignment, MultiPair,
@@ -491,11 +492,12 @@ class _Adapter:
         return f
 
     def mesh(self, design, *, side=None, **_):
-        """``teeth(pair, res) -> MeshTeeth`` of the loaded-contact models (concrete set-up)."""
+        """``(teeth_of, pair, prepared)`` of the loaded-contact models (concrete
+        set-up): ``teeth_of(pair, res) -> MeshTeeth``, the differentiable pair and the
+        prepared pair to run the TCA of."""
         from gearjax.gears.hypoid.mesh import hypoid_mesh_teeth
         prep, _ = self._prepared(design, side)
-        drive = bool(prep.drive)
-        return lambda pair, res: hypoid_mesh_teeth(pair, res, drive)
+        return TeethOf(hypoid_mesh_teeth, (("drive", bool(prep.drive)),)), prep.pair, prep
 
     def sensitivity(self, design, mis=None, *, side=None, steps_per_pitch=16, half_pitches=2.0,
                     n_pairs=5, approach=DEFAULT_APPROACH, **_):

@@ -52,6 +52,7 @@ from gearjax.fields import float64_array
 from gearjax.gears.involute.geometry import (InvolutePair, generated_flank, pair_geometry,
                                              rack_family, rack_family_data, rack_psi0)
 from gearjax.surfaces import GeneratedSurface
+from gearjax.loaded_contact import TeethOf
 from gearjax.tca_result import (TCAResult, check_side, contact_kinematics, register_family,
                                 strong_float64)
 from gearjax.tca import (DEFAULT_APPROACH, Assembly, ContactPath, Misalignment, MultiPair,
@@ -456,12 +457,14 @@ class _Adapter:
         return f
 
     def mesh(self, des, *, side="drive", line_contact=None, **_):
-        """``teeth(d, res) -> MeshTeeth`` of the loaded-contact models (concrete set-up)."""
+        """``(teeth_of, pair, design)`` of the loaded-contact models (concrete set-up):
+        ``teeth_of(pair, res) -> MeshTeeth``, the differentiable pair and the design to
+        run the TCA of."""
         from gearjax.gears.involute.mesh import check_mesh_supported, involute_mesh_teeth
         lc = self._options(des, line_contact)
         check_mesh_supported(des, lc)
         drive = check_side(side) == "drive"
-        return lambda d, res: involute_mesh_teeth(d, res, lc, drive)
+        return TeethOf(involute_mesh_teeth, (("line_contact", lc), ("drive", drive))), des, des
 
     def sensitivity(self, des, mis=None, *, side="drive", steps_per_pitch=24,
                     half_pitches=1.25, line_contact=None, **_):
