@@ -36,7 +36,7 @@ downstream carry exact gradients.  The lever arms follow from the contact:
 
 Units: mm, N, N mm (torque), rad, MPa.
 References (docs/references.md): [Litvin2004]; [Weber1953]; [Sainsot2004];
-[ISO6336-1] (mesh stiffness, load sharing); [Johnson1985] (Hertz).
+[ISO6336-1] (mesh stiffness, load sharing); [ISO10300-1]; [Johnson1985] (Hertz).
 """
 
 from __future__ import annotations
@@ -49,9 +49,11 @@ import numpy as np
 
 from gearjax.contact import hertz_exact, hertz_line_traced
 from gearjax.newton import newton_solve
+from gearjax.tooth_compliance import (contact_compliance, iso6336_single_stiffness,
+                                      tooth_compliance, tooth_geometry)
 
 __all__ = ["LoadedContact", "MeshTeeth", "TeethOf", "pair_compliance", "COMPLIANCE_MODELS",
-           "iso6336_single_stiffness", "force_from_approach", "share_torque", "pair_arrays",
+           "hertz_coefficient", "contact_stress", "force_from_approach", "share_torque", "pair_arrays",
            "lever_arms", "BALANCE_TOL"]
 
 #: relative tolerance of the torque balance sum_k l1_k F_k = T1
@@ -296,38 +298,43 @@ class MeshTeeth(NamedTuple):
     drive: jax.Array
 
 
-#: ISO 6336-1:2019 eq. (73) coefficients C1..C9 of the theoretical single stiffness
-ISO6336_C = (0.04723, 0.15551, 0.25791, -0.00635, -0.11654, -0.00193, -0.24188, 0.00529,
-             0.00182)
-#: ISO 6336-1 method B factors: C_M (solid gears), C_R (solid blanks), C_B (basic rack)
-ISO6336_CM, ISO6336_CR, ISO6336_CB = 0.8, 1.0, 1.0
+COMPLIANCE_MODELS = ("weber", "iso6336")
 
 
-def iso6336_single_stiffness(zn1, zn2, x1, x2, beta):
-    """Single stiffness ``c' = C_M C_R C_B cos(beta) / q'`` of [ISO6336-1] method B
-    (N/(mm um) per unit face width), ``q' = C1 + C2/zn1 + C3/zn2 + C4 x1 + C5 x1/zn1
-    + C6 x2 + C7 x2/zn2 + C8 x1^2 + C9 x2^2`` (mm um/N) with the virtual tooth
-    numbers ``zn`` of the normal section (negative for an internal gear)."""
-    C1, C2, C3, C4, C5, C6, C7, C8, C9 = ISO6336_C
-    q = (C1 + C2 / zn1 + C3 / zn2 + C4 * x1 + C5 * x1 / zn1 + C6 * x2 + C7 * x2 / zn2
-         + C8 * x1 ** 2 + C9 * x2 ** 2)
-    return ISO6336_CM * ISO6336_CR * ISO6336_CB * jnp.cos(beta) / q
+def pair_compliance(teeth: MeshTeeth, r_x, load_per_width, model: str = "weber"):
+    """Linear compliance ``q`` (mm/N) of tooth pair 0 at every path point (module
+    docstring; the Hertz term of a point contact is added by the caller).
 
+    ``"weber"`` (default): both teeth as cantilevers of the virtual spur gears --
+    bending, shear and axial compression of the variable section plus the fillet
+    foundation ([Weber1953], [Sainsot2004]; :func:`gearjax.tooth_compliance.tooth_compliance`)
+    -- per unit width, over the width carrying the load; a line contact adds Weber's
+    contact compliance of the line at ``load_per_width`` (N/mm) with the reduced
+    radius ``r_x`` (:func:`gearjax.tooth_compliance.contact_compliance`), a point
+    contact gets the Hertz approach instead (nonlinear, :func:`hertz_coefficient`).
 
-COMPLIANCE_MODELS = ("iso6336",)
-
-
-def pair_compliance(teeth: MeshTeeth, r_x, r_y, E_prime, model: str = "iso6336"):
-    """``(q, c)`` per path point: linear compliance (mm/N) and Hertz coefficient
-    (mm/N^(2/3)) of tooth pair 0 (module docstring).
-
-    ``"iso6336"``: the single stiffness of [ISO6336-1] method B, constant along the
-    path, over the width carrying the load: ``q = 1e-3 / (c' width)`` (the 1e-3
-    converts um to mm); the standard's stiffness includes the flattening of the
-    contact, so no Hertz term is added (``c = 0``).
+    ``"iso6336"``: the single stiffness ``c'`` of [ISO6336-1] method B, constant along
+    the path: ``q = 1e-3 / (c' width)`` (the 1e-3 converts um to mm); the standard's
+    stiffness includes the flattening of the contact, so no Hertz term is added.
     """
     if model not in COMPLIANCE_MODELS:
         raise ValueError(f"compliance model = {model!r} must be one of {COMPLIANCE_MODELS}")
-    c1 = iso6336_single_stiffness(teeth.z[0], teeth.z[1], teeth.x[0], teeth.x[1], teeth.beta)
-    q = 1e-3 / (c1 * teeth.width)
-    return q, jnp.zeros_like(q)
+    z, x, al = teeth.z, teeth.x, teeth.alpha
+    if model == "iso6336":
+        cb3 = jnp.cos(teeth.beta) ** 3      # the standard forms z_n = z / cos^3(beta)
+        c1 = iso6336_single_stiffness(z[0] * cb3, z[1] * cb3, x[0], x[1], teeth.beta,
+                                      alpha_n=0.5 * (al[0] + al[1])).c_prime
+        return 1e-3 / (c1 * teeth.width)
+
+    def tooth(i):
+        g = tooth_geometry(z[i], teeth.module, al[i], x[i], teeth.ha[i], teeth.hf[i])
+        r = jnp.clip(teeth.r_load[i], g.r_form, g.r_a)
+        return jax.vmap(lambda ri: tooth_compliance(ri, z[i], teeth.module, al[i], x[i],
+                                                    teeth.ha[i], teeth.hf[i]))(r)
+
+    t1, t2 = tooth(0), tooth(1)
+    q = (t1.total + t2.total) / teeth.width
+    if teeth.line_length is not None:
+        qc = contact_compliance(load_per_width, r_x, t1.half_thickness, t2.half_thickness)
+        q = q + qc / teeth.line_length
+    return q

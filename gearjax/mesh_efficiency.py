@@ -136,7 +136,7 @@ def _equivalent_ry(F, r_x, L, E_prime):
 
 def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, speed_rad_s, oil: Oil,
                            surface: Surface, *, steps_per_pitch: int, n_pairs: int,
-                           E_prime=STEEL_E_PRIME, compliance: str = "iso6336",
+                           E_prime=STEEL_E_PRIME, compliance: str = "weber",
                            viscosity_model: str = "roelands",
                            film_method: str = "auto") -> MeshEfficiency:
     """Loaded contact, friction and efficiency of the pair over one mesh cycle
@@ -160,10 +160,16 @@ def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, speed_ra
     r_y0 = (jnp.where(on, kin.r_y, jnp.inf) if line
             else jnp.where(on, jnp.minimum(jnp.nan_to_num(kin.r_y, posinf=jnp.inf),
                                            MAX_RADIUS_RATIO * r_x0), 1.0))
-    q0, c0 = pair_compliance(teeth, r_x0, r_y0, E_prime, compliance)
-    if not line and compliance != "iso6336":
-        c0 = c0 + hertz_coefficient(r_x0, r_y0, E_prime)
     l1_0, l2_0 = lever_arms(path.point, path.normal, jnp.where(on, kin.gear_ratio, 1.0))
+    T1 = 1e3 * jnp.asarray(torque_Nm, float)
+    # nominal load per unit length of a line contact (one pair carrying the torque):
+    # it enters Weber's contact compliance only through a logarithm
+    w_nom = T1 / (jnp.where(on, l1_0, 1.0) * teeth.width)
+    q0 = pair_compliance(teeth, r_x0, w_nom, compliance)
+    if line or compliance == "iso6336":
+        c0 = jnp.zeros_like(q0)
+    else:
+        c0 = hertz_coefficient(r_x0, r_y0, E_prime)
 
     def pairs(a, fill):
         return pair_arrays(a, steps_per_pitch, K, fill, win)
@@ -171,7 +177,6 @@ def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, speed_ra
     act = pairs(on, False)
     te = pairs(jnp.where(on, path.te, 0.0), 0.0)
     l1, l2, q, c = (pairs(jnp.where(on, a, 1.0), 1.0) for a in (l1_0, l2_0, q0, c0))
-    T1 = 1e3 * jnp.asarray(torque_Nm, float)
     env, y, F, w, bal, conv = share_torque(te, act, l1, l2, q, c, T1, teeth.drive)
     sgn = jnp.where(teeth.drive, 1.0, -1.0)
 
@@ -229,7 +234,7 @@ def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, speed_ra
                           edge_loaded, degenerate)
 
 
-def efficiency_function(design, *, side=None, compliance: str = "iso6336", E_prime=STEEL_E_PRIME,
+def efficiency_function(design, *, side=None, compliance: str = "weber", E_prime=STEEL_E_PRIME,
                         viscosity_model: str = "roelands", film_method: str = "auto",
                         **tca_options):
     """A pure, traceable ``f(pair, torque_Nm, speed_rad_s, oil, surface, mis=None) ->
@@ -262,7 +267,7 @@ def efficiency_function(design, *, side=None, compliance: str = "iso6336", E_pri
 
 
 def mesh_efficiency(design, torque_Nm, rpm, oil: Oil, surface: Surface, *, misalignment=None,
-                    side=None, compliance: str = "iso6336", E_prime=STEEL_E_PRIME,
+                    side=None, compliance: str = "weber", E_prime=STEEL_E_PRIME,
                     viscosity_model: str = "roelands", film_method: str = "auto",
                     strict: bool = True, **tca_options):
     """Loaded contact, friction along the path and mesh efficiency of ``design`` at

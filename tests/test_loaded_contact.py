@@ -11,8 +11,7 @@ import numpy as np
 import pytest
 
 from gearjax.contact import hertz_exact
-from gearjax.loaded_contact import (BALANCE_TOL, force_from_approach, iso6336_single_stiffness,
-                                    pair_arrays, share_torque)
+from gearjax.loaded_contact import BALANCE_TOL, force_from_approach, pair_arrays, share_torque
 
 T1 = 2.0e5          # N mm
 L1, L2 = 30.0, 60.0  # lever arms, mm
@@ -133,13 +132,3 @@ def test_pair_arrays_shift_by_whole_pitches():
     np.testing.assert_array_equal(out, [[7.0, 8.0], [4.0, 5.0], [1.0, 2.0]])
     out = pair_arrays(a, 3, 3, -1.0, np.array([0, 9]))
     np.testing.assert_array_equal(out, [[3.0, -1.0], [0.0, 9.0], [-1.0, 6.0]])
-
-
-def test_iso6336_single_stiffness_of_the_standard_example():
-    """ISO 6336-1 method B: for x = 0 and z -> infinity q' -> C1, so
-    c'_th = 1/0.04723 = 21.17 N/(mm um) and c' = 0.8 c'_th; a 20/40 pair lies near
-    the 14 N/(mm um) of the standard's typical value."""
-    np.testing.assert_allclose(iso6336_single_stiffness(1e12, 1e12, 0.0, 0.0, 0.0),
-                               0.8 / 0.04723, rtol=1e-9)
-    c = float(iso6336_single_stiffness(20.0, 40.0, 0.0, 0.0, 0.0))
-    assert 13.0 < c < 15.0

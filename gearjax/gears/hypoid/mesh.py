@@ -4,9 +4,10 @@
 Each member is the virtual cylindrical gear of its normal section at the mean point
 ([ISO10300-1]): mean cone distance ``R_m = A_o - F/2``, mean normal module
 ``m_mn = 2 R_m sin(delta_1) cos(beta_m1) / z1`` (of the pinion; the gear's from its
-own data), virtual tooth number ``z_vn = z / (cos(delta) cos^3(beta_m))`` (the
-normal section of the virtual spur gear: [ISO10300-1] ``z_vn = z_v / (cos^2(beta_vb)
-cos(beta_vm))`` with ``beta_vb ~ beta_m``).  Addendum and dedendum at the mean point
+own data), virtual tooth numbers ``z_v = z / cos(delta)``, ``z_vn = z_v / (cos^2(beta_vb)
+cos(beta_m))``, ``sin(beta_vb) = sin(beta_m) cos(alpha_n)`` ([ISO10300-1];
+:func:`gearjax.tooth_compliance.virtual_cylindrical_teeth`; each member with its own
+mean spiral angle).  Addendum and dedendum at the mean point
 ``h_am, h_fm`` give the tooth form: ``x = (h_am - h_fm) / (2 m_mn)``,
 ``h_a* = h_f* = (h_am + h_fm) / (2 m_mn)``.  The contact point maps onto the virtual
 gear at its height above the root cone: ``r_v = z_vn m_mn / 2 - h_fm + h``.
@@ -28,6 +29,7 @@ import jax.numpy as jnp
 from gearjax.gears.hypoid.pair import HypoidPair, mean_dedendum
 from gearjax.loaded_contact import MeshTeeth
 from gearjax.tca_result import TCAResult
+from gearjax.tooth_compliance import virtual_cylindrical_teeth
 
 __all__ = ["hypoid_mesh_teeth"]
 
@@ -37,7 +39,7 @@ def _member(spec, h):
     Rm = b.outer_cone_distance - 0.5 * b.face_width
     beta = b.mean_spiral_angle
     m_mn = 2.0 * Rm * jnp.sin(b.pitch_angle) * jnp.cos(beta) / b.teeth
-    z_vn = b.teeth / (jnp.cos(b.pitch_angle) * jnp.cos(beta) ** 3)
+    z_vn = virtual_cylindrical_teeth(b.teeth, b.pitch_angle, beta, spec.cutter.blade_angle).z_vn
     h_fm = mean_dedendum(b)
     h_am = b.outer_addendum - 0.5 * b.face_width * jnp.tan(b.face_angle - b.pitch_angle)
     x = (h_am - h_fm) / (2.0 * m_mn)
