@@ -209,7 +209,7 @@ def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, speed_ra
     fr = FrictionResult(*(jnp.swapaxes(v, 0, 1) for v in ml.friction))
     loaded_on = F > 0.0
     w_loss = F * us * loaded_on
-    mean_mu = jnp.sum(fr.mu * w_loss) / jnp.sum(w_loss)
+    mean_mu = jnp.sum(ml.mu.T * w_loss) / jnp.sum(w_loss)
     share = l1 * F / T1
     lc = LoadedContact(F, share, w, p_max, a_ax, b_ax, y, env - sgn * y, bal, conv,
                        jnp.sum(loaded_on, axis=0))

@@ -25,7 +25,7 @@ from gearjax.gears.involute.tca import InvoluteTCA
 from gearjax.loaded_contact import MeshTeeth
 from gearjax.tca_result import TCAResult
 
-__all__ = ["involute_mesh_teeth", "check_mesh_supported"]
+__all__ = ["involute_mesh_teeth", "check_mesh_supported", "ohlendorf_loss_factor"]
 
 
 def check_mesh_supported(des: InvoluteTCA, line_contact: bool) -> None:
@@ -60,3 +60,24 @@ def involute_mesh_teeth(des: InvoluteTCA, res: TCAResult, line_contact: bool,
     return MeshTeeth(z, mn, jnp.stack([p.pressure_angle + des.dalpha, p.pressure_angle]),
                      beta, jnp.stack([p.x1, p.x2]), one, 1.25 * one, r_load, width, line,
                      jnp.asarray(drive))
+
+
+def ohlendorf_loss_factor(pair):
+    """Ohlendorf's tooth loss factor of a cylindrical pair ([Ohlendorf1958], as in
+    [ISO/TR 14179-2] and Niemann & Winter):
+
+        H_V = pi (u + 1) / (z1 u cos(beta_b)) (1 - eps_a + eps_1^2 + eps_2^2),
+
+    u = z2/z1, eps_a the transverse contact ratio, eps_1, eps_2 the addendum contact
+    ratios of pinion and gear (path from the pitch point to the end / from the start
+    of contact, over the transverse base pitch).  It assumes the load shared equally
+    in double contact (line load constant along the path for helical pairs) and a
+    constant mu: the mean sliding loss is ``P_V = mu_m H_V P_in`` (for eps_a < 2
+    with the pitch point in single contact).  Traceable."""
+    geo = pair_geometry(pair)
+    p_bt = 2.0 * jnp.pi * geo["rb1"] / pair.z1
+    e1 = (geo["rho_E"] - geo["rho_P"]) / p_bt
+    e2 = (geo["rho_P"] - geo["rho_A"]) / p_bt
+    u = pair.z2 / pair.z1
+    return (jnp.pi * (u + 1.0) / (pair.z1 * u * jnp.cos(geo["beta_b"]))
+            * (1.0 - geo["contact_ratio"] + e1 ** 2 + e2 ** 2))
