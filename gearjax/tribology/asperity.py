@@ -139,19 +139,22 @@ _LS_TOL = 1e-11           # residual tolerance of the converged flag (as the for
 _LGAMMA_3_5 = math.lgamma(3.5)
 
 
+# the columns weight e^{-λt - t²/2} for I_5/2, I_3/2, I_1/2, I_2 (t^n dt = 2 T^{n+1} v^{2n+1} dv)
+_LS_MOMENTS = np.stack([_LS_W * _LS_V ** 6, _LS_W * _LS_V ** 4, _LS_W * _LS_V ** 2,
+                        _LS_W * _LS_V ** 5], axis=-1)
+
+
 def _gt_integrals(lam):
-    """ln F_5/2(λ) and the ratios I_3/2/I_5/2, I_1/2/I_5/2, I_2/I_5/2 from ONE set of
-    exponentials (the I_n share the factor e^{-λt - t²/2}; t = T v², 32 nodes)."""
+    """ln F_5/2(λ) and the ratios I_3/2/I_5/2, I_1/2/I_5/2, I_2/I_5/2 (= F_n/F_5/2) from
+    ONE set of 32 exponentials (the I_n share the factor e^{-λt - t²/2}, t = T v²);
+    the four weighted sums are one small matrix product."""
     T = _tail_scale(lam)
     t = T[..., None] * (_LS_V * _LS_V)
     e = jnp.exp(-lam[..., None] * t - 0.5 * t * t)
-    v2 = _LS_V * _LS_V
-    i52 = jnp.sum(_LS_W * v2 ** 3 * e, axis=-1)          # I_n = 2 T^{n+1} Σ w v^{2n+1} e
-    q32 = jnp.sum(_LS_W * v2 ** 2 * e, axis=-1) / (T * i52)
-    q12 = jnp.sum(_LS_W * v2 * e, axis=-1) / (T * T * i52)
-    q2 = jnp.sum(_LS_W * v2 ** 2.5 * e, axis=-1) / (T ** 0.5 * i52)
+    m = e @ _LS_MOMENTS
+    i52 = m[..., 0]
     log_f52 = -0.5 * lam * lam - _LOG_SQRT_2PI + jnp.log(2.0 * T ** 3.5 * i52)
-    return log_f52, q32, q12, q2
+    return log_f52, m[..., 1] / (T * i52), m[..., 2] / (T * T * i52), m[..., 3] / (jnp.sqrt(T) * i52)
 
 
 class _Contact(NamedTuple):
@@ -256,8 +259,13 @@ def load_sharing_traced(F, Rx, k, a, b, u_e, eta0, alpha, E_prime, sigma, densit
                       partial(_ls_residual, film_method=film_method), th)
     phi = jax.nn.sigmoid(s)
     lg1 = jax.nn.softplus(s)
-    hc, hm = _film(lg1, th, film_method)
-    hc0 = _film(jnp.zeros_like(s), th, film_method)[0]
+    # the films are power laws in γ1 (see _ls_iterate): h(γ1) = h(1) γ1^c with
+    # c = ln[h(e)/h(1)], the same numbers as film_thickness_traced(F/γ1, E'/γ1) to
+    # round-off (tested), for two film evaluations instead of three
+    hc0, hm0 = _film(jnp.zeros_like(s), th, film_method)
+    hc1, hm1 = _film(jnp.ones_like(s), th, film_method)
+    hc = hc0 * jnp.exp(jnp.log(hc1 / hc0) * lg1)
+    hm = hm0 * jnp.exp(jnp.log(hm1 / hm0) * lg1)
     lam = hc / th.sigma
     log_f52, _, _, q2 = _gt_integrals(lam)
     res = -jax.nn.softplus(-s) - _log_cap(th) - log_f52
