@@ -35,7 +35,8 @@ fluid forms its film as if it carried F_n/γ1 on bodies of modulus E'/γ1 (film
 formula of :mod:`gearjax.tribology.film`), the asperities carry
 ``F_a = π a b p_a(h_c/σ)`` over the Hertz ellipse of the total load.  The single
 unknown is the asperity share φ = F_a/F_n = 1/γ2, solved for its logit
-``s = ln(φ/(1-φ))`` with the implicit-differentiated Newton solver:
+``s = ln(φ/(1-φ))`` by a fixed number of Halley steps from an explicit start
+(:func:`load_sharing_traced`), derivatives by the implicit function theorem:
 
     R(s) = ln φ - ln(π a b K_GT E' / F_n) - ln F_5/2(h_c(F_n/γ1, E'/γ1)/σ) = 0.
 
