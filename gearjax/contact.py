@@ -45,8 +45,9 @@ the very elongated contact (m → 1, Ry/Rx up to 1e15) are both evaluated to
 machine precision and differentiably.  Equation (1) is solved for
 ``t = ln k`` by three Newton steps from an explicit start (Hamrock–Brewe near the
 circle, the elongated-ellipse asymptote beyond), derivatives by the implicit
-function theorem (:func:`gearjax.newton.implicit_root`).  ``t < 0`` (Rx > Ry) is the analytic continuation to ``m < 0``;
-the AGM works there too, so both orientations need no branch.
+function theorem (:func:`gearjax.newton.implicit_root`).  ``t < 0`` (Rx > Ry) is
+the analytic continuation to ``m < 0``; the AGM works there too, so both
+orientations need no branch.
 
 Line contact is the limit Ry/Rx → ∞ at fixed load per unit length ``w'``:
 ``b = sqrt(8 w' Rx / (π E'))``, ``p_max = 2 w' / (π b)``
