@@ -1,8 +1,13 @@
 """Throughput of the friction model: μ for 1e5 contact points per call, forward and
-gradient, against a NumPy/SciPy per-point loop (same model, same equations) on a
-subset, scaled.  Prints a table; not a test.
+gradient, the per-stage breakdown (Hertz ellipse, load sharing, shear integral, each
+jitted alone on the same points), against a NumPy/SciPy per-point loop (same model,
+same equations) on a subset, scaled.  Prints a table; not a test.
 
     python benchmarks/bench_friction.py [--points 100000] [--baseline-points 200]
+
+Before the fixed-step kernel (commit bcd37da, vmapped while-loop Newton solves with
+line search, lax.map over chunks of 1024) this machine measured 4.4e4 points/s
+forward and 3.8e4 points/s gradient at 2e4 points (docs/friction.md, Performance).
 """
 
 from __future__ import annotations
@@ -69,6 +74,36 @@ def numpy_mu(F, ue, us, Rx, Ry, Ep, eta0, z, tau0, sigma, dens, beta, fc, vslip)
     return fc * phi * math.tanh(us / vslip) + Ft / F
 
 
+def _stage_times(timeit, cpu_times, args_j, oil, surf, Ep):
+    """Each stage of the kernel jitted alone on the same points (its inputs precomputed)."""
+    import jax
+    import jax.numpy as jnp
+
+    from gearjax.contact import hertz_exact
+    from gearjax.tribology.asperity import load_sharing_traced
+    from gearjax.tribology.friction import _S, _WS
+    from gearjax.tribology.lubricant import eyring_shear, viscosity
+
+    F, ue, us, Rx, Ry = args_j
+    hz_f = jax.jit(lambda F, Rx, Ry: hertz_exact(F, Rx, Ry, Ep))
+    hz = hz_f(F, Rx, Ry)
+    ls_f = jax.jit(lambda F, Rx, k, a, b, ue: load_sharing_traced(
+        F, Rx, k, a, b, ue, oil.eta0, oil.alpha, Ep, surf.sigma, surf.density, surf.beta))
+    ls = ls_f(F, Rx, hz.k, hz.a, hz.b, ue)
+
+    def shear(phi, pmax, us, hc, a, b, F):
+        p_f = ((1.0 - phi) * pmax)[:, None] * jnp.asarray(_S)
+        tau = eyring_shear(viscosity(p_f, oil), us[:, None], hc[:, None], oil.tau0)
+        return 2 * jnp.pi * a * b * jnp.sum(_WS * _S * tau, axis=-1) / F
+
+    sh_f = jax.jit(shear)
+    runs = [("Hertz ellipse (hertz_exact)", hz_f, (F, Rx, Ry)),
+            ("load sharing (load_sharing_traced)", ls_f, (F, Rx, hz.k, hz.a, hz.b, ue)),
+            ("shear integral (48-node Gauss-Legendre)", sh_f,
+             (ls.phi, hz.p_max, us, ls.h_c, hz.a, hz.b, F))]
+    return [(name, timeit(f, *a), cpu_times[f]) for name, f, a in runs]
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--points", type=int, default=100_000)
@@ -103,19 +138,27 @@ def main():
 
     grad = jax.jit(jax.grad(total_mu, argnums=(0, 1, 2, 3, 4, 5, 6)))
 
+    cpu_times = {}
+
     def timeit(fn, *a):
+        """(first call incl. compile, best wall time of the repeats); the process CPU time
+        of the best repeat goes to ``cpu_times`` (a loaded shared machine inflates wall
+        time, not the CPU time of a single-threaded kernel)."""
         t0 = time.perf_counter()
         jax.block_until_ready(fn(*a))
         compile_s = time.perf_counter() - t0
-        best = math.inf
+        best, best_cpu = math.inf, math.inf
         for _ in range(args.repeats):
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), time.process_time()
             jax.block_until_ready(fn(*a))
             best = min(best, time.perf_counter() - t0)
+            best_cpu = min(best_cpu, time.process_time() - c0)
+        cpu_times[fn] = best_cpu
         return compile_s, best
 
     c_f, t_f = timeit(fwd, *args_j)
     c_g, t_g = timeit(grad, *args_j, oil.eta0, surf.sigma)
+    stages = _stage_times(timeit, cpu_times, args_j, oil, surf, Ep)
 
     m = args.baseline_points
     t0 = time.perf_counter()
@@ -125,12 +168,19 @@ def main():
     mu_j = np.asarray(fwd(*args_j))[:m]
     agree = np.max(np.abs(np.asarray(mu_np) - mu_j) / np.abs(mu_j))
 
-    print(f"gearjax friction benchmark ({jax.devices()[0].platform}, {n} points per call)")
-    print(f"{'route':44s} {'points/s':>12s} {'call (s)':>10s} {'compile (s)':>12s}")
-    print(f"{'JAX forward mu (jit, vmap)':44s} {n / t_f:12.4g} {t_f:10.3f} {c_f:12.2f}")
-    print(f"{'JAX gradient of sum(mu) wrt 7 inputs':44s} {n / t_g:12.4g} {t_g:10.3f} {c_g:12.2f}")
+    import os
+    print(f"gearjax friction benchmark ({jax.devices()[0].platform}, {os.cpu_count()} cores, "
+          f"{n} points per call)")
+    print(f"{'route':44s} {'points/s':>12s} {'call (s)':>10s} {'compile (s)':>12s} "
+          f"{'CPU s/call':>11s}")
+    print(f"{'JAX forward mu (jit)':44s} {n / t_f:12.4g} {t_f:10.3f} {c_f:12.2f} "
+          f"{cpu_times[fwd]:11.3f}")
+    print(f"{'JAX gradient of sum(mu) wrt 7 inputs':44s} {n / t_g:12.4g} {t_g:10.3f} {c_g:12.2f} "
+          f"{cpu_times[grad]:11.3f}")
     print(f"{'NumPy/SciPy per-point loop (forward only)':44s} {m / t_np:12.4g} "
           f"{t_np * n / m:10.3f} {'-':>12s}   (timed on {m} points, scaled)")
+    for name, (_, t), cpu in stages:
+        print(f"{'  stage: ' + name:44s} {n / t:12.4g} {t:10.3f} {'-':>12s} {cpu:11.3f}")
     print(f"speed-up of JAX forward over the loop: {(m / t_np) and (n / t_f) / (m / t_np):.0f}x; "
           f"max relative difference of mu on the subset: {agree:.1e}")
 

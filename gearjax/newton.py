@@ -47,7 +47,7 @@ import jax.numpy as jnp
 import numpy as np
 from jax.custom_derivatives import SymbolicZero
 
-__all__ = ["NewtonResult", "newton_solve"]
+__all__ = ["NewtonResult", "newton_solve", "implicit_root"]
 
 
 class NewtonResult(NamedTuple):
@@ -264,3 +264,43 @@ def _eager(theta) -> bool:
 def _newton_jit(F, tol, xtol, max_steps, max_halvings, natural, x0, theta):
     return newton_solve(F, x0, theta, tol=tol, xtol=xtol, max_steps=max_steps,
                         max_halvings=max_halvings, natural_monotonicity=natural)
+
+
+# ----------------------------------------------------------------------------
+# elementwise roots with a fixed iteration count
+# ----------------------------------------------------------------------------
+
+def implicit_root(solve: Callable, residual: Callable, theta):
+    """Root ``x(theta)`` of an *elementwise* equation ``residual(x, theta) = 0``.
+
+    ``solve(theta) -> x`` is any forward iteration (typically a fixed number of
+    safeguarded Newton or Halley steps from an explicit start, as array code with
+    no loops in the trace); it is not differentiated.  ``residual`` must act
+    elementwise: entry i of the result depends on entry i of ``x`` only, so its
+    Jacobian in ``x`` is diagonal.  Derivatives follow from the implicit function
+    theorem at the returned root,
+
+        dx = -(∂R/∂θ · dθ) / (∂R/∂x),
+
+    a ``jax.custom_jvp`` rule that is linear in ``dθ`` (so ``grad``/``jacrev``
+    transpose it) and costs one forward-mode pass of ``residual``.  ``theta`` is a
+    pytree of arrays broadcasting with ``x``; ``solve`` and ``residual`` must not
+    close over traced values (pass them in ``theta``).  Works under ``jit``,
+    ``vmap`` and ``grad``.  The caller computes the final residual and its own
+    convergence flag (nothing here assumes the iteration converged).
+    """
+    return _implicit_root(solve, residual, theta)
+
+
+@partial(jax.custom_jvp, nondiff_argnums=(0, 1))
+def _implicit_root(solve, residual, theta):
+    return jax.lax.stop_gradient(solve(jax.lax.stop_gradient(theta)))
+
+
+@_implicit_root.defjvp
+def _implicit_root_jvp(solve, residual, primals, tangents):
+    (theta,), (theta_dot,) = primals, tangents
+    x = _implicit_root(solve, residual, theta)
+    r_x = jax.jvp(lambda v: residual(v, theta), (x,), (jnp.ones_like(x),))[1]
+    r_t = jax.jvp(lambda th: residual(x, th), (theta,), (theta_dot,))[1]
+    return x, -r_t / r_x
