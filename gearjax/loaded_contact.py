@@ -14,7 +14,7 @@ pair answers with the normal load ``F_k(w_k)`` of its compliance,
     w = q_k F + c_k F^(2/3)      (w > 0),     F = 0     (w <= 0),
 
 ``q_k`` (mm/N) the linear compliance of the two teeth (bending, shear, fillet
-foundation; for a line contact also the contact, [Weber1953]/[Sainsot2004], see
+foundation; for a line contact also the contact, [Weber1949]/[Sainsot2004], see
 :mod:`gearjax.tooth_compliance`) divided by the width that carries the load, and
 ``c_k F^(2/3)`` the Hertz approach of a point contact (``c_k`` = approach at 1 N of
 :func:`gearjax.contact.hertz_exact` for the flanks' principal radii; the local
@@ -35,7 +35,7 @@ downstream carry exact gradients.  The lever arms follow from the contact:
 (equal normal velocities of the two flanks at the contact point, [Litvin2004] ch. 9).
 
 Units: mm, N, N mm (torque), rad, MPa.
-References (docs/references.md): [Litvin2004]; [Weber1953]; [Sainsot2004];
+References (docs/references.md): [Litvin2004]; [Weber1949]; [Sainsot2004];
 [ISO6336-1] (mesh stiffness, load sharing); [ISO10300-1]; [Johnson1985] (Hertz).
 """
 
@@ -307,7 +307,7 @@ def pair_compliance(teeth: MeshTeeth, r_x, load_per_width, model: str = "weber")
 
     ``"weber"`` (default): both teeth as cantilevers of the virtual spur gears --
     bending, shear and axial compression of the variable section plus the fillet
-    foundation ([Weber1953], [Sainsot2004]; :func:`gearjax.tooth_compliance.tooth_compliance`)
+    foundation ([Weber1949], [Sainsot2004]; :func:`gearjax.tooth_compliance.tooth_compliance`)
     -- per unit width, over the width carrying the load; a line contact adds Weber's
     contact compliance of the line at ``load_per_width`` (N/mm) with the reduced
     radius ``r_x`` (:func:`gearjax.tooth_compliance.contact_compliance`), a point
