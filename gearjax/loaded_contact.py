@@ -231,8 +231,11 @@ def contact_stress(F, r_x, r_y, E_prime, line_length=None):
     on = F > 0.0
     Fs = jnp.where(on, F, 1.0)
     if line_length is None:
-        hz = hertz_exact(Fs, r_x, r_y, E_prime)
-        p, a, b = hz.p_max, hz.a, hz.b
+        # hertz_exact solves for the ellipticity with newton_solve (1-D batches only)
+        shape = jnp.broadcast_shapes(jnp.shape(Fs), jnp.shape(r_x), jnp.shape(r_y))
+        flat = lambda v: jnp.broadcast_to(v, shape).reshape(-1)  # noqa: E731
+        hz = hertz_exact(flat(Fs), flat(r_x), flat(r_y), E_prime)
+        p, a, b = (v.reshape(shape) for v in (hz.p_max, hz.a, hz.b))
     else:
         Ls = jnp.where(on, line_length, 1.0)
         b, p = hertz_line_traced(Fs / Ls, r_x, E_prime)

@@ -126,3 +126,11 @@ def test_bad_plot_path_refused_before_work(capsys, monkeypatch, tmp_path):
     assert "--plot" in capsys.readouterr().err
     assert main(["efficiency", "example:no_such_design", *BASE[1:]]) == 2
     assert "no_such_design" in capsys.readouterr().err
+
+
+def test_helical_pair_in_line_contact_refused_in_one_line(capsys):
+    """The library refuses it in its concrete set-up, before anything is traced."""
+    argv = ["efficiency", DESIGN + ",helix=15", *BASE[1:]]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "helix = 15" in err[0] and "lead_crown" in err[0]
