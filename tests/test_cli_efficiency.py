@@ -134,3 +134,24 @@ def test_helical_pair_in_line_contact_refused_in_one_line(capsys):
     assert main(argv) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "helix = 15" in err[0] and "lead_crown" in err[0]
+
+
+def test_table_from_the_same_result(run, capsys):
+    """The table printer on the run's result (a second run would compile again)."""
+    import argparse
+
+    from gearjax.commands.efficiency import _print_table
+    out = _strict(run[1])
+    args = argparse.Namespace(design=DESIGN, side="drive", torque_Nm=200.0, rpm=1500.0,
+                              oil="mineral_vg100", sigma_um=0.4)
+    _print_table(out, args)
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].startswith("# mesh efficiency involute:")
+    assert lines[1].split()[:5] == ["phi1[deg]", "n", "s[-1]", "s[+0]", "s[+1]"]
+    rows = lines[2:2 + 8]
+    assert all(r.split()[-1] == "ok" for r in rows)
+    assert float(rows[0].split()[0]) == pytest.approx(out["phi1_deg"][0], abs=1e-4)
+    summary = "\n".join(lines[10:])
+    for label in ("eta_bar", "mean mu", "max p_max", "P_in", "loaded TE p-t-p"):
+        assert label in summary
+    assert f"{100 * out['mean_efficiency']:.4f} %" in summary

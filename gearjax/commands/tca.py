@@ -17,6 +17,8 @@ import sys
 
 import numpy as np
 
+from gearjax.commands.designs import involute_design, parse_misalign
+
 JSON_KEYS_DOC = """JSON keys:
   input            the design and options as given
   phi1_rad         pinion angles of the grid (rad); the reference (pitch point) in the middle
@@ -75,9 +77,6 @@ def register(sub):
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.add_argument("--plot", default=None, help="write the TE and contact-pattern figure (.png)")
     p.set_defaults(func=run)
-
-
-from gearjax.commands.designs import MAX_FACE_WIDTH_MM, involute_design, parse_misalign  # noqa: E402,F401
 
 
 def _nan_list(a):
