@@ -10,6 +10,7 @@ The chain (docs/architecture.md), each step a pure JAX function so that
                      -> tooth contact analysis (TCAResult)     gearjax.tca, gearjax.tca_result
                      -> kinematics at the contact points       gearjax.tca_result, gearjax.kinematics
                      -> Hertz load, film, friction, losses     gearjax.contact, gearjax.tribology
+                     -> load sharing, mesh efficiency          gearjax.loaded_contact, gearjax.mesh_efficiency
                      -> objective -> gradient -> optimiser     gearjax.optimize
 
 Backbone (top level): ``frames`` (4x4 transforms), ``newton`` (implicit-differentiated
@@ -74,6 +75,11 @@ from gearjax.tribology import (OILS, FrictionResult, Oil, Surface, friction_coef
                                friction_traced, get_oil, make_oil, make_surface, mesh_losses,
                                mesh_losses_traced, stribeck_curve)
 from gearjax.tribology.ehl import solve_ehl  # noqa: E402
+# -- loaded contact and mesh efficiency ---------------------------------------------
+from gearjax.loaded_contact import COMPLIANCE_MODELS, LoadedContact  # noqa: E402
+from gearjax.mesh_efficiency import (RPM_RANGE, TORQUE_RANGE_NM, MeshEfficiency,  # noqa: E402
+                                     check_operating_point, efficiency_function,
+                                     efficiency_warnings, mesh_efficiency)
 
 
 def run_tca(design, misalignment=None, *, side=None, **options) -> TCAResult:
@@ -159,6 +165,9 @@ __all__ = [
     "HertzResult", "hertz_point", "hertz_line", "Oil", "OILS", "get_oil", "make_oil",
     "Surface", "make_surface", "FrictionResult", "friction_coefficient", "friction_traced",
     "mesh_losses", "mesh_losses_traced", "stribeck_curve", "solve_ehl",
+    # loaded contact and mesh efficiency
+    "mesh_efficiency", "efficiency_function", "efficiency_warnings", "MeshEfficiency",
+    "LoadedContact", "check_operating_point", "TORQUE_RANGE_NM", "RPM_RANGE", "COMPLIANCE_MODELS",
     # optimisers and solvers
     "minimize_optax", "minimize_lbfgsb", "least_squares_lm", "OptResult", "LMResult",
     "status_message", "newton_solve", "NewtonResult", "ConvergenceError",

@@ -22,6 +22,7 @@ COMMANDS = [
     "gearjax.commands.friction",
     "gearjax.commands.kinematics",
     "gearjax.commands.tca",
+    "gearjax.commands.efficiency",
 ]
 
 

@@ -220,24 +220,9 @@ def lever_arms(point, normal, gear_ratio):
     return l1, l1 / jnp.abs(gear_ratio)
 
 
-def _elementwise(fn, *args):
-    """``fn`` of scalars mapped over the broadcast arrays ``args`` (vmap)."""
-    args = jnp.broadcast_arrays(*(jnp.asarray(a, float) for a in args))
-    shape = args[0].shape
-    out = jax.vmap(fn)(*(a.ravel() for a in args))
-    return jax.tree.map(lambda v: v.reshape(shape), out)
-
-
-def _hertz_pab(F, r_x, r_y, E_prime):
-    def one(F, rx, ry, E):
-        hz = hertz_exact(F, rx, ry, E)
-        return hz.p_max, hz.a, hz.b
-    return _elementwise(one, F, r_x, r_y, E_prime)
-
-
 def hertz_coefficient(r_x, r_y, E_prime):
     """Approach of a Hertz point contact at 1 N (mm/N^(2/3)); ``delta = c F^(2/3)``."""
-    return _elementwise(lambda rx, ry, E: hertz_exact(1.0, rx, ry, E).approach, r_x, r_y, E_prime)
+    return hertz_exact(jnp.ones_like(jnp.asarray(r_x, float)), r_x, r_y, E_prime).approach
 
 
 def contact_stress(F, r_x, r_y, E_prime, line_length=None):
@@ -249,7 +234,8 @@ def contact_stress(F, r_x, r_y, E_prime, line_length=None):
     on = F > 0.0
     Fs = jnp.where(on, F, 1.0)
     if line_length is None:
-        p, a, b = _hertz_pab(Fs, r_x, r_y, E_prime)
+        hz = hertz_exact(Fs, r_x, r_y, E_prime)
+        p, a, b = hz.p_max, hz.a, hz.b
     else:
         Ls = jnp.where(on, line_length, 1.0)
         b, p = hertz_line_traced(Fs / Ls, r_x, E_prime)

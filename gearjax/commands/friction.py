@@ -63,7 +63,8 @@ RANGES = {
 }
 
 
-def _check(flag, value):
+def check_flag(flag, value):
+    """``value`` of option ``flag`` checked against :data:`RANGES` (one-line ValueError)."""
     lo, hi, lo_open, unit = RANGES[flag]
     return check_range(flag, value, lo, hi, lo_open=lo_open, unit=unit)
 
@@ -74,8 +75,18 @@ def _add_common(p):
                    help="relative radius of curvature in the rolling direction (mm, in (0, 1e6])")
     p.add_argument("--ry-mm", type=float, required=True,
                    help="relative radius of curvature in the transverse direction (mm, in (0, 1e6])")
+    add_lubricant_options(p)
+    p.add_argument("--json", action="store_true", help="print JSON instead of a table")
+
+
+def add_lubricant_options(p):
+    """The oil (--oil NAME, or --eta0 with --alpha-per-GPa/--tau0-MPa), surface
+    (--sigma-um, asperity options, --fc), --E-prime-MPa, --film and --viscosity
+    options shared by the friction, stribeck and efficiency commands
+    (read back by :func:`lubricant_from_args`)."""
     g = p.add_mutually_exclusive_group(required=True)
-    g.add_argument("--oil", help="example oil: mineral_vg100 | mineral_vg220 | pao_vg100")
+    g.add_argument("--oil", help="example oil: mineral_vg100 | mineral_vg220 | pao_vg100 "
+                                 "(gearjax.OILS)")
     g.add_argument("--eta0", type=float, help="inlet viscosity (Pa·s, in (6.31e-5, 100])")
     p.add_argument("--alpha-per-GPa", type=float, default=None,
                    help="pressure-viscosity coefficient with --eta0 (1/GPa, in (0, 100], default 20)")
@@ -95,7 +106,6 @@ def _add_common(p):
     p.add_argument("--film", choices=["auto", "point", "line"], default="auto",
                    help="film formula (default auto: Hamrock-Dowson blended into line contact)")
     p.add_argument("--viscosity", choices=["roelands", "barus"], default="roelands")
-    p.add_argument("--json", action="store_true", help="print JSON instead of a table")
 
 
 def register(sub):
@@ -127,16 +137,25 @@ def register(sub):
 
 
 def _materials(args):
-    from gearjax.tribology import get_oil, make_oil, make_surface
-    from gearjax.tribology.friction import STEEL_E_PRIME
-
-    for flag in ("--load-N", "--rx-mm", "--ry-mm", "--sigma-um", "--asperity-density-per-mm2",
-                 "--asperity-radius-um", "--fc"):
-        _check(flag, getattr(args, flag[2:].replace("-", "_")))
+    for flag in ("--load-N", "--rx-mm", "--ry-mm"):
+        check_flag(flag, getattr(args, flag[2:].replace("-", "_")))
     ratio = max(args.rx_mm, args.ry_mm) / min(args.rx_mm, args.ry_mm)
     if ratio > 1e15:
         raise ValueError(f"--ry-mm / --rx-mm = {args.ry_mm / args.rx_mm:g} is outside the "
                          "allowed range [1e-15, 1e15]")
+    return lubricant_from_args(args)
+
+
+def lubricant_from_args(args):
+    """``(Oil, Surface, E')`` from the options of :func:`add_lubricant_options`,
+    each checked against :data:`RANGES` (one-line ValueError naming the option; an
+    unknown --oil lists the known ones).  Model-range warnings of ``make_oil`` are
+    Python warnings (the commands print them as ``gearjax: warning:`` lines)."""
+    from gearjax.tribology import get_oil, make_oil, make_surface
+    from gearjax.tribology.friction import STEEL_E_PRIME
+
+    for flag in ("--sigma-um", "--asperity-density-per-mm2", "--asperity-radius-um", "--fc"):
+        check_flag(flag, getattr(args, flag[2:].replace("-", "_")))
     if args.oil is not None:
         for flag in ("--alpha-per-GPa", "--tau0-MPa"):
             if getattr(args, flag[2:].replace("-", "_")) is not None:
@@ -149,10 +168,10 @@ def _materials(args):
         if args.tau0_MPa is None:
             args.tau0_MPa = 5.0
         for flag in ("--eta0", "--alpha-per-GPa", "--tau0-MPa"):
-            _check(flag, getattr(args, flag[2:].replace("-", "_")))
+            check_flag(flag, getattr(args, flag[2:].replace("-", "_")))
         oil = make_oil(args.eta0, args.alpha_per_GPa, args.tau0_MPa)
     surf = make_surface(args.sigma_um, args.asperity_density_per_mm2, args.asperity_radius_um, args.fc)
-    Ep = STEEL_E_PRIME if args.E_prime_MPa is None else _check("--E-prime-MPa", args.E_prime_MPa)
+    Ep = STEEL_E_PRIME if args.E_prime_MPa is None else check_flag("--E-prime-MPa", args.E_prime_MPa)
     return oil, surf, Ep
 
 
@@ -168,8 +187,8 @@ def run_friction(args) -> int:
 
     from gearjax.commands import print_json, warn_nonfinite
 
-    _check("--ue", args.ue)
-    _check("--us", args.us)
+    check_flag("--ue", args.ue)
+    check_flag("--us", args.us)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         oil, surf, Ep = _materials(args)
@@ -215,7 +234,7 @@ def run_stribeck(args) -> int:
     from gearjax.tribology import REGIMES, stribeck_curve
 
     for flag in ("--srr", "--ue-min", "--ue-max"):
-        _check(flag, getattr(args, flag[2:].replace("-", "_")))
+        check_flag(flag, getattr(args, flag[2:].replace("-", "_")))
     if args.ue_max <= args.ue_min:
         raise ValueError(f"--ue-max = {args.ue_max:g} m/s must exceed --ue-min = {args.ue_min:g} m/s")
     n = check_int("--points", args.points, 2, 2000)

@@ -17,6 +17,8 @@ import sys
 
 import numpy as np
 
+from gearjax.commands.designs import involute_design, parse_misalign
+
 JSON_KEYS_DOC = """JSON keys:
   input            the design and options as given
   phi1_rad         pinion angles of the grid (rad); the reference (pitch point) in the middle
@@ -77,45 +79,6 @@ def register(sub):
     p.set_defaults(func=run)
 
 
-#: widest accepted face width of an inline involute design (mm)
-MAX_FACE_WIDTH_MM = 1000.0
-
-_ALLOWED = {"z1", "z2", "m", "alpha", "b", "helix", "x1", "x2", "dalpha", "crown", "lead_crown"}
-
-
-def _parse_kv(text, allowed, what):
-    out = {}
-    for item in filter(None, (s.strip() for s in text.split(","))):
-        if "=" not in item:
-            raise ValueError(f"{what}: {item!r} is not KEY=VALUE")
-        k, v = (s.strip() for s in item.split("=", 1))
-        if k not in allowed:
-            raise ValueError(f"{what}: unknown key {k!r} (allowed: {', '.join(sorted(allowed))})")
-        if k in out:
-            raise ValueError(f"{what}: {k} is given twice")
-        try:
-            out[k] = float(v)
-        except ValueError:
-            raise ValueError(f"{what}: {k} = {v!r} must be a number") from None
-    return out
-
-
-def _design(text):
-    from gearjax import InvolutePair, InvoluteTCA
-
-    from gearjax.errors import check_range
-
-    kv = _parse_kv(text[len("involute:"):], _ALLOWED, "design")
-    missing = [k for k in ("z1", "z2", "m", "alpha", "b") if k not in kv]
-    if missing:
-        raise ValueError(f"design: missing {', '.join(missing)}")
-    check_range("design b (face width)", kv["b"], 0.0, MAX_FACE_WIDTH_MM, lo_open=True, unit="mm")
-    pair = InvolutePair.create(kv["z1"], kv["z2"], kv["m"], kv["alpha"], kv.get("helix", 0.0),
-                               kv.get("x1", 0.0), kv.get("x2", 0.0))
-    return kv, InvoluteTCA.create(pair, kv["b"], kv.get("dalpha", 0.0), kv.get("crown", 0.0),
-                                  kv.get("lead_crown", 0.0))
-
-
 def _nan_list(a):
     a = np.asarray(a, float)
     return [None if not np.isfinite(x) else float(x) for x in a.ravel()]
@@ -123,7 +86,7 @@ def _nan_list(a):
 
 def _involute_side(args, mis, m, side_name, half, kin):
     import gearjax as gj
-    _, des = _design(args.design)
+    _, des = involute_design(args.design)
     res = gj.run_tca(des, mis, side=side_name, steps_per_pitch=m, half_pitches=half,
                      kinematics=kin)
     return res, gj.involute_limits(des, side_name)
@@ -213,15 +176,13 @@ def _failure(side, exc, args) -> str:
 
 
 def run(args) -> int:
-    from gearjax import ConvergenceError, Misalignment
+    from gearjax import ConvergenceError
     from gearjax.commands import print_json
     from gearjax.errors import check_int, check_range
     from gearjax.io import check_output_path
     from gearjax.progress import Progress
 
-    mis_kv = _parse_kv(args.misalign, {"dE", "dP", "dG", "dSigma"}, "misalign")
-    mis = Misalignment.create(mis_kv.get("dE", 0.0), mis_kv.get("dP", 0.0),
-                              mis_kv.get("dG", 0.0), mis_kv.get("dSigma", 0.0))
+    mis_kv, mis = parse_misalign(args.misalign)
     n = check_int("positions", args.positions, lo=11, hi=1001)
     if (n - 1) % 10:
         raise ValueError(f"positions = {n} must be of the form 10k+1 (11, 21, ..., 61, ...)")
@@ -231,7 +192,7 @@ def run(args) -> int:
         check_output_path(args.plot, "--plot", (".png",))
     sides = ["drive", "coast"] if args.side == "both" else [args.side]
     if args.design.startswith("involute:"):
-        _design(args.design)                       # validate before any tracing
+        involute_design(args.design)               # validate before any tracing
         solve = lambda side: _involute_side(args, mis, m, side, half, args.kinematics)
     else:
         from gearjax import load_design

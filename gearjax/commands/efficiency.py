@@ -1,0 +1,303 @@
+"""``gearjax efficiency``: loaded contact, friction along the path of contact and mesh
+efficiency of a gear pair at one operating point (see :mod:`gearjax.mesh_efficiency`).
+
+DESIGN as for ``gearjax tca`` (:mod:`gearjax.commands.designs`): an inline involute
+pair or a hypoid/spiral-bevel design file / ``example:NAME``.  The oil, surface and
+film options are those of ``gearjax friction`` (:func:`gearjax.commands.friction.
+add_lubricant_options`, same ranges).  The pinion torque (N m) and speed (rpm) are
+checked against :data:`gearjax.TORQUE_RANGE_NM` and :data:`gearjax.RPM_RANGE`.
+
+Exit status as ``gearjax tca``: 0 with a result (problems of the result -- TCA
+quality flags, positions whose load balance or friction solve did not converge, a
+loaded edge contact, a grid too short -- are ``gearjax: warning:`` lines on stderr
+and ``valid``/``warnings`` in the output); 2 bad input, refused before any work; 3
+no position of the cycle is valid (the result is printed, with one error line).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import warnings
+
+import numpy as np
+
+from gearjax.commands.designs import involute_design, is_involute, parse_misalign
+from gearjax.commands.friction import PLOT_SUFFIXES, add_lubricant_options, lubricant_from_args
+
+EFFICIENCY_KEYS_DOC = """JSON keys (K tooth pairs, M positions over one mesh cycle = one pinion pitch):
+  input                 the options as given (design, side, misalign, torque_Nm, rpm,
+                        oil, sigma_um, asperity options, fc, film, viscosity,
+                        compliance, positions, pitches, pairs) plus the oil's
+                        eta0_Pas, alpha_per_GPa, tau0_MPa and E_prime_MPa
+  phi1_deg              (M,) pinion angle of each position (deg; reference in the middle)
+  pairs                 (K,) tooth-pair index k of the rows below (pair k = pair 0
+                        shifted by k pinion pitches)
+  n_loaded              (M,) number of tooth pairs carrying load
+  load_N                (K, M) normal load of each pair (N; 0 where it carries none)
+  load_share            (K, M) torque share l1 F / T1 of each pair (sums to 1 over k)
+  p_max_MPa             (K, M) maximum Hertz pressure (MPa; null where unloaded)
+  lambda                (K, M) film parameter h_c / sigma (null where unloaded)
+  mu                    (K, M) friction coefficient (null where unloaded)
+  u_e_m_s               (K, M) entrainment speed |u_e| (m/s; null where unloaded)
+  u_s_m_s               (K, M) sliding speed |u_s| (m/s; null where unloaded)
+  regime                (K, M) "boundary" | "mixed" | "full film" (null where unloaded)
+  mu_position           (M,) load-weighted friction coefficient sum mu F / sum F
+  lambda_min            (M,) smallest lambda of the loaded pairs
+  p_max_position_MPa    (M,) highest p_max of the loaded pairs
+  power_loss_W          (M,) sliding power loss P_f = sum mu F |u_s| (W)
+  efficiency            (M,) eta_m = 1 - P_f / P_in
+  te_loaded_arcsec      (M,) loaded transmission error (arcsec)
+  valid                 (M,) every loaded contact converged (load balance, Hertz,
+                        friction), no loaded edge contact, grid not truncated
+  edge_loaded           (M,) an edge contact would carry load (not modelled)
+  mean_efficiency       eta_bar = 1 - mean(P_f) / P_in over the cycle (-)
+  mean_mu               sum mu F |u_s| / sum F |u_s| over the cycle (-)
+  max_p_max_MPa         highest Hertz pressure over the cycle (MPa)
+  power_in_W            P_in = T1 omega1 (W)
+  mean_power_loss_W     mean P_f over the cycle (W)
+  te_loaded_ptp_arcsec  peak-to-peak of the loaded TE over the cycle (arcsec)
+  truncated             the TCA grid or the number of pairs misses a pair in contact
+  quality               contact-quality flags of the unloaded TCA (as gearjax tca)
+  warnings              the warning lines (also on stderr)
+  plot                  the figure's path or null"""
+
+#: positions per mesh cycle and the grid/pair options (ranges of the TCA options)
+POSITIONS_RANGE = (4, 400)
+PITCHES_RANGE = (0.75, 4.0)
+PAIRS_RANGE = (3, 9)
+
+#: exit status when no position of the cycle gives a valid result
+NO_VALID_STATUS = 3
+
+
+def register(sub):
+    import gearjax as gj
+
+    p = sub.add_parser(
+        "efficiency", help="loaded contact, friction and mesh efficiency at a torque and speed",
+        description="Load sharing between the tooth pairs, Hertz pressure, film parameter, "
+                    "friction coefficient and sliding power loss at each position of one "
+                    "mesh cycle, and the mean mesh efficiency, of an involute pair or a "
+                    "hypoid/spiral-bevel design at a pinion torque and speed.",
+        epilog=EFFICIENCY_KEYS_DOC, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("design", help="involute:z1=..,z2=..,m=..,alpha=..,b=..[,...], or a "
+                                  "hypoid/spiral-bevel design file or example:NAME")
+    lo, hi = gj.TORQUE_RANGE_NM
+    p.add_argument("--torque-Nm", type=float, required=True,
+                   help=f"pinion torque (N m, in [{lo:g}, {hi:g}])")
+    lo, hi = gj.RPM_RANGE
+    p.add_argument("--rpm", type=float, required=True,
+                   help=f"pinion speed (rpm, in [{lo:g}, {hi:g}])")
+    add_lubricant_options(p)
+    p.add_argument("--side", choices=["drive", "coast"], default="drive")
+    p.add_argument("--misalign", default="",
+                   help="dE=mm,dP=mm,dG=mm,dSigma=deg (any subset; default all 0)")
+    p.add_argument("--compliance", choices=list(gj.COMPLIANCE_MODELS), default="iso6336",
+                   help="tooth compliance model of the load sharing (default iso6336)")
+    p.add_argument("--positions", type=float, default=None,
+                   help=f"positions per mesh cycle (one pinion pitch), integer "
+                        f"{POSITIONS_RANGE[0]}..{POSITIONS_RANGE[1]} (default 24 involute, "
+                        "16 hypoid)")
+    p.add_argument("--pitches", type=float, default=None,
+                   help=f"half-range of the TCA grid in pitches ({PITCHES_RANGE[0]:g} ... "
+                        f"{PITCHES_RANGE[1]:g}; default 1.25 involute, 2 hypoid)")
+    p.add_argument("--pairs", type=float, default=None,
+                   help=f"tooth pairs considered, odd {PAIRS_RANGE[0]}..{PAIRS_RANGE[1]} "
+                        "(default 3 involute, 5 hypoid)")
+    p.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    p.add_argument("--plot", default=None,
+                   help="write load share, mu and P_f along the mesh (.png, .pdf or .svg)")
+    p.set_defaults(func=run)
+
+
+def _grid_options(args) -> dict:
+    """The TCA options given on the command line (validated; absent = family default)."""
+    from gearjax.errors import check_int, check_range
+
+    opts = {}
+    if args.positions is not None:
+        opts["steps_per_pitch"] = check_int("--positions", args.positions, *POSITIONS_RANGE)
+    if args.pitches is not None:
+        opts["half_pitches"] = check_range("--pitches", args.pitches, *PITCHES_RANGE)
+    if args.pairs is not None:
+        k = check_int("--pairs", args.pairs, *PAIRS_RANGE)
+        if k % 2 == 0:
+            raise ValueError(f"--pairs = {k} must be odd (pairs -k..k)")
+        opts["n_pairs"] = k
+    return opts
+
+
+def _lists(a, mask=None, scale=1.0):
+    """Nested lists of ``a * scale``; ``None`` where ``mask`` is False (an intentional
+    gap: the pair carries no load).  Other non-finite values stay NaN, so that
+    :func:`gearjax.commands.print_json` writes them as null *and* warns."""
+    a = np.asarray(a, float) * scale
+    keep = np.ones(a.shape, bool) if mask is None else np.asarray(mask, bool)
+    if a.ndim == 0:
+        return float(a) if keep else None
+    return [_lists(x, m) for x, m in zip(a, keep)]
+
+
+def _position_stats(eff):
+    """Per position: load-weighted mu, smallest lambda, highest p_max (loaded pairs)."""
+    F = np.asarray(eff.loaded.load, float)
+    on = F > 0.0
+    mu = np.asarray(eff.friction.mu, float)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mu_pos = np.sum(np.where(on, mu * F, 0.0), axis=0) / np.sum(np.where(on, F, 0.0), axis=0)
+    lam = np.where(on, np.asarray(eff.friction.lam, float), np.inf).min(axis=0)
+    pmax = np.where(on, np.asarray(eff.loaded.p_max, float), -np.inf).max(axis=0)
+    any_on = on.any(axis=0)
+    return (np.where(any_on, mu_pos, np.nan), np.where(any_on, lam, np.nan),
+            np.where(any_on, pmax, np.nan))
+
+
+def _output(eff, res, inp, warn_lines, plot):
+    """The JSON object of the result (strict JSON: NaN -> null by print_json)."""
+    from gearjax import ARCSEC
+    from gearjax.tribology import REGIMES
+
+    F = np.asarray(eff.loaded.load, float)
+    on = F > 0.0
+    K = F.shape[0]
+    mu_pos, lam_min, pmax_pos = _position_stats(eff)
+    te = np.asarray(eff.loaded.te_loaded, float) / ARCSEC
+    pf = np.asarray(eff.power_loss, float)
+    fr = eff.friction
+    regime = np.asarray(fr.regime)
+    return {
+        "input": inp,
+        "phi1_deg": _lists(np.degrees(np.asarray(eff.phi1, float))),
+        "pairs": [int(k) for k in np.arange(K) - K // 2],
+        "n_loaded": [int(n) for n in np.asarray(eff.loaded.n_loaded)],
+        "load_N": _lists(F),
+        "load_share": _lists(eff.loaded.share),
+        "p_max_MPa": _lists(eff.loaded.p_max, on),
+        "lambda": _lists(fr.lam, on),
+        "mu": _lists(fr.mu, on),
+        "u_e_m_s": _lists(eff.u_e, on, 1e-3),
+        "u_s_m_s": _lists(eff.u_s, on, 1e-3),
+        "regime": [[REGIMES[int(g)] if o else None for g, o in zip(rg, ro)]
+                   for rg, ro in zip(regime, on)],
+        "mu_position": _lists(mu_pos),
+        "lambda_min": _lists(lam_min),
+        "p_max_position_MPa": _lists(pmax_pos),
+        "power_loss_W": _lists(pf),
+        "efficiency": _lists(eff.efficiency),
+        "te_loaded_arcsec": _lists(te),
+        "valid": [bool(v) for v in np.asarray(eff.valid)],
+        "edge_loaded": [bool(v) for v in np.asarray(eff.edge_loaded)],
+        "mean_efficiency": float(eff.mean_efficiency),
+        "mean_mu": float(eff.mean_mu),
+        "max_p_max_MPa": float(eff.max_p_max),
+        "power_in_W": float(eff.power_in),
+        "mean_power_loss_W": float(np.mean(pf)),
+        "te_loaded_ptp_arcsec": float(np.max(te) - np.min(te)),
+        "truncated": bool(np.asarray(eff.truncated)),
+        "quality": res.flags(),
+        "warnings": list(warn_lines),
+        "plot": plot,
+    }
+
+
+def _cell(v, width, fmt):
+    """A table cell, ``-`` where there is no value (no pair loaded)."""
+    if v is None or not np.isfinite(v):
+        return f"{'-':>{width}s}"
+    return f"{v:{width}{fmt}}"
+
+
+def _print_table(out, args):
+    phi = out["phi1_deg"]
+    pairs = out["pairs"]
+    share = np.asarray(out["load_share"], float)
+    print(f"# mesh efficiency {args.design} ({args.side}); T1 = {args.torque_Nm:g} N m, "
+          f"n1 = {args.rpm:g} rpm, oil {args.oil or 'custom'}, sigma = {args.sigma_um:g} um; "
+          f"misalign {out['input']['misalign'] or 'none'}")
+    head = " ".join(f"{f's[{k:+d}]':>7s}" for k in pairs)
+    print(f"{'phi1[deg]':>10s} {'n':>2s} {head} {'pmax[MPa]':>9s} {'lam_min':>8s} {'mu':>8s} "
+          f"{'P_f[W]':>10s} {'eta_m':>8s} flag")
+    for i in range(len(phi)):
+        flag = ("ok" if out["valid"][i] else "edge" if out["edge_loaded"][i] else "invalid")
+        shares = " ".join(_cell(s, 7, ".4f") for s in share[:, i])
+        print(f"{_cell(phi[i], 10, '.4f')} {out['n_loaded'][i]:2d} {shares} "
+              f"{_cell(out['p_max_position_MPa'][i], 9, '.1f')} "
+              f"{_cell(out['lambda_min'][i], 8, '.3f')} {_cell(out['mu_position'][i], 8, '.5f')} "
+              f"{_cell(out['power_loss_W'][i], 10, '.3f')} {_cell(out['efficiency'][i], 8, '.5f')} "
+              f"{flag}")
+    print(f"# eta_bar = {100.0 * out['mean_efficiency']:.4f} %  (mean P_f "
+          f"{out['mean_power_loss_W']:.3f} W)")
+    print(f"# mean mu = {out['mean_mu']:.5f}")
+    print(f"# max p_max = {out['max_p_max_MPa']:.1f} MPa")
+    print(f"# P_in = {out['power_in_W']:.2f} W")
+    print(f"# loaded TE p-t-p = {out['te_loaded_ptp_arcsec']:.4f} arcsec")
+    if out["plot"]:
+        print(f"# plot written to {out['plot']}")
+
+
+def run(args) -> int:
+    import gearjax as gj
+    from gearjax.commands import print_json, warn_nonfinite
+    from gearjax.errors import check_range
+    from gearjax.io import check_output_path
+    from gearjax.progress import Progress
+
+    # every input is checked before any work (one line naming it, status 2)
+    T = check_range("--torque-Nm", args.torque_Nm, *gj.TORQUE_RANGE_NM, unit="N m")
+    n = check_range("--rpm", args.rpm, *gj.RPM_RANGE, unit="rpm")
+    gj.check_operating_point(T, n)
+    mis_kv, mis = parse_misalign(args.misalign)
+    opts = _grid_options(args)
+    if args.plot is not None:
+        check_output_path(args.plot, "--plot", PLOT_SUFFIXES)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        oil, surf, Ep = lubricant_from_args(args)
+    design = (involute_design(args.design)[1] if is_involute(args.design)
+              else gj.load_design(args.design))
+    opts_all = {**gj.family_of(design).defaults, **opts}
+
+    with Progress(1, "efficiency") as bar, bar.phase(
+            f"{args.side} side: TCA, load sharing, friction ({opts_all['steps_per_pitch']} "
+            "positions)"):
+        eff, res = gj.mesh_efficiency(design, T, n, oil, surf, misalignment=mis, side=args.side,
+                                      compliance=args.compliance, E_prime=Ep,
+                                      viscosity_model=args.viscosity, film_method=args.film,
+                                      **opts)
+        bar.update()
+    for w in caught:
+        sys.stderr.write(f"gearjax: warning: {w.message}\n")
+    warn_lines = gj.efficiency_warnings(eff, res)
+    for w in warn_lines:
+        sys.stderr.write(f"gearjax: warning: {args.side} side: {w}\n")
+
+    if args.plot is not None:
+        from gearjax.plot.efficiency import efficiency_figure
+        from gearjax.plot.tribology import save_figure_atomic
+        save_figure_atomic(efficiency_figure(eff, title=f"{args.design} ({args.side})"),
+                           args.plot)
+    inp = {"design": args.design, "side": args.side, "misalign": mis_kv, "torque_Nm": T,
+           "rpm": n, "oil": args.oil, "eta0_Pas": float(oil.eta0),
+           "alpha_per_GPa": float(oil.alpha) * 1e3, "tau0_MPa": float(oil.tau0),
+           "sigma_um": args.sigma_um, "asperity_density_per_mm2": args.asperity_density_per_mm2,
+           "asperity_radius_um": args.asperity_radius_um, "fc": args.fc,
+           "E_prime_MPa": float(Ep), "film": args.film, "viscosity": args.viscosity,
+           "compliance": args.compliance, "positions": int(opts_all["steps_per_pitch"]),
+           "pitches": float(opts_all["half_pitches"]), "pairs": int(opts_all["n_pairs"])}
+    out = _output(eff, res, inp, warn_lines, args.plot)
+    status = 0
+    if not any(out["valid"]) or not math.isfinite(out["mean_efficiency"]):
+        sys.stderr.write(f"gearjax: error: {args.side} side: no position of the mesh cycle gives "
+                         "a valid loaded contact (see the warnings); try another --side, "
+                         "smaller --misalign values, a wider grid (--pitches 2) or check the "
+                         "design\n")
+        status = NO_VALID_STATUS
+    if args.json:
+        print_json(out)
+        return status
+    warn_nonfinite(k for k in ("mean_efficiency", "mean_mu", "max_p_max_MPa", "power_in_W")
+                   if not math.isfinite(out[k]))
+    _print_table(out, args)
+    return status

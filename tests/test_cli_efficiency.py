@@ -1,0 +1,157 @@
+"""``gearjax efficiency`` in-process: one run of the command on a small spur pair (JSON
+and a figure; the compile dominates, so it is shared by the tests of the result), and
+refusals of bad input that must come before any JAX work."""
+
+import contextlib
+import io
+import json
+import os
+import re
+
+import numpy as np
+import pytest
+
+import gearjax
+from gearjax.cli import main
+from gearjax.commands.efficiency import EFFICIENCY_KEYS_DOC
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+DESIGN = "involute:z1=20,z2=40,m=4,alpha=20,b=30"
+BASE = [DESIGN, "--torque-Nm", "200", "--rpm", "1500", "--oil", "mineral_vg100",
+        "--sigma-um", "0.4"]
+
+
+def _strict(text):
+    def no_constant(name):
+        raise AssertionError(f"non-strict JSON constant {name}")
+    return json.loads(text, parse_constant=no_constant)
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory):
+    """The one real run: 8 positions per mesh cycle, JSON on stdout, a PNG."""
+    d = tmp_path_factory.mktemp("eff")
+    png = d / "eff.png"
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        rc = main(["efficiency", *BASE, "--positions", "8", "--json", "--plot", str(png)])
+    return rc, out.getvalue(), err.getvalue(), d, png
+
+
+def _documented_keys():
+    keys = []
+    for line in EFFICIENCY_KEYS_DOC.splitlines()[1:]:
+        m = re.match(r"  (\w+)\s", line)
+        if m:
+            keys.append(m.group(1))
+    return keys
+
+
+def test_json_keys_documented_strict_and_plot(run):
+    rc, text, err, d, png = run
+    assert rc == 0, err
+    out = _strict(text)
+    assert sorted(out) == sorted(_documented_keys())
+    readme = open(os.path.join(ROOT, "README.md"), encoding="utf-8").read()
+    section = readme.split("### `gearjax efficiency`", 1)[1].split("\n### ", 1)[0]
+    missing = [k for k in out if f"`{k}`" not in section]
+    assert not missing, f"JSON keys not documented in the README's efficiency section: {missing}"
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and out["plot"] == str(png)
+    assert [p.name for p in d.iterdir()] == ["eff.png"]          # no temporary file left
+    assert "Traceback" not in err
+
+
+def test_load_shares_efficiency_and_summary(run):
+    out = _strict(run[1])
+    M = len(out["phi1_deg"])
+    assert M == 8 and out["pairs"] == [-1, 0, 1] and out["input"]["positions"] == 8
+    share = np.asarray(out["load_share"], float)
+    load = np.asarray(out["load_N"], float)
+    assert share.shape == (3, M)
+    assert np.allclose(share.sum(axis=0), 1.0, atol=1e-9)
+    # a spur pair of contact ratio ~1.6: one or two pairs in contact over the cycle
+    assert set(out["n_loaded"]) == {1, 2}
+    assert np.array_equal((load > 0).sum(axis=0), out["n_loaded"])
+    # unloaded pairs are null, loaded ones are numbers
+    mu = out["mu"]
+    assert all((mu[k][i] is None) == (load[k, i] == 0.0) for k in range(3) for i in range(M))
+    assert all(out["valid"]) and not out["truncated"]
+    assert 0.0 < out["mean_efficiency"] < 1.0
+    eta = np.asarray(out["efficiency"], float)
+    assert np.all((eta > 0.0) & (eta <= 1.0))
+    # eta_bar = 1 - mean(P_f)/P_in; P_in = T omega
+    assert out["power_in_W"] == pytest.approx(200.0 * 1500.0 * np.pi / 30.0, rel=1e-12)
+    assert out["mean_efficiency"] == pytest.approx(
+        1.0 - np.mean(out["power_loss_W"]) / out["power_in_W"], rel=1e-12)
+    assert 0.0 < out["mean_mu"] < 0.2 and out["max_p_max_MPa"] > 0.0
+    assert out["max_p_max_MPa"] == pytest.approx(max(out["p_max_position_MPa"]), rel=1e-12)
+
+
+def _no_work(monkeypatch):
+    def forbidden(*a, **k):
+        raise AssertionError("mesh_efficiency called for bad input")
+    monkeypatch.setattr(gearjax, "mesh_efficiency", forbidden)
+
+
+@pytest.mark.parametrize("flag,value,names", [
+    ("--torque-Nm", "-5", ["--torque-Nm", "-5", "0.001"]),
+    ("--torque-Nm", "0", ["--torque-Nm", "0.001"]),
+    ("--rpm", "0", ["--rpm", "0.001"]),
+    ("--rpm", "-100", ["--rpm", "-100"]),
+    ("--oil", "castor", ["castor", "mineral_vg100", "pao_vg100"]),
+    ("--sigma-um", "20", ["--sigma-um", "20", "10"]),
+    ("--positions", "2", ["--positions", "4"]),
+    ("--pairs", "4", ["--pairs", "odd"]),
+    ("--misalign", "dX=1", ["dX"]),
+])
+def test_bad_operating_point_refused_in_one_line(capsys, monkeypatch, flag, value, names):
+    _no_work(monkeypatch)
+    argv = ["efficiency", *BASE]
+    if flag in argv:
+        argv[argv.index(flag) + 1] = value
+    else:
+        argv += [flag, value]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("gearjax: error:")
+    assert all(n in err[0] for n in names), err[0]
+
+
+def test_bad_plot_path_refused_before_work(capsys, monkeypatch, tmp_path):
+    _no_work(monkeypatch)
+    assert main(["efficiency", *BASE, "--plot", str(tmp_path / "no" / "e.png")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--plot" in err[0] and "does not exist" in err[0]
+    assert main(["efficiency", *BASE, "--plot", str(tmp_path / "e.txt")]) == 2
+    assert "--plot" in capsys.readouterr().err
+    assert main(["efficiency", "example:no_such_design", *BASE[1:]]) == 2
+    assert "no_such_design" in capsys.readouterr().err
+
+
+def test_helical_pair_in_line_contact_refused_in_one_line(capsys):
+    """The library refuses it in its concrete set-up, before anything is traced."""
+    argv = ["efficiency", DESIGN + ",helix=15", *BASE[1:]]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "helix = 15" in err[0] and "lead_crown" in err[0]
+
+
+def test_table_from_the_same_result(run, capsys):
+    """The table printer on the run's result (a second run would compile again)."""
+    import argparse
+
+    from gearjax.commands.efficiency import _print_table
+    out = _strict(run[1])
+    args = argparse.Namespace(design=DESIGN, side="drive", torque_Nm=200.0, rpm=1500.0,
+                              oil="mineral_vg100", sigma_um=0.4)
+    _print_table(out, args)
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].startswith("# mesh efficiency involute:")
+    assert lines[1].split()[:5] == ["phi1[deg]", "n", "s[-1]", "s[+0]", "s[+1]"]
+    rows = lines[2:2 + 8]
+    assert all(r.split()[-1] == "ok" for r in rows)
+    assert float(rows[0].split()[0]) == pytest.approx(out["phi1_deg"][0], abs=1e-4)
+    summary = "\n".join(lines[10:])
+    for label in ("eta_bar", "mean mu", "max p_max", "P_in", "loaded TE p-t-p"):
+        assert label in summary
+    assert f"{100 * out['mean_efficiency']:.4f} %" in summary
