@@ -90,9 +90,11 @@ class MeshEfficiency(NamedTuple):
     truncated : the grid or the number of pairs does not cover every pair in contact.
     edge_loaded : (M,) an edge contact would be compressed under the load (its load
         is not modelled: the result is then not valid).
-    degenerate : (M,) a loaded point contact whose relative curvature along the
-        ellipse (nearly) vanishes, ``r_y > MAX_RADIUS_RATIO r_x`` (Hertz theory does
-        not apply; ``r_y`` is clamped there and the position is not valid).
+    degenerate : (M,) a contact of the TCA path whose relative curvature is not
+        positive definite (``r_y > MAX_RADIUS_RATIO r_x`` or infinite: on or beyond the
+        edge of regression of a generated flank, where the flank is undercut) would be
+        compressed under the load; such contacts carry no modelled load, and the
+        position is not valid.
     """
 
     phi1: jax.Array
@@ -153,13 +155,15 @@ def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, speed_ra
     on = res.on_flank & jnp.isfinite(kin.r_x) & jnp.isfinite(kin.u_e)
     line = teeth.line_length is not None
     # compliance and lever arms of pair 0 along the grid
+    # a true point contact has a positive definite relative curvature; where it is
+    # not (r_y > MAX_RADIUS_RATIO r_x, or infinite), the contact lies on or beyond the
+    # edge of regression of a generated flank (undercut: that part of the flank is
+    # not there) -- no surface contact: excluded like an edge contact, flagged when
+    # the loaded gear would press on it
+    degenerate0 = (on & ~(kin.r_y < MAX_RADIUS_RATIO * kin.r_x)) if not line else on & False
+    on = on & ~degenerate0
     r_x0 = jnp.where(on, kin.r_x, 1.0)
-    # a point contact whose relative curvature (nearly) vanishes along the ellipse is
-    # degenerate (Hertz theory does not apply): clamp the radius ratio, flag it
-    degenerate0 = on & ~(kin.r_y < MAX_RADIUS_RATIO * kin.r_x) if not line else on & False
-    r_y0 = (jnp.where(on, kin.r_y, jnp.inf) if line
-            else jnp.where(on, jnp.minimum(jnp.nan_to_num(kin.r_y, posinf=jnp.inf),
-                                           MAX_RADIUS_RATIO * r_x0), 1.0))
+    r_y0 = jnp.where(on, kin.r_y, jnp.inf) if line else jnp.where(on, kin.r_y, 1.0)
     l1_0, l2_0 = lever_arms(path.point, path.normal, jnp.where(on, kin.gear_ratio, 1.0))
     T1 = 1e3 * jnp.asarray(torque_Nm, float)
     # nominal load per unit length of a line contact (one pair carrying the torque):
@@ -226,7 +230,9 @@ def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, speed_ra
     e_te = pairs(jnp.where(edge, path.te, 0.0), 0.0)
     e_act = pairs(edge, False)
     edge_loaded = jnp.any(e_act & (sgn * (e_te - (env - sgn * y)) > 0.0), axis=0)
-    degenerate = jnp.any(pairs(degenerate0, False) & loaded_on, axis=0)
+    d_te = pairs(jnp.where(degenerate0, path.te, 0.0), 0.0)
+    degenerate = jnp.any(pairs(degenerate0, False) & (sgn * (d_te - (env - sgn * y)) > 0.0),
+                         axis=0)
     valid = (conv & jnp.all(fr.converged | ~loaded_on, axis=0) & ~edge_loaded & ~truncated
              & ~degenerate)
     return MeshEfficiency(path.phi1[win], lc, ue, us, R_x, R_y, fr, ml.power_loss, ml.efficiency,
@@ -321,9 +327,9 @@ def efficiency_warnings(eff: MeshEfficiency, res: TCAResult) -> list[str]:
         out.append(f"edge contact under load at {int(np.sum(np.asarray(eff.edge_loaded)))} "
                    "positions (its load is not modelled)")
     if np.any(np.asarray(eff.degenerate)):
-        out.append(f"degenerate contact (relative curvature along the ellipse ~ 0, r_y/r_x > "
-                   f"{MAX_RADIUS_RATIO:g}) under load at {int(np.sum(np.asarray(eff.degenerate)))} "
-                   "positions: Hertz theory does not apply there")
+        out.append(f"contact beyond the edge of regression of a flank (relative curvature not "
+                   f"positive definite, r_y/r_x > {MAX_RADIUS_RATIO:g}) under load at "
+                   f"{int(np.sum(np.asarray(eff.degenerate)))} positions: not modelled")
     if not np.all(np.asarray(eff.loaded.converged)):
         out.append("load sharing did not converge at some positions")
     if not np.all(valid):
