@@ -231,16 +231,21 @@ def synthesise_member(E: float):
     st = sy.start(d0, "drive")
     log(f"[E={E:g}] blank {info['blank_method']}, beta_m1 {info['pinion_spiral_deg']:.4f} deg, "
         f"start {time.perf_counter() - t0:.1f} s (drive={st.drive}, hand={st.pair.hand})")
-    v = V0
-    for a in CONTINUATION:
-        t = time.perf_counter()
-        v = sy.synthesise(st, sy.Targets(TARGETS.xi1, TARGETS.h1_mm, TARGETS.te_arcsec, a,
-                                         TARGETS.semi_major_mm), v0=v).v
-        log(f"[E={E:g}]   path {a:g} deg solved in {time.perf_counter() - t:.1f} s")
-    t = time.perf_counter()
-    res = sy.synthesise(st, TARGETS, v0=v)
-    log(f"[E={E:g}]   path {TARGETS.path_angle_deg:g} deg solved in {time.perf_counter() - t:.1f} s, "
-        f"{res.iterations} steps, residuals {np.round(res.residuals, 6).tolist()}")
+    route = "continuation from -65 deg"
+    try:
+        v = V0
+        for a in CONTINUATION:
+            t = time.perf_counter()
+            v = sy.synthesise(st, sy.Targets(TARGETS.xi1, TARGETS.h1_mm, TARGETS.te_arcsec, a,
+                                             TARGETS.semi_major_mm), v0=v).v
+            log(f"[E={E:g}]   path {a:g} deg solved in {time.perf_counter() - t:.1f} s")
+        res = sy.synthesise(st, TARGETS, v0=v)
+    except Exception as exc:          # e.g. E = 0: the -60 deg step loses the reference contact
+        log(f"[E={E:g}]   continuation failed ({exc!r}); direct solve for the targets from v0")
+        route = "direct from v0 (continuation failed: " + repr(exc)[:120] + ")"
+        res = sy.synthesise(st, TARGETS, v0=V0)
+    log(f"[E={E:g}]   path {TARGETS.path_angle_deg:g} deg: {res.iterations} steps, "
+        f"residuals {np.round(res.residuals, 6).tolist()}")
     st_c = sy.start(d0, "coast")
     pin_c = sy.apply_variables(st_c.pair.pinion, jnp.asarray(res.v), st_c.theta_m)
     pairs = {"drive": res.pair, "coast": th.HypoidPair(
@@ -255,7 +260,7 @@ def synthesise_member(E: float):
     path = FAMILY_DIR / f"offset_E{E:g}.toml"
     atomic_write(path, HEADER.format(E=E, method=info["blank_method"]) + "\n" + dumps_toml(out.data))
     back = load_design(path)
-    info.update(synthesis_seconds=time.perf_counter() - t0, synthesis_iterations=res.iterations,
+    info.update(synthesis_route=route, synthesis_seconds=time.perf_counter() - t0, synthesis_iterations=res.iterations,
                 synthesis_residuals=dict(zip(sy.RESIDUAL_NAMES, res.residuals.tolist())),
                 synthesis_achieved=res.achieved, synthesis_v=dict(zip(sy.VARIABLES, res.v.tolist())),
                 design_file=str(path.relative_to(ROOT)))
@@ -324,10 +329,19 @@ def evaluate(design, info, oil, surface):
         entrainment_mean_mm_s=float(np.sum((F * np.asarray(eff.u_e))[loaded]) / wsum),
         sliding_at_reference_mm_s=dict(total=float(S[mid] * omega), lengthwise=float(Sl[mid] * omega),
                                        profile=float(Sp[mid] * omega)),
-        contacts_loaded_mean=float(np.mean(np.asarray(eff.loaded.n_loaded))) if hasattr(eff.loaded, "n_loaded") else None,
+        contacts_loaded_mean=float(np.mean(np.asarray(eff.loaded.n_loaded))),
         lambda_min=float(np.min(np.asarray(eff.friction.lam)[loaded])),
         lambda_mean=float(np.sum((F * np.asarray(eff.friction.lam))[loaded]) / wsum),
         valid=np.asarray(eff.valid).tolist(),
+        degenerate=np.asarray(eff.degenerate).tolist(),
+        mean_efficiency_valid_positions=float(1.0 - np.mean(np.asarray(eff.power_loss)[np.asarray(eff.valid)])
+                                              / float(eff.power_in)) if np.any(np.asarray(eff.valid)) else None,
+        power_loss_W=np.asarray(eff.power_loss).tolist(),
+        h1_range_loaded_mm=[float(np.min(kp(np.asarray(res.coords["h1"]))[loaded])),
+                            float(np.max(kp(np.asarray(res.coords["h1"]))[loaded]))],
+        xi1_range_loaded=[float(np.min(kp(np.asarray(res.coords["xi1"]))[loaded])),
+                          float(np.max(kp(np.asarray(res.coords["xi1"]))[loaded]))],
+        contact_ratio_unloaded=float(np.asarray(res.multi.contact_ratio)),
         truncated=bool(np.asarray(eff.truncated)),
         warnings=efficiency_warnings(eff, res),
         efficiency_seconds=secs, frame_check=chk, **info)
