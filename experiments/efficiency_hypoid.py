@@ -14,9 +14,8 @@ Objective (smooth, in a jitted optax loop through ``gearjax.optimize``)::
     J = P_f / P_f,0                                   mean mesh power loss over a pitch
       + 10 relu(ptp - PTP_MAX)^2 / arcsec^2           unloaded TE peak-to-peak bound
       + 10 relu(MARGIN_MIN - margin_ref)^2 / mm^2     bearing stays on the flank
-      + 10 relu(|xi| - XI_MAX)^2 (on-flank points)    no contact near the face ends
+      + 10 relu(|xi_ref| - XI_MAX)^2                  bearing centred along the face
       + 10 relu(CR_MIN - contact ratio)^2
-      + 10 sum relu(RX_MIN - R_x)^2 / mm^2 (loaded)   away from the edge of regression
 
 The end design is re-checked with the full forward model (``mesh_efficiency`` and
 the TCA quality flags: no edge contact, converged, valid positions) and saved as a
@@ -55,7 +54,7 @@ RESULTS = ROOT / "experiments" / "results"
 DESIGN = "hypoid_iso_10x41_synthesised"
 TORQUE, RPM, SIGMA_UM = 200.0, 1000.0, 0.4
 OIL = gj.OILS[0]
-PTP_MAX, MARGIN_MIN, XI_MAX, CR_MIN, RX_MIN = 15.0, 1.0, 0.9, 1.2, 3.0
+PTP_MAX, MARGIN_MIN, XI_MAX, CR_MIN = 15.0, 1.0, 0.5, 1.2
 #: (field, scale): one unit of the optimiser's variable
 VARIABLES = [("pinion.machine.radial_distance", 1.0), ("pinion.machine.cradle_angle", 0.01),
              ("pinion.machine.tilt", 0.01), ("pinion.machine.swivel", 0.01),
@@ -103,13 +102,9 @@ def terms(eff, res, p0):
     loss = jnp.mean(eff.power_loss) / p0
     pen_te = jax.nn.relu(ptp - PTP_MAX) ** 2
     pen_m = jax.nn.relu(MARGIN_MIN - res.margin[mid]) ** 2
-    pen_xi = jnp.sum(jnp.where(on, jax.nn.relu(xi - XI_MAX) ** 2, 0.0))
+    pen_xi = jax.nn.relu(xi[mid] - XI_MAX) ** 2
     pen_cr = jax.nn.relu(CR_MIN - jnp.nan_to_num(res.contact_ratio)) ** 2
-    # loaded contacts away from the flank's edge of regression (r_x -> 0 near the
-    # pinion root, where Hertz theory fails: the "degenerate" positions)
-    loaded = eff.loaded.load > 0.0
-    pen_rx = jnp.sum(jnp.where(loaded, jax.nn.relu(RX_MIN - eff.r_x) ** 2, 0.0))
-    return loss, pen_te, pen_m, pen_xi, pen_cr, pen_rx
+    return loss, pen_te, pen_m, pen_xi, pen_cr
 
 
 def summary(eff, res):
@@ -131,7 +126,7 @@ def summary(eff, res):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--steps", type=int, default=60)
-    ap.add_argument("--lr", type=float, default=0.01)
+    ap.add_argument("--lr", type=float, default=0.004)
     args = ap.parse_args(argv)
     t0 = time.time()
     design, f, names, x0, scale, pair_of, evaluate = setup()

@@ -24,7 +24,7 @@ import gearjax as gj
 from gearjax.gears.involute.geometry import pair_geometry
 from gearjax.gears.involute.mesh import ohlendorf_loss_factor
 from gearjax.loaded_contact import BALANCE_TOL
-from gearjax.mesh_efficiency import efficiency_function, efficiency_warnings, mesh_efficiency
+from gearjax.mesh_efficiency import efficiency_warnings, mesh_efficiency, mesh_efficiency_traced
 from gearjax.tooth_compliance import iso6336_mesh_stiffness, iso6336_single_stiffness
 
 Z1, Z2, M, B = 20, 40, 4.0, 30.0
@@ -120,21 +120,39 @@ def test_weber_mean_mesh_stiffness_against_iso6336(spur, weber_run):
     assert y[n == 2].max() < y[n == 1].min()
 
 
-def test_gradients_against_central_differences(spur, oil_surface):
+def test_gradients_against_central_differences(spur, oil_surface, iso_run):
+    """d eta_bar through the loads, kinematics and friction: with respect to torque,
+    roughness, viscosity and two perturbations of the TCA result (on the unloaded TE,
+    i.e. the separations the load closes, and a scale on the radii of curvature r_x), against central differences.  The TE perturbation is a
+    slope ``a (phi1 - phi1_ref)`` (rad/rad), a base-pitch-mismatch-like separation of
+    the pairs in double contact.  (The TCA's own gradients
+    w.r.t. design fields are tested in tests/test_tca*.py; the whole chain of the
+    hypoid example against central differences is experiments/efficiency_gradients.py.)"""
     oil, surf = oil_surface
     oil = dataclasses.replace(oil, name="")
-    f = efficiency_function(spur[1], compliance="iso6336")
+    _, res = iso_run
+    des = spur[1]
+    teeth_of = gj.family_of(des).mesh(des)[0]
 
     def eta(v):
-        T, sigma, eta0 = v[0], v[1], v[2]
-        eff, _ = f(f.pair, T, RPM * np.pi / 30.0, dataclasses.replace(oil, eta0=eta0),
-                   dataclasses.replace(surf, sigma=sigma))
+        T, sigma, eta0, a, b = v
+        mid = res.path.phi1.shape[0] // 2
+        path = res.path._replace(te=res.path.te + a * (res.path.phi1 - res.path.phi1[mid]))
+        kin = res.kinematics._replace(r_x=res.kinematics.r_x * (1.0 + b))
+        r = dataclasses.replace(res, path=path, kinematics=kin)
+        eff = mesh_efficiency_traced(r, teeth_of(des, r), T, RPM * np.pi / 30.0,
+                                     dataclasses.replace(oil, eta0=eta0),
+                                     dataclasses.replace(surf, sigma=sigma),
+                                     steps_per_pitch=24, n_pairs=3, compliance="weber")
         return eff.mean_efficiency
 
-    x0 = jnp.array([TORQUE, float(surf.sigma), float(oil.eta0)])
+    x0 = jnp.array([TORQUE, float(surf.sigma), float(oil.eta0), 0.0, 0.0])
     jeta = jax.jit(eta)
     g = jax.jit(jax.grad(eta))(x0)
-    for i in range(3):
-        h = 1e-4 * float(x0[i])
+    assert np.all(np.isfinite(g))
+    for i in range(5):
+        h = 1e-4 * float(x0[i]) if x0[i] != 0 else 1e-6
         fd = (jeta(x0.at[i].add(h)) - jeta(x0.at[i].add(-h))) / (2 * h)
-        np.testing.assert_allclose(g[i], fd, rtol=1e-5)
+        np.testing.assert_allclose(g[i], fd, rtol=1e-5, atol=1e-12)
+    # the separations matter: a TE slope unbalances the double-contact sharing
+    assert abs(float(g[3])) > 1e-6
