@@ -25,16 +25,13 @@ from pathlib import Path
 
 import jax
 import jax.numpy as jnp
-import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 import gearjax as gj  # noqa: E402
 from gearjax.io import atomic_write  # noqa: E402
-from gearjax.mesh_efficiency import efficiency_function  # noqa: E402
-
-DESIGN = "hypoid_iso_10x41_synthesised"
-TORQUE, RPM, SIGMA_UM, OIL = 200.0, 1000.0, 0.4, "mineral_vg100"
+sys.path.insert(0, str(ROOT / "experiments"))
+from efficiency_hypoid import DESIGN, RPM, TORQUE, chain  # noqa: E402
 H = 1e-6
 
 
@@ -43,13 +40,7 @@ def log(msg):
 
 
 def main():
-    design = gj.load_design(f"example:{DESIGN}")
-    f = efficiency_function(design, side="drive")
-    oil = dataclasses.replace(gj.get_oil(OIL), name="")
-    surf = gj.make_surface(SIGMA_UM)
-    names = [n for n in gj.field_names(f.pair) if ".machine." in n or ".cutter." in n]
-    d0 = gj.get_fields(f.pair, names)
-    x0 = jnp.stack([jnp.asarray(d0[n], float) for n in names])
+    design, f, oil, surf, names, x0 = chain()
     mis0 = gj.Misalignment.zero()
 
     def eta(x, mis, T, w, eta0, sigma):

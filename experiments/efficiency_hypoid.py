@@ -73,15 +73,23 @@ def log(msg):
     print(f"[efficiency_hypoid] {msg}", file=sys.stderr, flush=True)
 
 
-def setup():
+def chain(names=None):
+    """``(design, f, oil, surface, names, x0)``: the example's pure efficiency function
+    at the operating point's oil and surface, and the values ``x0`` of the design
+    fields ``names`` (default: every machine setting and cutter parameter)."""
     design = gj.load_design(f"example:{DESIGN}")
     f = efficiency_function(design, side="drive")
     oil = dataclasses.replace(gj.get_oil(OIL), name="")
     surf = gj.make_surface(SIGMA_UM)
-    names = [n for n, _ in VARIABLES]
-    scale = jnp.array([s for _, s in VARIABLES])
+    if names is None:
+        names = [n for n in gj.field_names(f.pair) if ".machine." in n or ".cutter." in n]
     d0 = gj.get_fields(f.pair, names)
-    x0 = jnp.stack([jnp.asarray(d0[n], float) for n in names])
+    return design, f, oil, surf, names, jnp.stack([jnp.asarray(d0[n], float) for n in names])
+
+
+def setup():
+    design, f, oil, surf, names, x0 = chain([n for n, _ in VARIABLES])
+    scale = jnp.array([s for _, s in VARIABLES])
     omega = RPM * math.pi / 30.0
 
     def pair_of(u):
@@ -97,7 +105,6 @@ def setup():
 
 def terms(eff, res, p0):
     """The objective's parts (traceable)."""
-    on = res.on_flank
     mid = res.path.phi1.shape[0] // 2
     ptp = res.ptp / gj.ARCSEC
     xi = jnp.maximum(jnp.abs(res.coords["xi1"]), jnp.abs(res.coords["xi2"]))
