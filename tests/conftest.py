@@ -67,3 +67,26 @@ def _release_compiled_code():
     """
     yield
     jax.clear_caches()
+
+
+# Test files in decreasing order of their cold-cache time (measured on 2 cores, mostly
+# XLA compilation; see docs/testing.md).  pytest-xdist hands whole files to the
+# workers in collection order (`--dist loadfile --no-loadscope-reorder` in
+# pyproject.toml; its default order, by number of tests, put the slowest files --
+# those with few, large tests -- last); starting the longest files first keeps a
+# worker from idling while the other finishes a long file at the end.  Files not
+# listed follow in their usual order.  A new slow file belongs in this list.
+SLOWEST_FIRST = (
+    "test_gradients_end_to_end.py", "test_cutter_radius_pair.py", "test_fuzz_designs.py",
+    "test_tca_hypoid.py", "test_synthesis.py", "test_synthesis_hypoid.py",
+    "test_edge_contact.py", "test_cutter_radius_study.py", "test_cli_tca.py",
+    "test_formate_pair.py", "test_tca.py", "test_cutter_radius_optimize.py",
+    "test_involute.py", "test_ehl.py", "test_kinematics.py", "test_notebooks.py",
+    "test_hypoid_surface.py", "test_tca_result.py",
+)
+
+
+def pytest_collection_modifyitems(config, items):
+    rank = {name: i for i, name in enumerate(SLOWEST_FIRST)}
+    # a stable sort: the tests of a file keep their order (module fixtures)
+    items.sort(key=lambda item: rank.get(item.path.name, len(rank)))

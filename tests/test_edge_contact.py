@@ -11,6 +11,8 @@ section by ``(b/2) dg cos aw / r_b2`` (Litvin & Fuentes, Gear Geometry and Appli
 Theory, ch. 15: a crossing of the axes of unmodified gears gives edge contact).
 """
 
+import json
+
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -128,8 +130,14 @@ def test_crowned_pinion_keeps_its_bearing_inside_and_a_large_crossing_is_flagged
 
 
 def test_cli_warns_on_edge_contact(capsys):
-    code = main(["tca", "involute:z1=20,z2=40,m=4,alpha=20,b=30", "--misalign", "dSigma=0.05",
-                 "--json"])
+    """The crowned helical pair of the test above at the large crossing, through the
+    CLI (61 positions = 24 steps per pitch, 1.25 pitches, kinematics: the options of
+    ``run_tca`` above, so the compiled program is shared): edge contact is warned on
+    stderr and flagged in the JSON."""
+    code = main(["tca", "involute:z1=20,z2=40,m=4,alpha=20,b=30,helix=15,x1=0.2,lead_crown=2e-4",
+                 "--misalign", "dSigma=0.5", "--kinematics", "--json"])
     out = capsys.readouterr()
     assert code == 0
     assert "edge contact at the" in out.err
+    q = json.loads(out.out)["quality"]
+    assert q["face_end_contact"] and q["edge_contact"]

@@ -37,7 +37,8 @@ CASES = {
 
 
 def setup(case):
-    c = CASES[case]
+    """``case``: a name of CASES, or its dict of (possibly traced) values."""
+    c = CASES[case] if isinstance(case, str) else case
     mesh = crossed_axes(c["shaft_angle"], c["offset"], c["ratio"])
     k2 = -mesh.omega2 / jnp.linalg.norm(mesh.omega2)
     P0 = jnp.array([30.0, 4.0, 12.0])
@@ -70,9 +71,10 @@ def contact_u(family2, psi, v=0.0):
                         0.0, jnp.stack([psi, v])).x
 
 
-def quantities(case):
-    """Everything the test compares, computed in one jitted call per case."""
-    mesh, sigma1, family2, sigma2_body, sigma2, k2 = setup(case)
+def quantities(params):
+    """Everything the test compares, for the case values ``params`` (traced: the three
+    cases run one compiled program)."""
+    mesh, sigma1, family2, sigma2_body, sigma2, k2 = setup(params)
     uv0 = jnp.zeros(2)
     g1 = local_geometry(sigma1, uv0)
     g2 = local_geometry(sigma2, uv0)
@@ -90,9 +92,12 @@ def quantities(case):
                 u_at_0=contact_u(family2, 0.0))
 
 
+_quantities = jax.jit(quantities)
+
+
 @pytest.mark.parametrize("case", list(CASES))
 def test_eigenfunctions_against_independent_routes(case):
-    d = jax.jit(quantities, static_argnums=0)(case)
+    d = _quantities({k: jnp.asarray(v, float) for k, v in CASES[case].items()})
     mesh, g1, g2, kin, vr1, vr2 = d["mesh"], d["g1"], d["g2"], d["kin"], d["vr1"], d["vr2"]
     assert abs(float(d["u_at_0"])) < 1e-12
     np.testing.assert_allclose(g2.r, g1.r, atol=1e-12)          # same point
