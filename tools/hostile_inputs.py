@@ -773,6 +773,33 @@ def build_cases() -> list[Case]:
                       ("nan_radial_distance", "drive"), ("list_sliding_base", "drive"),
                       ("string_sliding_base", "drive"), ("blank_offset_nan", "drive")):
         corrupt_case("tca", key, ["--side", side, "--json"], heavy=True)
+
+    # ---------------------------------------------------------------- efficiency
+    eff = [("--torque-Nm", "200"), ("--rpm", "1500"), ("--oil", "mineral_vg100"),
+           ("--sigma-um", "0.4")]
+    add("efficiency.ok.spur_json", ["efficiency", TCA_INV, *_argv(eff), "--json"], "ok",
+        "README example (spur pair), JSON", heavy=True)
+    for flag, values in {"--torque-Nm": ("0", "-200", "nan", "inf", "1e300", "abc"),
+                         "--rpm": ("0", "-1500", "nan", "inf", "1e300"),
+                         "--sigma-um": ("0", "-0.4", "nan", "1e300"),
+                         "--positions": ("0", "2", "1e6", "nan"),
+                         "--pairs": ("2", "0", "11")}.items():
+        for v in values:
+            add(f"efficiency.{flag[2:]}={_slug(v)}",
+                ["efficiency", TCA_INV, *_argv(eff, {flag: v}), "--json"], "refuse", f"{flag} {v}")
+    add("efficiency.oil=olive", ["efficiency", TCA_INV, *_argv(eff, {"--oil": "olive"})],
+        "refuse", "unknown oil")
+    add("efficiency.no_torque", ["efficiency", TCA_INV, *_argv(eff, {"--torque-Nm": None})],
+        "refuse", "missing --torque-Nm")
+    add("efficiency.helical_line_contact",
+        ["efficiency", "involute:z1=20,z2=40,m=4,alpha=20,b=30,helix=15", *_argv(eff)],
+        "refuse", "helical pair in line contact: the loaded contact needs a lead crown")
+    add("efficiency.plot_dir_missing",
+        ["efficiency", TCA_INV, *_argv(eff), "--plot", "{tmp}/no/such/dir/e.png"], "refuse",
+        "--plot into a missing directory: refused before any work")
+    add("efficiency.compliance=steel", ["efficiency", TCA_INV, *_argv(eff),
+                                        "--compliance", "steel"], "refuse",
+        "unknown compliance model")
     return cs
 
 
