@@ -227,6 +227,9 @@ def test_shear_integral_matches_graded_composite_rule(model):
                   axis=1) + np.arcsinh(X0 * np.exp(150.0)) * (1 - h * h) / 2)
     got = np.asarray(jax.jit(shear_integral, static_argnums=3)(pf, X0, oil, model))
     np.testing.assert_allclose(got, ref, rtol=2e-9)   # observed 3.9e-10 / 4.7e-10
+    # odd in X0 (signed sliding speeds in mesh arrays), as asinh
+    neg = np.asarray(jax.jit(shear_integral, static_argnums=3)(pf, -X0, oil, model))
+    np.testing.assert_allclose(neg, -got, rtol=1e-14)
     # at u_s = 0 the integral and its derivative in X0 are finite (∫ η/η0 s ds)
     oil1 = Oil(*(jnp.asarray(v) for v in (ETA0, Z, TAU0, 880.0)))
     assert float(shear_integral(1500.0, 0.0, oil1, model)) == 0.0
