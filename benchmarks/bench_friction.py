@@ -17,8 +17,8 @@ current figures of docs/friction.md.
 ``--devices N`` (N > 1) sets ``XLA_FLAGS=--xla_force_host_platform_device_count=N``
 before JAX starts and shards the points over the N CPU devices (a deployment option
 of the calling program: the flag is process-wide and must be set before JAX
-initialises, so the library does not set it).  XLA on CPU otherwise runs each
-fused elementwise kernel on one thread.
+initialises, so the library does not set it).  A single CPU device already runs the
+large fused kernels on all cores; measured gain of 2 devices: ~3 % (quiet machine).
 """
 
 from __future__ import annotations
