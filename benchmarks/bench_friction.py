@@ -3,20 +3,36 @@ gradient, the per-stage breakdown (Hertz ellipse, load sharing, shear integral, 
 jitted alone on the same points), against a NumPy/SciPy per-point loop (same model,
 same equations) on a subset, scaled.  Prints a table; not a test.
 
-    python benchmarks/bench_friction.py [--points 100000] [--baseline-points 200]
+    python benchmarks/bench_friction.py [--points 100000] [--baseline-points 200] [--devices 2]
 
 Before the fixed-step kernel (commit bcd37da, vmapped while-loop Newton solves with
 line search, lax.map over chunks of 1024) this machine measured 4.4e4 points/s
 forward and 3.8e4 points/s gradient at 2e4 points (docs/friction.md, Performance).
+The first fixed-step kernel (commit afbe9cf: 48-node shear rule, pow-based film
+formulas, 32-node load-sharing steps) measured 0.26 s of CPU per 1e5 points forward
+(3.8e5 points per CPU-second) and 0.70 s gradient; stages 0.029 (Hertz), 0.113
+(load sharing), 0.152 (shear) s of CPU per 1e5 points, in the same window as the
+current figures of docs/friction.md.
+
+``--devices N`` (N > 1) sets ``XLA_FLAGS=--xla_force_host_platform_device_count=N``
+before JAX starts and shards the points over the N CPU devices (a deployment option
+of the calling program: the flag is process-wide and must be set before JAX
+initialises, so the library does not set it).  A single CPU device already runs the
+large fused kernels on all cores; measured gain of 2 devices: ~3 % (quiet machine).
 """
 
 from __future__ import annotations
 
 import argparse
 import math
+import os
+import sys
 import time
 
 import numpy as np
+
+# benchmark the checkout this file belongs to, not an installed gearjax
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 
 def numpy_mu(F, ue, us, Rx, Ry, Ep, eta0, z, tau0, sigma, dens, beta, fc, vslip):
@@ -81,7 +97,7 @@ def _stage_times(timeit, cpu_times, args_j, oil, surf, Ep):
 
     from gearjax.contact import hertz_exact
     from gearjax.tribology.asperity import load_sharing_traced
-    from gearjax.tribology.friction import _S, _WS
+    from gearjax.tribology.friction import _S, _WS, shear_integral
     from gearjax.tribology.lubricant import eyring_shear, viscosity
 
     F, ue, us, Rx, Ry = args_j
@@ -92,15 +108,20 @@ def _stage_times(timeit, cpu_times, args_j, oil, surf, Ep):
     ls = ls_f(F, Rx, hz.k, hz.a, hz.b, ue)
 
     def shear(phi, pmax, us, hc, a, b, F):
+        X0 = oil.eta0 * 1e-6 * us / (hc * oil.tau0)
+        return 2 * jnp.pi * a * b * oil.tau0 * shear_integral((1.0 - phi) * pmax, X0, oil) / F
+
+    def shear_48(phi, pmax, us, hc, a, b, F):   # the former fixed 48-node rule in s
         p_f = ((1.0 - phi) * pmax)[:, None] * jnp.asarray(_S)
         tau = eyring_shear(viscosity(p_f, oil), us[:, None], hc[:, None], oil.tau0)
         return 2 * jnp.pi * a * b * jnp.sum(_WS * _S * tau, axis=-1) / F
 
-    sh_f = jax.jit(shear)
+    sh_f, sh48_f = jax.jit(shear), jax.jit(shear_48)
+    sh_args = (ls.phi, hz.p_max, us, ls.h_c, hz.a, hz.b, F)
     runs = [("Hertz ellipse (hertz_exact)", hz_f, (F, Rx, Ry)),
             ("load sharing (load_sharing_traced)", ls_f, (F, Rx, hz.k, hz.a, hz.b, ue)),
-            ("shear integral (48-node Gauss-Legendre)", sh_f,
-             (ls.phi, hz.p_max, us, ls.h_c, hz.a, hz.b, F))]
+            ("shear integral (16-node sinh-mapped)", sh_f, sh_args),
+            ("(former 48-node shear rule, comparison)", sh48_f, sh_args)]
     return [(name, timeit(f, *a), cpu_times[f]) for name, f, a in runs]
 
 
@@ -109,8 +130,13 @@ def main():
     ap.add_argument("--points", type=int, default=100_000)
     ap.add_argument("--baseline-points", type=int, default=200)
     ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--devices", type=int, default=1,
+                    help="shard over this many CPU devices (sets XLA_FLAGS before JAX starts)")
     args = ap.parse_args()
 
+    if args.devices > 1:
+        os.environ["XLA_FLAGS"] = (os.environ.get("XLA_FLAGS", "") +
+                                   f" --xla_force_host_platform_device_count={args.devices}")
     import jax
     import jax.numpy as jnp
 
@@ -128,6 +154,10 @@ def main():
     surf = make_surface(0.5)
     Ep = 226374.0
     args_j = [jnp.asarray(v) for v in (F, ue, us, Rx, Ry)]
+    if args.devices > 1:
+        from jax.sharding import Mesh, NamedSharding, PartitionSpec
+        mesh = Mesh(np.array(jax.devices()[:args.devices]), ("points",))
+        args_j = [jax.device_put(v, NamedSharding(mesh, PartitionSpec("points"))) for v in args_j]
 
     fwd = jax.jit(lambda F, ue, us, Rx, Ry: friction_traced(F, ue, us, Rx, Ry, oil, surf, Ep).mu)
 
@@ -168,9 +198,9 @@ def main():
     mu_j = np.asarray(fwd(*args_j))[:m]
     agree = np.max(np.abs(np.asarray(mu_np) - mu_j) / np.abs(mu_j))
 
-    import os
     print(f"gearjax friction benchmark ({jax.devices()[0].platform}, {os.cpu_count()} cores, "
-          f"{n} points per call)")
+          f"{len(jax.devices())} device(s), {n} points per call, load average "
+          f"{os.getloadavg()[0]:.1f})")
     print(f"{'route':44s} {'points/s':>12s} {'call (s)':>10s} {'compile (s)':>12s} "
           f"{'CPU s/call':>11s}")
     print(f"{'JAX forward mu (jit)':44s} {n / t_f:12.4g} {t_f:10.3f} {c_f:12.2f} "
@@ -181,6 +211,8 @@ def main():
           f"{t_np * n / m:10.3f} {'-':>12s}   (timed on {m} points, scaled)")
     for name, (_, t), cpu in stages:
         print(f"{'  stage: ' + name:44s} {n / t:12.4g} {t:10.3f} {'-':>12s} {cpu:11.3f}")
+    print(f"forward per CPU-second: {n / cpu_times[fwd]:.3g} points; gradient: "
+          f"{n / cpu_times[grad]:.3g} points")
     print(f"speed-up of JAX forward over the loop: {(m / t_np) and (n / t_f) / (m / t_np):.0f}x; "
           f"max relative difference of mu on the subset: {agree:.1e}")
 

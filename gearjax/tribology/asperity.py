@@ -132,30 +132,42 @@ class LoadSharing(NamedTuple):
 
 # Load sharing: 32-node rule (ln F_5/2 within 1.4e-13 of an adaptive quadrature for
 # every λ ≥ 0, the same as the 96-node rule of log_F_n; tests/test_tribology.py)
-_LS_NODES, _LS_WEIGHTS = np.polynomial.legendre.leggauss(32)
-_LS_V = 0.5 * (_LS_NODES + 1.0)
-_LS_W = 0.5 * _LS_WEIGHTS
 _LS_STEPS = 4             # Halley steps from the explicit start (measured: 1e-15 in s)
 _LS_TOL = 1e-11           # residual tolerance of the converged flag (as the former solve)
 _LGAMMA_3_5 = math.lgamma(3.5)
 
 
-# the columns weight e^{-λt - t²/2} for I_5/2, I_3/2, I_1/2, I_2 (t^n dt = 2 T^{n+1} v^{2n+1} dv)
-_LS_MOMENTS = np.stack([_LS_W * _LS_V ** 6, _LS_W * _LS_V ** 4, _LS_W * _LS_V ** 2,
-                        _LS_W * _LS_V ** 5], axis=-1)
+
+def _moments(n):
+    """Nodes v² on [0, 1] and the columns weighting e^{-λt - t²/2} for I_5/2, I_3/2,
+    I_1/2, I_2 (t^n dt = 2 T^{n+1} v^{2n+1} dv) of the n-node Gauss–Legendre rule."""
+    x, w = np.polynomial.legendre.leggauss(n)
+    v, w = 0.5 * (x + 1.0), 0.5 * w
+    return v * v, np.stack([w * v ** 6, w * v ** 4, w * v ** 2, w * v ** 5], axis=-1)
 
 
-def _gt_integrals(lam):
+_LS_V2, _LS_MOMENTS = _moments(32)
+# 16 nodes: ln F_5/2 within 3e-5 (I_3/2/I_5/2 within 2e-5 relative) for every λ ≥ 0 —
+# used for the start and the first Halley steps only; the last two steps, the
+# residual and the flag use the 32-node rule (Halley's cubic convergence removes the
+# difference: 3e-5 -> ~1e-14 -> round-off)
+_LS_V2_COARSE, _LS_MOMENTS_COARSE = _moments(16)
+_LS_FINE_STEPS = 2
+
+
+def _gt_integrals(lam, coarse=False):
     """ln F_5/2(λ) and the ratios I_3/2/I_5/2, I_1/2/I_5/2, I_2/I_5/2 (= F_n/F_5/2) from
-    ONE set of 32 exponentials (the I_n share the factor e^{-λt - t²/2}, t = T v²);
-    the four weighted sums are one small matrix product."""
+    ONE set of 32 (``coarse``: 16) exponentials (the I_n share the factor
+    e^{-λt - t²/2}, t = T v²); the four weighted sums are one small matrix product."""
+    v2, mom = (_LS_V2_COARSE, _LS_MOMENTS_COARSE) if coarse else (_LS_V2, _LS_MOMENTS)
     T = _tail_scale(lam)
-    t = T[..., None] * (_LS_V * _LS_V)
+    t = T[..., None] * v2
     e = jnp.exp(-lam[..., None] * t - 0.5 * t * t)
-    m = e @ _LS_MOMENTS
+    m = e @ mom
     i52 = m[..., 0]
-    log_f52 = -0.5 * lam * lam - _LOG_SQRT_2PI + jnp.log(2.0 * T ** 3.5 * i52)
-    return log_f52, m[..., 1] / (T * i52), m[..., 2] / (T * T * i52), m[..., 3] / (jnp.sqrt(T) * i52)
+    sT = jnp.sqrt(T)
+    log_f52 = -0.5 * lam * lam - _LOG_SQRT_2PI + jnp.log(2.0 * (T * T * T * sT) * i52)
+    return log_f52, m[..., 1] / (T * i52), m[..., 2] / (T * T * i52), m[..., 3] / (sT * i52)
 
 
 class _Contact(NamedTuple):
@@ -216,7 +228,7 @@ def _ls_iterate(th, film_method):
     lam0 = _film(jnp.zeros_like(th.F), th, film_method)[0] / th.sigma
     c = jnp.log(_film(jnp.ones_like(th.F), th, film_method)[0] / th.sigma / lam0)
     L = _log_cap(th)
-    s_ff = L + _gt_integrals(lam0)[0]
+    s_ff = L + _gt_integrals(lam0, coarse=True)[0]
     y = -L
     lb = jnp.sqrt(jnp.maximum(2.0 * (_LGAMMA_3_5 - _LOG_SQRT_2PI - 3.5 * math.log(1.245) - y), 0.0))
     for _ in range(4):
@@ -224,11 +236,12 @@ def _ls_iterate(th, film_method):
         lb = jnp.maximum(lb + g / (lb + 3.5 / (lb + 1.245)), 0.0)
     s_b = jnp.log(jnp.maximum(lb, 1e-300) / lam0) / c
     s = jnp.where(lb > lam0, jnp.maximum(s_ff, s_b), s_ff)
-    for _ in range(_LS_STEPS):
+    for i in range(_LS_STEPS):
         sg = jax.nn.sigmoid(s)
-        lam = lam0 * jnp.exp(c * jax.nn.softplus(s))
-        log_f, q32, q12, _ = _gt_integrals(lam)
-        r = -jax.nn.softplus(-s) - L - log_f
+        sp = jax.nn.softplus(s)
+        lam = lam0 * jnp.exp(c * sp)
+        log_f, q32, q12, _ = _gt_integrals(lam, coarse=i < _LS_STEPS - _LS_FINE_STEPS)
+        r = s - sp - L - log_f                                # ln φ = -softplus(-s) = s - softplus(s)
         dl = c * sg * lam
         ddl = dl * (c * sg + 1.0 - sg)
         d2 = -2.5 * (-1.5 * q12 + 2.5 * q32 * q32)        # d² ln F_5/2 / dλ²

@@ -35,6 +35,8 @@ published formula; ``"point"`` and ``"line"`` give either formula alone.
 
 from __future__ import annotations
 
+import math
+
 import jax.numpy as jnp
 
 from gearjax.tribology.lubricant import PA_S_TO_MPA_S
@@ -46,30 +48,55 @@ K_POINT_DEFAULT = 8.0
 K_LINE_DEFAULT = 64.0
 
 
+def _log_inputs(Rx, u_e, eta0, alpha, E_prime):
+    """ln U, ln G of the dimensionless groups (shared by both film formulas)."""
+    return jnp.log(eta0 * PA_S_TO_MPA_S * u_e / (E_prime * Rx)), jnp.log(alpha * E_prime)
+
+
+def _log_hamrock_dowson(F, Rx, k, lnU, lnG, E_prime):
+    """(ln h_c, ln h_min) of Hamrock–Dowson, mm: the power laws as one exp of a sum of
+    logs (three logs for the whole formula instead of six pows)."""
+    lnW = jnp.log(F / (E_prime * Rx * Rx))
+    lnR = jnp.log(Rx)
+    lhc = (math.log(2.69) + 0.67 * lnU + 0.53 * lnG - 0.067 * lnW
+           + jnp.log1p(-0.61 * jnp.exp(-0.73 * k)) + lnR)
+    lhm = (math.log(3.63) + 0.68 * lnU + 0.49 * lnG - 0.073 * lnW
+           + jnp.log1p(-jnp.exp(-0.68 * k)) + lnR)
+    return lhc, lhm
+
+
+def _log_pan_hamrock(w, Rx, lnU, lnG, E_prime):
+    """(ln h_c, ln h_min) of Pan–Hamrock, mm."""
+    lnWl = jnp.log(w / (E_prime * Rx))
+    lnR = jnp.log(Rx)
+    lhc = math.log(2.922) - 0.166 * lnWl + 0.692 * lnU + 0.470 * lnG + lnR
+    lhm = math.log(1.714) - 0.128 * lnWl + 0.694 * lnU + 0.568 * lnG + lnR
+    return lhc, lhm
+
+
 def hamrock_dowson(F, Rx, k, u_e, eta0, alpha, E_prime):
     """Hamrock–Dowson central and minimum film (h_c, h_min) in mm.
 
-    F N, Rx mm, ellipticity k = a/b (-), u_e mm/s, η0 Pa·s, α 1/MPa, E' MPa.
+    F N, Rx mm, ellipticity k = a/b (-), u_e mm/s, η0 Pa·s, α 1/MPa, E' MPa:
+    ``h_c/Rx = 2.69 U^0.67 G^0.53 W^-0.067 (1 - 0.61 e^{-0.73k})``,
+    ``h_min/Rx = 3.63 U^0.68 G^0.49 W^-0.073 (1 - e^{-0.68k})``,
+    U = η0 u_e/(E' Rx), G = α E', W = F/(E' Rx²).
     """
-    U = eta0 * PA_S_TO_MPA_S * u_e / (E_prime * Rx)
-    G = alpha * E_prime
-    W = F / (E_prime * Rx * Rx)
-    hc = 2.69 * U ** 0.67 * G ** 0.53 * W ** -0.067 * (1.0 - 0.61 * jnp.exp(-0.73 * k))
-    hm = 3.63 * U ** 0.68 * G ** 0.49 * W ** -0.073 * (1.0 - jnp.exp(-0.68 * k))
-    return hc * Rx, hm * Rx
+    lnU, lnG = _log_inputs(Rx, u_e, eta0, alpha, E_prime)
+    lhc, lhm = _log_hamrock_dowson(F, Rx, k, lnU, lnG, E_prime)
+    return jnp.exp(lhc), jnp.exp(lhm)
 
 
 def pan_hamrock_line(w, Rx, u_e, eta0, alpha, E_prime):
     """Pan–Hamrock line-contact central and minimum film (h_c, h_min) in mm.
 
-    w load per unit length N/mm, Rx mm, u_e mm/s, η0 Pa·s, α 1/MPa, E' MPa.
+    w load per unit length N/mm, Rx mm, u_e mm/s, η0 Pa·s, α 1/MPa, E' MPa:
+    ``h_c/Rx = 2.922 W'^-0.166 U^0.692 G^0.470``,
+    ``h_min/Rx = 1.714 W'^-0.128 U^0.694 G^0.568``, W' = w/(E' Rx).
     """
-    U = eta0 * PA_S_TO_MPA_S * u_e / (E_prime * Rx)
-    G = alpha * E_prime
-    Wl = w / (E_prime * Rx)
-    hc = 2.922 * Wl ** -0.166 * U ** 0.692 * G ** 0.470
-    hm = 1.714 * Wl ** -0.128 * U ** 0.694 * G ** 0.568
-    return hc * Rx, hm * Rx
+    lnU, lnG = _log_inputs(Rx, u_e, eta0, alpha, E_prime)
+    lhc, lhm = _log_pan_hamrock(w, Rx, lnU, lnG, E_prime)
+    return jnp.exp(lhc), jnp.exp(lhm)
 
 
 def blend_weight(k, k_point=K_POINT_DEFAULT, k_line=K_LINE_DEFAULT):
@@ -92,12 +119,13 @@ def film_thickness_traced(F, Rx, k, a, u_e, eta0, alpha, E_prime, method="auto",
     """
     if method not in ("auto", "point", "line"):
         raise ValueError(f"film method = {method!r} must be 'auto', 'point' or 'line'")
+    lnU, lnG = _log_inputs(Rx, u_e, eta0, alpha, E_prime)
     if method == "point":
-        return hamrock_dowson(F, Rx, k, u_e, eta0, alpha, E_prime)
-    w = 0.75 * F / a
-    hl = pan_hamrock_line(w, Rx, u_e, eta0, alpha, E_prime)
+        lhc, lhm = _log_hamrock_dowson(F, Rx, k, lnU, lnG, E_prime)
+        return jnp.exp(lhc), jnp.exp(lhm)
+    lc_l, lm_l = _log_pan_hamrock(0.75 * F / a, Rx, lnU, lnG, E_prime)
     if method == "line":
-        return hl
-    hp = hamrock_dowson(F, Rx, k, u_e, eta0, alpha, E_prime)
+        return jnp.exp(lc_l), jnp.exp(lm_l)
+    lc_p, lm_p = _log_hamrock_dowson(F, Rx, k, lnU, lnG, E_prime)
     s = blend_weight(k, k_point, k_line)
-    return (hp[0] ** (1.0 - s) * hl[0] ** s, hp[1] ** (1.0 - s) * hl[1] ** s)
+    return jnp.exp(lc_p + s * (lc_l - lc_p)), jnp.exp(lm_p + s * (lm_l - lm_p))

@@ -42,12 +42,13 @@ from gearjax.fields import float64_array
 
 __all__ = ["Oil", "make_oil", "get_oil", "OILS", "roelands_z", "roelands_viscosity",
            "barus_viscosity", "viscosity", "dowson_higginson_density", "eyring_shear",
-           "P_ROELANDS_MPA", "PA_S_TO_MPA_S"]
+           "P_ROELANDS_MPA", "PA_S_TO_MPA_S", "LN_ETA_INF", "LN_ETA_CAP", "log_viscosity_ratio"]
 
 P_ROELANDS_MPA = 1.0 / 5.1e-3   # 196.08 MPa  (5.1e-9 1/Pa)
 PA_S_TO_MPA_S = 1e-6            # 1 Pa·s = 1e-6 N·s/mm²
-_LN_ETA_INF = 9.67              # -ln(6.31e-5 Pa·s)
-_LN_ETA_CAP = 150.0             # overflow guard for ln(η/η0) at absurd pressures
+LN_ETA_INF = 9.67               # -ln(6.31e-5 Pa·s)
+LN_ETA_CAP = 150.0              # overflow guard for ln(η/η0) at absurd pressures
+_LN_ETA_INF, _LN_ETA_CAP = LN_ETA_INF, LN_ETA_CAP
 ETA0_MAX_PAS = 100.0            # highest accepted inlet viscosity, Pa·s
 ALPHA_MAX_PER_GPA = 100.0       # highest accepted pressure-viscosity coefficient, 1/GPa
 TAU0_MAX_MPA = 100.0            # highest accepted Eyring stress, MPa
@@ -171,6 +172,18 @@ def viscosity(p, oil: Oil, model: str = "roelands"):
         return roelands_viscosity(p, oil.eta0, oil.z)
     if model == "barus":
         return barus_viscosity(p, oil.eta0, oil.alpha)
+    raise ValueError(f"viscosity model = {model!r} must be 'roelands' or 'barus'")
+
+
+def log_viscosity_ratio(p, oil: Oil, model: str = "roelands"):
+    """ln(η(p)/η0) of ``oil`` *without* the cap ``LN_ETA_CAP`` of :func:`viscosity`:
+    Roelands ``(ln η0 + 9.67) expm1(z log1p(p/p_R))`` (one log and one exp per value),
+    Barus ``α p``; p in MPa."""
+    p = jnp.asarray(p, float)
+    if model == "roelands":
+        return (jnp.log(oil.eta0) + _LN_ETA_INF) * jnp.expm1(oil.z * jnp.log1p(p / P_ROELANDS_MPA))
+    if model == "barus":
+        return oil.alpha * p
     raise ValueError(f"viscosity model = {model!r} must be 'roelands' or 'barus'")
 
 
