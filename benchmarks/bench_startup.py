@@ -60,12 +60,16 @@ JOBS = {
     "friction": ("gearjax friction", "cli",
                  ["friction", "--load-N", "1000", "--rx-mm", "10", "--ry-mm", "300", "--ue", "5",
                   "--us", "1", "--oil", "mineral_vg100", "--sigma-um", "0.4"]),
+    "efficiency": ("gearjax efficiency (spur 20/40, 200 N m, 1500 rpm)", "cli",
+                   ["efficiency", "involute:z1=20,z2=40,m=4,alpha=20,b=30", "--torque-Nm", "200",
+                    "--rpm", "1500", "--oil", "mineral_vg100", "--sigma-um", "0.4"]),
     "tca": ("hypoid_tca (8/43 drive, prepare + TCA)", "py", "tca"),
     "tca-coast": ("hypoid_tca drive, then coast (2nd side)", "py", "tca_coast"),
     "tca-grad": ("grad of TE p-t-p wrt pinion radial distance", "py", "tca_grad"),
     "synthesis": ("local synthesis (spiral bevel 10/30)", "py", "synthesis"),
 }
-DEFAULT = ["surface", "tca-hypoid", "tca-involute", "kinematics", "blank", "friction", "tca"]
+DEFAULT = ["surface", "tca-hypoid", "tca-involute", "kinematics", "blank", "friction", "efficiency",
+           "tca"]
 
 EVENTS = {"/jax/core/compile/jaxpr_trace_duration": "trace",
           "/jax/core/compile/jaxpr_to_mlir_module_duration": "lower",

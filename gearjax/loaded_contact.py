@@ -49,6 +49,7 @@ import numpy as np
 
 from gearjax.contact import hertz_exact, hertz_line_traced
 from gearjax.newton import newton_solve
+from gearjax.tca import pair_arrays
 from gearjax.tooth_compliance import (contact_compliance, iso6336_single_stiffness,
                                       tooth_compliance, tooth_geometry)
 
@@ -153,20 +154,20 @@ def _one_position(te, act, l1, l2, q, c, T1, sgn):
     lead = jnp.argmax(key)
     env = te[lead]
     g = jnp.where(act, sgn * (env - te), 0.0)
-    safe = jnp.where(act, 1.0, 0.0)
     l1s, l2s = jnp.where(act, l1, 1.0), jnp.where(act, l2, 1.0)
     qs, cs = jnp.where(act, q, 1.0), jnp.where(act, c, 0.0)
     # upper bound: the leading pair (g = 0) alone carries the torque
     F_lead = T1 / l1s[lead]
     y0 = (qs[lead] * F_lead + cs[lead] * jnp.cbrt(F_lead) ** 2) / l2s[lead]
-    th = (g, l1s, l2s, qs, cs, act, T1)
+    # with no pair active the lead stands in, so that the solve stays regular (the
+    # position is reported not converged)
     act_or_lead = act | ((jnp.arange(act.shape[0]) == lead) & ~some)
-    th = th[:5] + (act_or_lead, T1)
+    th = (g, l1s, l2s, qs, cs, act_or_lead, T1)
     sol = newton_solve(_residual, jax.lax.stop_gradient(y0) * (1.0 + 1e-12), th,
                        tol=BALANCE_TOL, max_steps=_OUTER_STEPS, xtol=0.0)
     y = sol.x
     w = jnp.where(act, l2s * (y - g), -jnp.inf)
-    F = force_from_approach(jnp.where(act, w, -1.0), qs, cs) * safe
+    F = force_from_approach(jnp.where(act, w, -1.0), qs, cs)
     bal = jnp.abs(jnp.sum(l1s * F) / T1 - 1.0)
     conv = sol.converged & (bal <= BALANCE_TOL) & some
     nan = jnp.nan
@@ -190,27 +191,6 @@ def share_torque(te, active, l1, l2, q, c, torque_Nmm, drive=True):
     fn = jax.vmap(_one_position, in_axes=(1, 1, 1, 1, 1, 1, None, None),
                   out_axes=(0, 0, 1, 1, 0, 0))
     return fn(te, active, l1, l2, q, c, T1, sgn)
-
-
-def pair_arrays(arr, steps_per_pitch: int, n_pairs: int, fill, window):
-    """Values of tooth pairs ``k = -(K//2) .. K//2`` at the grid positions ``window``.
-
-    ``arr`` : (N, ...) a quantity of tooth pair 0 on the uniform TCA grid (pair k is
-    pair 0 shifted by k pinion pitches = ``k * steps_per_pitch`` grid steps, as in
-    :func:`gearjax.tca.multi_pair`).  Returns (K, len(window), ...), ``fill`` where
-    the shifted index falls outside the grid.
-    """
-    n = arr.shape[0]
-    ks = np.arange(n_pairs) - n_pairs // 2
-    window = np.asarray(window)
-    out = []
-    for k in ks:
-        src = window - k * steps_per_pitch
-        ok = (src >= 0) & (src < n)
-        v = arr[np.clip(src, 0, n - 1)]
-        okb = ok.reshape(ok.shape + (1,) * (v.ndim - 1))
-        out.append(jnp.where(okb, v, fill))
-    return jnp.stack(out)
 
 
 def lever_arms(point, normal, gear_ratio):

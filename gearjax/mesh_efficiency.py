@@ -11,7 +11,7 @@ The chain, every step a JAX function of the design::
 
 **Positions.**  One mesh cycle = one angular pitch of the pinion: the
 ``steps_per_pitch`` grid positions centred on the reference.  Tooth pair ``k`` at a
-position is pair 0 shifted by ``k`` pitches (:func:`gearjax.loaded_contact.pair_arrays`),
+position is pair 0 shifted by ``k`` pitches (:func:`gearjax.tca.pair_arrays`),
 exactly as the unloaded TE envelope of :func:`gearjax.tca.multi_pair`.
 
 **Velocities.**  ``ContactKinematics`` gives per rad/s of pinion speed the surface
@@ -183,6 +183,7 @@ def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, speed_ra
     l1, l2, q, c = (pairs(jnp.where(on, a, 1.0), 1.0) for a in (l1_0, l2_0, q0, c0))
     env, y, F, w, bal, conv = share_torque(te, act, l1, l2, q, c, T1, teeth.drive)
     sgn = jnp.where(teeth.drive, 1.0, -1.0)
+    te_loaded = env - sgn * y
 
     # kinematics of every pair at every position (speeds per rad/s -> mm/s)
     omega = jnp.asarray(speed_rad_s, float)
@@ -215,7 +216,7 @@ def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, speed_ra
     w_loss = F * us * loaded_on
     mean_mu = jnp.sum(ml.mu.T * w_loss) / jnp.sum(w_loss)
     share = l1 * F / T1
-    lc = LoadedContact(F, share, w, p_max, a_ax, b_ax, y, env - sgn * y, bal, conv,
+    lc = LoadedContact(F, share, w, p_max, a_ax, b_ax, y, te_loaded, bal, conv,
                        jnp.sum(loaded_on, axis=0))
     # coverage: pair 0 on the flank where no pair of the window sees it
     ks = np.arange(K) - K // 2
@@ -225,14 +226,14 @@ def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, speed_ra
         seen[src[(src >= 0) & (src < n)]] = True
     inside0 = (res.margin >= 0.0) & path.converged
     truncated = jnp.any(inside0 & ~seen) | inside0[0] | inside0[-1]
-    # edge contacts that the loaded gear would press on
-    edge = res.edge_points
-    e_te = pairs(jnp.where(edge, path.te, 0.0), 0.0)
-    e_act = pairs(edge, False)
-    edge_loaded = jnp.any(e_act & (sgn * (e_te - (env - sgn * y)) > 0.0), axis=0)
-    d_te = pairs(jnp.where(degenerate0, path.te, 0.0), 0.0)
-    degenerate = jnp.any(pairs(degenerate0, False) & (sgn * (d_te - (env - sgn * y)) > 0.0),
-                         axis=0)
+    def pressed(mask0):
+        """(M,) a contact of pair 0 in ``mask0`` (no load modelled there) would be
+        compressed by the loaded gear at the position."""
+        te_m = pairs(jnp.where(mask0, path.te, 0.0), 0.0)
+        return jnp.any(pairs(mask0, False) & (sgn * (te_m - te_loaded) > 0.0), axis=0)
+
+    edge_loaded = pressed(res.edge_points)          # face-end (edge) contacts
+    degenerate = pressed(degenerate0)              # beyond an edge of regression
     valid = (conv & jnp.all(fr.converged | ~loaded_on, axis=0) & ~edge_loaded & ~truncated
              & ~degenerate)
     return MeshEfficiency(path.phi1[win], lc, ue, us, R_x, R_y, fr, ml.power_loss, ml.efficiency,
@@ -255,8 +256,10 @@ def efficiency_function(design, *, side=None, compliance: str = "weber", E_prime
     opts = {**ad.defaults, **tca_options}
     opts.pop("kinematics", None)
     kw = {} if side is None else {"side": side}
-    f_tca = ad.traced(design, **kw, **opts)
-    teeth_of = ad.mesh(design, **kw, **opts)[0]
+    # the concrete set-up once (a hypoid design is prepared -- reference search --
+    # by ``mesh``; the TCA then runs on the prepared pair)
+    teeth_of, pair0, run_design = ad.mesh(design, **kw, **opts)
+    f_tca = ad.traced(run_design, **kw, **opts)
     spp, K = int(opts["steps_per_pitch"]), int(opts["n_pairs"])
 
     def f(pair, torque_Nm, speed_rad_s, oil, surface, mis=None):
@@ -267,7 +270,7 @@ def efficiency_function(design, *, side=None, compliance: str = "weber", E_prime
                                      film_method=film_method)
         return eff, res
 
-    f.pair = getattr(f_tca, "pair", design)
+    f.pair = pair0
     f.options = dict(opts, side=side, compliance=compliance)
     return f
 

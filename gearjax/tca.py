@@ -84,7 +84,7 @@ from gearjax.errors import ConvergenceError, check_int, check_range, require_con
 from gearjax.newton import newton_solve
 from gearjax.surfaces import GeneratedSurface, local_geometry, unit_normal
 
-__all__ = ["Misalignment", "Assembly", "contact_equations", "contact_system", "ContactSystem",
+__all__ = ["pair_arrays", "Misalignment", "Assembly", "contact_equations", "contact_system", "ContactSystem",
            "local_geometry_on", "point_normal", "flank_at", "path_tangent", "solve_grid", "gear_mount",
            "ContactPath", "contact_path", "te_arcsec", "require_path",
            "ARCSEC", "ellipse_from_weingarten", "rotation_about", "relative_curvature",
@@ -563,6 +563,27 @@ def _crossing(phi, f):
     return jnp.where(jnp.any(hit), val, jnp.nan)
 
 
+def pair_arrays(arr, steps_per_pitch: int, n_pairs: int, fill, window):
+    """Values of tooth pairs ``k = -(K//2) .. K//2`` at the grid positions ``window``.
+
+    ``arr`` : (N, ...) a quantity of tooth pair 0 on the uniform TCA grid (pair k is
+    pair 0 shifted by k pinion pitches = ``k * steps_per_pitch`` grid steps, as in
+    :func:`multi_pair`).  Returns (K, len(window), ...), ``fill`` where
+    the shifted index falls outside the grid.
+    """
+    n = arr.shape[0]
+    ks = np.arange(n_pairs) - n_pairs // 2
+    window = np.asarray(window)
+    out = []
+    for k in ks:
+        src = window - k * steps_per_pitch
+        ok = (src >= 0) & (src < n)
+        v = arr[np.clip(src, 0, n - 1)]
+        okb = ok.reshape(ok.shape + (1,) * (v.ndim - 1))
+        out.append(jnp.where(okb, v, fill))
+    return jnp.stack(out)
+
+
 def multi_pair(path: ContactPath, margin, steps_per_pitch: int, z1: int, drive: bool = True,
                n_pairs: int = 3) -> MultiPair:
     """Shift pair 0 by whole pitches and form the unloaded TE envelope (traceable).
@@ -578,16 +599,9 @@ def multi_pair(path: ContactPath, margin, steps_per_pitch: int, z1: int, drive: 
     m = steps_per_pitch
     inside0 = (margin >= 0.0) & path.converged
     te0 = jnp.where(inside0, path.te, jnp.nan)
-    ks = np.arange(n_pairs) - n_pairs // 2
     idx = np.arange(n)
-
-    def shifted(arr, k, fill):
-        src = idx - k * m
-        ok = (src >= 0) & (src < n)
-        return jnp.where(ok, arr[np.clip(src, 0, n - 1)], fill)
-
-    te_pairs = jnp.stack([shifted(te0, k, jnp.nan) for k in ks])
-    inside = jnp.stack([shifted(inside0, k, False) for k in ks])
+    te_pairs = pair_arrays(te0, m, n_pairs, jnp.nan, idx)
+    inside = pair_arrays(inside0, m, n_pairs, False, idx)
     sgn = jnp.where(drive, 1.0, -1.0)        # ``drive`` may be traced
     key = jnp.where(inside, sgn * te_pairs, -jnp.inf)
     active = jnp.argmax(key, axis=0)
