@@ -63,8 +63,9 @@ from gearjax.gears.hypoid.cutter import FaceMillCutter, make_cutter  # noqa: E40
 from gearjax.gears.hypoid.machine import MachineSettings  # noqa: E402
 from gearjax.gears.hypoid.flank import FlankSpec, MemberBlank, flank_surface  # noqa: E402
 from gearjax.gears.hypoid.pair import HypoidPair, complementary_pinion, pair_flanks  # noqa: E402
-from gearjax.gears.hypoid.design_file import (HypoidDesign, design_from_dict,  # noqa: E402
-                                              load_design, save_design)
+from gearjax.gears.hypoid.design_file import HypoidDesign, save_design  # noqa: E402
+from gearjax.gears.hypoid.design_file import KINDS as HYPOID_KINDS  # noqa: E402
+from gearjax.io import design_from_dict, load_design  # noqa: E402  (any family, by [design] kind)
 from gearjax.gears.hypoid.tca import pinion_outline  # noqa: E402
 from gearjax.gears.hypoid.tca import prepare as prepare_hypoid  # noqa: E402
 from gearjax.gears.hypoid import synthesis  # noqa: E402
@@ -144,7 +145,7 @@ def tca_sensitivity(design, misalignment=None, *, side=None, **options):
 __all__ = [
     "__version__",
     # designs and files
-    "load_design", "save_design", "design_from_dict", "HypoidDesign", "list_examples",
+    "load_design", "save_design", "design_from_dict", "HypoidDesign", "HYPOID_KINDS", "list_examples",
     "example_path", "atomic_write",
     # pairs and blanks
     "InvolutePair", "InvoluteTCA", "pair_geometry", "HypoidPair", "pair_flanks",
