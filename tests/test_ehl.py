@@ -215,6 +215,37 @@ def test_implicit_gradients_match_central_differences(base):
             assert abs(ad - fd) <= 1e-5 * abs(fd) + 1e-8 * scale, (name, out, ad, fd)
 
 
+# ---------------------------------------------------------------- upwind schemes
+
+
+@pytest.mark.parametrize("beta, order", [(0.0, 1.0), (1.0, 2.0)])
+def test_couette_difference_has_the_order_of_its_scheme(beta, order):
+    # the Couette part of the Reynolds operator (ε = 0, P = 0, ρ̄ = 1) must be
+    # -(cos θ ∂H/∂X + k⁻¹ sin θ ∂H/∂Y) of a smooth film; its error must fall like
+    # ΔX for first-order upwind (β = 0) and like ΔX² with the second-order correction
+    # (β = 1).  A wrong correction coefficient or a wrong upstream index leaves
+    # first order (or no convergence).
+    from gearjax.tribology.ehl.model import Fields, Scales, reynolds_operator
+    k, th = 1.3, 30.0
+    sc = Scales(*(jnp.asarray(1.0),) * 2, jnp.asarray(k), *(jnp.asarray(1.0),) * 7)
+    errs = []
+    for n in (40, 80):
+        g = make_grid(n, th, upwind=beta)
+        X, Y = g.nodes()
+        H = np.sin(0.7 * X + 0.3) * np.cos(0.5 * Y) + 2.0
+        dHx = 0.7 * np.cos(0.7 * X + 0.3) * np.cos(0.5 * Y)
+        dHy = -0.5 * np.sin(0.7 * X + 0.3) * np.sin(0.5 * Y)
+        c, s = math.cos(math.radians(th)), math.sin(math.radians(th))
+        ref = -(c * dHx + s / k * dHy)
+        z = jnp.zeros_like(jnp.asarray(H))
+        fl = Fields(jnp.asarray(H), z, z + 1.0, z + 1.0, z)
+        L = np.asarray(reynolds_operator(z, fl, sc, g, th))
+        inner = (np.abs(X) <= 1.5) & (np.abs(Y) <= 1.5)      # away from the edges
+        errs.append(np.max(np.abs(L - ref)[inner]))
+    observed = math.log2(errs[0] / errs[1])
+    assert abs(observed - order) < 0.25, (errs, observed)
+
+
 # ---------------------------------------------------------------- input checking
 
 
@@ -229,7 +260,7 @@ def test_non_converged_solve_raises_or_is_flagged():
     (dict(F=-1.0), "F"), (dict(u_e=0.0), "u_e"), (dict(Ry=1e4), "Ry/Rx"),
     (dict(eta0=1e-6), "eta0"), (dict(n=8), "n"), (dict(n=40.5), "n"),
     (dict(angle_deg=270.0), "angle_deg"), (dict(F=1e7), "p_max"),
-    (dict(mixed=True), "sigma_um"),
+    (dict(mixed=True), "sigma_um"), (dict(upwind=1.5), "upwind"),
 ])
 def test_bad_inputs_raise_value_error_naming_the_parameter(kw, word):
     args = dict(BASE)

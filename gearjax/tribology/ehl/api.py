@@ -19,8 +19,10 @@ validated entry point only) tries the schedules of ``AUTO_SCHEDULES`` in turn �
 the direct solve from the Hertz start first, then factors < 1 (a heavier start,
 for light loads), then factors > 1 — until one converges, and as a last resort
 nested iteration: the solution on the grid with n/2 nodes (itself "auto"),
-interpolated, as start.  Above ``NESTED_ABOVE`` = 128 nodes nested iteration is
-tried first (a failed direct solve on a fine grid is expensive).  Only the final solve counts for the convergence flag.
+interpolated, as start, solved with pseudo-transient continuation.  Above
+``NESTED_ABOVE`` = 128 nodes nested iteration is tried first (a failed direct solve
+on a fine grid is expensive); it recurses, so 512² starts from 256², which starts
+from 128².  Only the final solve counts for the convergence flag.
 """
 
 from __future__ import annotations
@@ -93,18 +95,20 @@ _outputs_jit = jax.jit(outputs, static_argnames=("grid", "mixed"))
 
 
 def ehl_traced(case: EHLCase, grid: EHLGrid, angle_deg: float = 0.0, mixed: bool = False,
-               continuation=(), tol=1e-9, max_steps: int = 60, x0=None) -> EHLResult:
+               continuation=(), tol=1e-9, max_steps: int = 60, x0=None, ptc=0.0) -> EHLResult:
     """Solve the EHL problem of ``case`` on ``grid`` (no validation; differentiable).
 
     The Newton iterations see ``stop_gradient(case)``; derivatives of the outputs
     w.r.t. ``case`` flow only through the implicit-function rule (reverse mode).
     ``continuation`` : tuple of λ multipliers (static), see the module docstring.
     ``x0`` : optional start state (default: Hertz pressure, Hamrock–Dowson H0).
+    ``ptc`` : initial pseudo-transient shift (0: plain damped Newton; see
+    :func:`gearjax.tribology.ehl.solver.newton_krylov`).
     """
     case = strong_float64(case)          # one compiled solve for every case
     cs = jax.lax.stop_gradient(case)
     st = solve_state(cs, grid, angle_deg, mixed, tol=tol, max_steps=max_steps,
-                     continuation=tuple(continuation), x0=x0)
+                     continuation=tuple(continuation), x0=x0, ptc=ptc)
     x_star = jax.lax.stop_gradient(st.x)
     out = _attached_outputs(x_star, case, grid, float(angle_deg), bool(mixed))
     return EHLResult(*out, st.residual, st.load_error, st.steps, st.converged, x_star)
@@ -124,7 +128,7 @@ def _check_grid_inputs(n, angle_deg):
 def solve_ehl(F, u_e, u_s, Rx, Ry, eta0, alpha_per_GPa, E_prime=226373.6, tau0_MPa=5.0,
               sigma_um=0.0, density_per_mm2=1.0e4, beta_um=10.0, f_c=0.1, v_slip_mm_s=1.0,
               *, n=128, angle_deg=0.0, mixed=None, continuation="auto", tol=1e-9,
-              max_steps=60, strict=True) -> tuple[EHLResult, EHLCase, EHLGrid]:
+              max_steps=60, strict=True, upwind=0.0) -> tuple[EHLResult, EHLCase, EHLGrid]:
     """Numerical EHL point contact (validated entry point).
 
     F N, u_e (mean rolling speed, along the direction ``angle_deg`` from the
@@ -132,7 +136,10 @@ def solve_ehl(F, u_e, u_s, Rx, Ry, eta0, alpha_per_GPa, E_prime=226373.6, tau0_M
     α 1/GPa, E' MPa, τ0 MPa, σ and β µm, asperity density 1/mm², boundary friction
     f_c, v_slip mm/s.  ``n`` nodes per direction (n × n grid, domain of
     :func:`gearjax.tribology.ehl.grid.default_domain`).  ``mixed`` (default: σ > 0)
-    switches on the Greenwood–Tripp asperity pressure.
+    switches on the Greenwood–Tripp asperity pressure.  ``upwind`` : weight β of the
+    second-order upwind correction of the Couette fluxes (0 first order, the default
+    and the scheme of the validation tables; 1 second-order upwind; see
+    :class:`gearjax.tribology.ehl.grid.EHLGrid`).
 
     Returns ``(result, case, grid)``.  With ``strict=True`` (default) a solve that
     did not converge raises :class:`gearjax.errors.ConvergenceError`; with
@@ -148,7 +155,7 @@ def solve_ehl(F, u_e, u_s, Rx, Ry, eta0, alpha_per_GPa, E_prime=226373.6, tau0_M
         mixed = float(sigma_um) > 0.0
     if mixed and float(sigma_um) <= 0.0:
         raise ValueError(f"mixed = True needs sigma_um > 0, got sigma_um = {sigma_um!r}")
-    grid = make_grid(int(n), float(angle_deg))
+    grid = make_grid(int(n), float(angle_deg), upwind=upwind)
     auto = isinstance(continuation, str) and continuation == "auto"
     schedules = AUTO_SCHEDULES if auto else (tuple(continuation),)
     res = None
@@ -171,22 +178,26 @@ def solve_ehl(F, u_e, u_s, Rx, Ry, eta0, alpha_per_GPa, E_prime=226373.6, tau0_M
 
 
 NESTED_ABOVE = 128
+NESTED_PTC = 1.0
 
 
 def _nested(a, grid):
-    """Nested iteration: auto-solve on n/2 nodes, interpolate, solve on ``grid``."""
+    """Nested iteration: auto-solve on n/2 nodes, interpolate (bilinear, P, P_a and H0),
+    solve on ``grid`` by Newton–Krylov with pseudo-transient continuation (initial
+    shift ``NESTED_PTC``): plain Newton from the interpolated state stalls on 256²
+    (the sharper exit spike of the fine grid), the damped iteration does not."""
     coarse, _, cgrid = solve_ehl(a["F"], a["u_e"], a["u_s"], a["Rx"], a["Ry"], a["eta0"],
                                  a["alpha_per_GPa"], a["E_prime"], a["tau0_MPa"],
                                  a["sigma_um"], a["density_per_mm2"], a["beta_um"], a["f_c"],
                                  a["v_slip_mm_s"], n=int(a["n"]) // 2,
                                  angle_deg=a["angle_deg"], mixed=a["mixed"],
                                  continuation="auto", tol=a["tol"], max_steps=a["max_steps"],
-                                 strict=False)
+                                 strict=False, upwind=a["upwind"])
     if not bool(coarse.converged):
         return None
     x0 = _prolong(coarse.x, cgrid, grid, bool(a["mixed"]))
     return ehl_traced(a["case"], grid, float(a["angle_deg"]), bool(a["mixed"]), (), a["tol"],
-                      int(a["max_steps"]), x0=x0)
+                      int(a["max_steps"]), x0=x0, ptc=NESTED_PTC)
 
 
 def _prolong(x, cgrid: EHLGrid, grid: EHLGrid, mixed: bool):
