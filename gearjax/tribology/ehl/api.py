@@ -40,7 +40,7 @@ from gearjax.fields import strong_float64
 from gearjax.tribology.ehl.grid import EHLGrid, make_grid
 from gearjax.tribology.ehl.implicit import attach_implicit_gradient
 from gearjax.tribology.ehl.model import EHLCase, fields, make_case, scales, unpack
-from gearjax.tribology.ehl.outputs import outputs
+from gearjax.tribology.ehl.outputs import EHLOutputs, outputs
 from gearjax.tribology.ehl.solver import newton_krylov, solve_state
 from gearjax.tribology.lubricant import PA_S_TO_MPA_S
 
@@ -48,31 +48,24 @@ __all__ = ["EHLResult", "solve_ehl", "ehl_traced", "ehl_gradients", "ehl_fields"
            "moes_parameters", "AUTO_SCHEDULES"]
 
 
-class EHLResult(NamedTuple):
-    """Outcome of one EHL solve.
+_RESULT_DOC = """Outcome of one EHL solve: the scalar outputs of
+:class:`gearjax.tribology.ehl.outputs.EHLOutputs` followed by the solver's state.
 
-    h_c, h_min : central film (bilinear at the contact centre) and minimum nodal film, mm.
-    mu, mu_fluid, mu_boundary : friction coefficient and its Ree–Eyring / asperity parts.
-    F_fluid, F_asperity : loads carried by the fluid and by the asperities, N.
-    residual : max|R| of the discrete equations (Fischer–Burmeister residual in
-        units of p_h; relative load error).
-    load_error : |∫∫(p + p_a) dA / F - 1|.
-    steps : Newton steps of the last stage.  converged : residual ≤ tol, finite.
-    x : the state vector [P, (P_a), H0] (dimensionless; see ehl_fields).
-    """
+h_c, h_min : central film (bilinear at the contact centre) and minimum nodal film, mm.
+mu, mu_fluid, mu_boundary : friction coefficient and its Ree–Eyring / asperity parts.
+F_fluid, F_asperity : loads carried by the fluid and by the asperities, N.
+residual : max|R| of the discrete equations (Fischer–Burmeister residual in
+    units of p_h; relative load error).
+load_error : |∫∫(p + p_a) dA / F - 1|.
+steps : Newton steps of the last stage.  converged : residual ≤ tol, finite.
+x : the state vector [P, (P_a), H0] (dimensionless; see ehl_fields).
+"""
 
-    h_c: jax.Array
-    h_min: jax.Array
-    mu: jax.Array
-    mu_fluid: jax.Array
-    mu_boundary: jax.Array
-    F_fluid: jax.Array
-    F_asperity: jax.Array
-    residual: jax.Array
-    load_error: jax.Array
-    steps: jax.Array
-    converged: jax.Array
-    x: jax.Array
+# the output fields are declared once, in EHLOutputs; the result appends the state
+EHLResult = NamedTuple("EHLResult", [(f, jax.Array) for f in EHLOutputs._fields]
+                       + [(f, jax.Array) for f in ("residual", "load_error", "steps",
+                                                   "converged", "x")])
+EHLResult.__doc__ = _RESULT_DOC
 
 
 def moes_parameters(case: EHLCase):
