@@ -102,6 +102,10 @@ def write_md(rows, path):
          "φ num | φ fast | μ num (SRR 0.05 / 0.2 / 1) | μ fast | μ err (0.05 / 0.2 / 1) | conv |",
          "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
+        if not r["converged"]:
+            L.append(f"| {r['lam_s']} | {r['pmax_GPa']} | {r['ry_rx']:.0f} | {r['sigma_um']:.3f} | "
+                     "not converged (residual " f"{r['residual']:.1e}) | | | | | | | | | | False |")
+            continue
         i = [r["srr"].index(s) for s in (0.05, 0.2, 1.0)]
         mn = " / ".join(f"{r['mu_num'][j]:.4f}" for j in i)
         mf = " / ".join(f"{r['mu_fast'][j]:.4f}" for j in i)
@@ -163,8 +167,63 @@ def figure(rows, path):
     fig.savefig(path, dpi=110)
 
 
+def fast_rows(rows, oil, c_a):
+    """Fast-model φ, h_c and μ(SRR) of every row with the asperity film factor c_a."""
+    out = []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for r in rows:
+            srr = np.asarray(r["srr"])
+            surf = make_surface(r["sigma_um"], asperity_film_factor=c_a)
+            fr = friction_coefficient(np.full(srr.shape, r["F"]), U_E, srr * U_E, RX,
+                                      RX * r["ry_rx"], oil, surf, E)
+            out.append(dict(phi=float(fr.phi[0]), hc=float(fr.h_c[0]) * 1e3,
+                            mu=[float(v) for v in fr.mu]))
+    return out
+
+
+def fit(rows, oil, base):
+    """Fit c_a (asperity film factor) to the numerical φ over the mixed points
+    (0.01 ≤ φ_num ≤ 0.9): least squares of ln φ_fast - ln φ_num, c_a on a 0.005 grid
+    in [0.5, 1]; report μ errors with and without it."""
+    ok = [r for r in rows if r["converged"] and 0.01 <= r["phi_num"] <= 0.9]
+    grid = np.round(np.arange(0.5, 1.0001, 0.005), 3)
+    cost = []
+    for c in grid:
+        fr = fast_rows(ok, oil, float(c))
+        cost.append(np.mean([(np.log(max(f["phi"], 1e-12)) - np.log(r["phi_num"])) ** 2
+                             for f, r in zip(fr, ok)]))
+    c_best = float(grid[int(np.argmin(cost))])
+    conv = [r for r in rows if r["converged"]]
+    res = {"c_a": c_best, "n_fit": len(ok), "rms_log_phi_fit": float(np.sqrt(min(cost))),
+           "rms_log_phi_plain": float(np.sqrt(cost[-1])), "points": []}
+    f1, fc = fast_rows(conv, oil, 1.0), fast_rows(conv, oil, c_best)
+    for r, a, b in zip(conv, f1, fc):
+        res["points"].append(dict(lam_s=r["lam_s"], pmax_GPa=r["pmax_GPa"], ry_rx=r["ry_rx"],
+                                  phi_num=r["phi_num"], phi_plain=a["phi"], phi_corr=b["phi"],
+                                  err_mu_plain=[rel(x, y) for x, y, s in zip(a["mu"], r["mu_num"], r["srr"]) if s > 0],
+                                  err_mu_corr=[rel(x, y) for x, y, s in zip(b["mu"], r["mu_num"], r["srr"]) if s > 0],
+                                  err_hc_plain=rel(a["hc"], r["hc_num"]),
+                                  err_hc_corr=rel(b["hc"], r["hc_num"])))
+    P = res["points"]
+    for tag in ("plain", "corr"):
+        e = np.abs(np.concatenate([p[f"err_mu_{tag}"] for p in P]))
+        res[f"mu_abs_err_median_{tag}"] = float(np.median(e))
+        res[f"mu_abs_err_p90_{tag}"] = float(np.percentile(e, 90))
+        res[f"mu_abs_err_max_{tag}"] = float(np.max(e))
+        m = [p for p in P if 0.01 <= p["phi_num"] <= 0.9]
+        em = np.abs(np.concatenate([p[f"err_mu_{tag}"] for p in m])) if m else np.array([np.nan])
+        res[f"mu_abs_err_median_mixed_{tag}"] = float(np.median(em))
+        res[f"mu_abs_err_max_mixed_{tag}"] = float(np.max(em))
+    with open(base + "_fit.json", "w") as fh:
+        json.dump(res, fh, indent=1)
+    print(json.dumps({k: v for k, v in res.items() if k != "points"}, indent=1))
+    return res
+
+
 def main():
     ap = argparse.ArgumentParser()
+    ap.add_argument("--fit", action="store_true", help="only fit c_a to the stored results")
     ap.add_argument("--n", type=int, default=64)
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--tag", default="")
@@ -175,6 +234,9 @@ def main():
     rows = []
     if os.path.exists(base + ".json"):
         rows = json.load(open(base + ".json"))
+    if args.fit:
+        fit(rows, oil, base)
+        return
     done = {(r["lam_s"], r["pmax_GPa"], r["ry_rx"]) for r in rows}
     for ry in rys:
         for pm in pms:

@@ -58,12 +58,18 @@ from gearjax.tribology.lubricant import (LN_ETA_CAP, LN_ETA_INF, P_ROELANDS_MPA,
 
 __all__ = ["Surface", "make_surface", "FrictionResult", "friction_point_traced",
            "friction_traced", "friction_coefficient", "REGIMES", "STEEL_E_PRIME",
-           "validate_contact_inputs"]
+           "validate_contact_inputs", "EHL_ASPERITY_FILM_FACTOR"]
 
 REGIMES = ("boundary", "mixed", "full film")
 STEEL_E_PRIME = 2.0 / (2.0 * (1.0 - 0.3 ** 2) / 206000.0)   # 226 374 MPa, steel on steel
 SIGMA_MAX_UM = 10.0          # highest accepted composite roughness, µm
 SPEED_MAX_MM_S = 5.0e5       # highest accepted entrainment / sliding speed, mm/s (500 m/s)
+
+#: asperity film factor c_a fitted to the numerical mixed-EHL reference (gearjax.tribology.ehl,
+#: 64² grid): least squares of ln φ over the 17 mixed points (0.01 ≤ φ ≤ 0.9) of the regime
+#: grid λ_s 0.3–5, p_max 0.5–2.5 GPa, Ry/Rx 1–20, u_e 2 m/s, default surface; rms error of
+#: ln φ 0.42 -> 0.18 (experiments/ehl_fast_check.py, docs/friction.md).  Not the default.
+EHL_ASPERITY_FILM_FACTOR = 0.86
 
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(48)
 _S = 0.5 * (_GL_X + 1.0)      # the former fixed 48-node rule on [0, 1] (benchmarks, tests)

@@ -154,7 +154,10 @@ def solve_ehl(F, u_e, u_s, Rx, Ry, eta0, alpha_per_GPa, E_prime=226373.6, tau0_M
     res = None
     if auto and int(n) > NESTED_ABOVE:
         res = _nested(locals(), grid)
-    if res is None or not bool(res.converged):
+    # on a fine grid the direct schedules are not tried after a nested solve whose
+    # coarse grid converged: they failed in every case tried (256²: 18 min) and cost
+    # up to 60 Newton steps each; the nested result is returned with its residual
+    if res is None or (not bool(res.converged) and int(n) <= NESTED_ABOVE):
         for sched in schedules:
             res = ehl_traced(case, grid, float(angle_deg), bool(mixed), sched, tol,
                              int(max_steps))

@@ -42,7 +42,10 @@ def _line_blocks(P, L, w, fl, dP_rho, dG, K0, K1, cw, d_a, s_a, c_a, d_c, s_c, c
     """Blocks (n_lines, m, m) or (n_lines, 2m, 2m); arrays laid out (lines, along)."""
     nl, m = P.shape
     L = w * L
-    r = jnp.sqrt(P * P + L * L) + 1e-300
+    # the same regularisation as the residual (model.residual_core): with the 1e-300
+    # outside the root, P, L ~ 1e-170 (cavitated nodes after a few Newton steps)
+    # underflow P², L² and give P/r ~ 1e130, an overflowing block (seen on 256²)
+    r = jnp.sqrt(P * P + L * L + 1e-300)
     A = 1.0 - P / r
     B = (-1.0 - L / r) * w
     eps = fl.eps
