@@ -38,10 +38,11 @@ import numpy as np  # noqa: E402
 
 from gearjax.contact import hertz_point  # noqa: E402
 from gearjax.tribology.ehl import solve_ehl  # noqa: E402
-from gearjax.tribology.ehl.api import _outputs_jit  # noqa: E402
+from gearjax.tribology.ehl.outputs import outputs  # noqa: E402
 from gearjax.tribology.friction import friction_coefficient, make_surface  # noqa: E402
 from gearjax.tribology.lubricant import make_oil  # noqa: E402
 
+_outputs_jit = jax.jit(outputs, static_argnames=("grid", "mixed"))
 HERE = os.path.dirname(os.path.abspath(__file__))
 OUT = os.path.join(HERE, "results")
 E, RX, ETA0, ALPHA, U_E = 226373.6, 10.0, 0.088, 22.0, 2000.0
