@@ -151,6 +151,18 @@ def test_elliptic_case_film_against_hamrock_dowson():
     assert abs(float(res.h_min) / hm - 1.0) <= 0.25
 
 
+def test_pseudo_transient_continuation_changes_the_path_not_the_root(base):
+    # the shift s (J + s I) of pseudo-transient continuation (used by the nested
+    # fine-grid solve) vanishes as the residual does: from the same Hertz start it must
+    # reach the root of plain Newton (same compiled program: ptc is traced)
+    res0, case, grid = base
+    res1 = ehl_traced(case, grid, ptc=1.0)
+    assert bool(res1.converged) and float(res1.residual) <= 1e-9
+    assert int(res1.steps) != int(res0.steps) or float(res1.residual) != float(res0.residual)
+    for f in ("h_c", "h_min", "mu"):
+        assert abs(float(getattr(res1, f)) / float(getattr(res0, f)) - 1.0) <= 1e-8, f
+
+
 def test_lower_speed_pressure_tends_to_hertz(base):
     # dry-contact limit: as u_e falls (Moes M 168 -> 416) the pressure approaches the
     # Hertz pressure (48² cannot resolve much larger M: the exit constriction would
