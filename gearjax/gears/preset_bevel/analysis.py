@@ -16,7 +16,8 @@ arc-seconds" is the pinion rotation ``kappa (t_min - t_m)^2``; as gear angle it 
 ``(z1/z2)`` of that (12 arc-seconds for 10/30 teeth).
 
 **Transfer gaps.**  Tooth pair 0 is on both flanks between ``phi_in`` and ``phi_out``
-(zero crossings of the boundary margin, interpolated linearly).  Where it enters,
+(zero crossings of the boundary margin: bracketed on the grid, then two Newton steps on
+its quadratic interpolant).  Where it enters,
 pair -1 (pair 0 one pitch later, ``TE_{-1}(phi) = TE_0(phi + p)``, ``p = 2 pi/z1``)
 carries the motion; where it leaves, pair +1 (``TE_0(phi - p)``).  With ``sgn = +1``
 for the maximum envelope and -1 for the minimum::
@@ -85,7 +86,8 @@ def interp_uniform(x0, h, f, x):
 
 def margin_crossings(res: TCAResult):
     """``(phi_in, phi_out)``: pinion angles where pair 0's margin crosses zero entering
-    and leaving the flanks (linear interpolation; NaN if none)."""
+    and leaving the flanks (bracketed on the grid, refined on the quadratic interpolant
+    of the margin; NaN if none)."""
     phi = res.path.phi1
     m = jnp.where(res.path.converged, res.margin, -1.0)
 
@@ -95,7 +97,16 @@ def margin_crossings(res: TCAResult):
         w = f[i] / (f[i] - f[i + 1])
         return jnp.where(jnp.any(hit), p[i] + w * (p[i + 1] - p[i]), jnp.nan)
 
-    return first_up(phi, m), first_up(phi[::-1], m[::-1])
+    h = phi[1] - phi[0]
+
+    def refine(x):
+        # two Newton steps on the quadratic interpolant of the margin (error O(h^3))
+        for _ in range(2):
+            mx, dm = jax.jvp(lambda y: interp_uniform(phi[0], h, m, y), (x,), (jnp.ones_like(x),))
+            x = x - mx / dm
+        return x
+
+    return refine(first_up(phi, m)), refine(first_up(phi[::-1], m[::-1]))
 
 
 def transfer_gaps(res: TCAResult, z1: int, steps_per_pitch: int):

@@ -228,9 +228,15 @@ def curve_point(c: CurveData, t):
 def curve_frame(c: CurveData, t):
     """``(r, alpha, n)``: point, unit tangent and unit flank normal (pure-rolling
     construction of the module docstring) at t."""
-    r, dr = jax.jvp(lambda x: curve_point(c, x), (t,), (jnp.ones_like(t),))
+    # closed-form tangent: f' = m f, theta' = 1 - 2 s kappa (t - t_m)
+    f = c.R0 * jnp.exp(c.m * t)
+    th = t + c.phase - c.s * c.kappa * (t - c.t_m) ** 2
+    dth = 1.0 - 2.0 * c.s * c.kappa * (t - c.t_m)
+    p = jnp.tan(c.delta1)
+    sn, cs = jnp.sin(th), jnp.cos(th)
+    r = jnp.stack([p * f * sn, p * f * cs, f])
+    dr = f * jnp.stack([p * (c.m * sn + dth * cs), p * (c.m * cs - dth * sn), c.m])
     al = dr / jnp.linalg.norm(dr)
-    th = jnp.arctan2(r[0], r[1])
     eN = jnp.stack([jnp.cos(c.delta1) * jnp.sin(th), jnp.cos(c.delta1) * jnp.cos(th),
                     -jnp.sin(c.delta1)])
     g = r / jnp.linalg.norm(r)
