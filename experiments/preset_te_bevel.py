@@ -137,11 +137,10 @@ def part_preset():
     lc = eff.loaded
     te_l = np.asarray(lc.te_loaded)
     env = np.asarray(res.multi.envelope)[A_window(res)]
-    pre_env = np.asarray(A.preset_te(des, res))[A_window(res)]
     # envelope of the preset parabolas of the pairs over the cycle (min envelope, drive)
-    pre_pairs = np.stack([np.asarray(A.preset_te(des, res))[A_window(res) - k * SPP]
-                          for k in (-1, 0, 1)])
-    pre_env = pre_pairs.min(axis=0)
+    y = np.asarray(res.path.phi1)[A_window(res)] - float(res.path.phi1[res.path.phi1.shape[0] // 2])
+    pre_env = np.min([preset_curve(des, y - k * 2 * math.pi / des.z1, 1.0) for k in (-1, 0, 1)],
+                     axis=0)
     shift = float(np.mean(te_l - pre_env))
     out["loaded"] = {
         "torque_Nm": TORQUE_NM, "rpm": RPM, "oil": "mineral_vg100", "sigma_um": 0.4,
@@ -156,6 +155,14 @@ def part_preset():
     _figure_te(des, res_m, res_0, te_l, pre_env, res)
     _figure_paths(des, res_0, res_m)
     return {"preset": out}
+
+
+def preset_curve(des, y, s):
+    """The preset TE (gear angle, rad) at pinion angle y from the reference (closed form
+    of gearjax.gears.preset_bevel.analysis.preset_te)."""
+    k = float(des.kappa)
+    x = 2.0 * y / (1.0 + np.sqrt(np.maximum(1.0 - 4.0 * s * k * y, 0.0)))
+    return s * (des.z1 / des.z2) * k * x ** 2
 
 
 def A_window(res):
@@ -175,7 +182,7 @@ def _figure_te(des, res_m, res_0, te_l, pre_env, res_loaded):
     for k, col in zip((-1, 0, 1), ("C1", "C0", "C2")):
         tp = np.asarray(res_m.multi.te_pairs)[k + 1]
         ax[0].plot(np.degrees(phi - mid), tp / AS, col, label=f"TCA pair {k:+d}")
-        sh = np.roll(pre, k * SPP)
+        sh = preset_curve(des, phi - mid - k * 2 * math.pi / des.z1, 1.0)
         ins = np.asarray(res_m.multi.inside)[k + 1]
         ax[0].plot(np.degrees(phi - mid)[ins], sh[ins] / AS, "k:", lw=1)
     ax[0].plot([], [], "k:", label="preset parabola")

@@ -5,7 +5,7 @@ exports ([Preset-TE-bevel]).
 Schema (file units: mm, degrees, arc-seconds; every geometry key is required except
 ``[flanks] spiral_R0_mm``)::
 
-    [design]  kind = "preset_te_bevel", name (optional string)
+    [design]  kind = "preset_te_bevel", name, description (optional strings)
     [pair]    teeth_pinion (int 3..200), teeth_gear (int 3..400, >= teeth_pinion),
               shaft_angle_deg (30..150), outer_transverse_module_mm (0.1..100),
               face_width_mm (> 0, <= 0.5 outer cone distance),
@@ -210,7 +210,7 @@ def read_preset_bevel(data: dict) -> PresetBevelFile:
     """Validate a parsed ``preset_te_bevel`` design file (ValueError naming the table and
     the key) and build the design."""
     check_keys("", data, {"design", "pair", "flanks", "preset"})
-    check_keys("design", data["design"], {"kind", "name"})
+    check_keys("design", data["design"], {"kind", "name", "description"})
     vals = {}
     for table, keys in SCHEMA.items():
         d = require_key("", data, table) if table in data else None
