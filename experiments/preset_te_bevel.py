@@ -102,7 +102,7 @@ def part_rolling():
 
 # -- preset TE, contact ends, loaded TE ---------------------------------------------------
 
-TORQUE_NM, RPM = 50.0, 1000.0
+TORQUES_NM, RPM = (2.0, 10.0, 50.0), 1000.0
 
 
 def part_preset():
@@ -131,28 +131,35 @@ def part_preset():
     }
     # loaded TE through the loaded-contact models (mesh_efficiency runs the load sharing)
     oil, surf = gj.get_oil("mineral_vg100"), gj.make_surface(0.4)
-    t = time.perf_counter()
-    eff, res = gj.mesh_efficiency(des, TORQUE_NM, RPM, oil, surf, side="drive", **OPTS)
-    sec = time.perf_counter() - t
-    lc = eff.loaded
-    te_l = np.asarray(lc.te_loaded)
-    env = np.asarray(res.multi.envelope)[A_window(res)]
-    # envelope of the preset parabolas of the pairs over the cycle (min envelope, drive)
-    y = np.asarray(res.path.phi1)[A_window(res)] - float(res.path.phi1[res.path.phi1.shape[0] // 2])
-    pre_env = np.min([preset_curve(des, y - k * 2 * math.pi / des.z1, 1.0) for k in (-1, 0, 1)],
-                     axis=0)
-    shift = float(np.mean(te_l - pre_env))
-    out["loaded"] = {
-        "torque_Nm": TORQUE_NM, "rpm": RPM, "oil": "mineral_vg100", "sigma_um": 0.4,
-        "te_loaded_ptp_arcsec": float(np.ptp(te_l) / AS),
-        "mean_deflection_arcsec": shift / AS,
-        "max_deviation_from_shifted_preset_arcsec": float(np.abs(te_l - pre_env - shift).max() / AS),
-        "max_deviation_unloaded_envelope_vs_preset_arcsec": float(np.abs(env - pre_env).max() / AS),
-        "pairs_loaded_per_position": np.asarray(lc.n_loaded).tolist(),
-        "max_p_max_MPa": float(eff.max_p_max), "mean_efficiency": float(eff.mean_efficiency),
-        "valid_positions": int(np.sum(np.asarray(eff.valid))), "positions": int(te_l.size),
-        "warnings": gj.efficiency_warnings(eff, res), "seconds_incl_compile": sec}
-    _figure_te(des, res_m, res_0, te_l, pre_env, res)
+    out["loaded"] = []
+    curves = {}
+    for T in TORQUES_NM:
+        t = time.perf_counter()
+        eff, res = gj.mesh_efficiency(des, T, RPM, oil, surf, side="drive", **OPTS)
+        sec = time.perf_counter() - t
+        lc = eff.loaded
+        te_l = np.asarray(lc.te_loaded)
+        env = np.asarray(res.multi.envelope)[A_window(res)]
+        # envelope of the preset parabolas of the pairs over the cycle (min envelope, drive)
+        y = (np.asarray(res.path.phi1)[A_window(res)]
+             - float(res.path.phi1[res.path.phi1.shape[0] // 2]))
+        pre_env = np.min([preset_curve(des, y - k * 2 * math.pi / des.z1, 1.0)
+                          for k in (-1, 0, 1)], axis=0)
+        shift = float(np.mean(te_l - pre_env))
+        curves[T] = (te_l - shift, pre_env, res)
+        out["loaded"].append({
+            "torque_Nm": T, "rpm": RPM, "oil": "mineral_vg100", "sigma_um": 0.4,
+            "te_loaded_ptp_arcsec": float(np.ptp(te_l) / AS),
+            "mean_deflection_arcsec": shift / AS,
+            "max_deviation_from_shifted_preset_arcsec": float(np.abs(te_l - pre_env - shift).max()
+                                                              / AS),
+            "max_deviation_unloaded_envelope_vs_preset_arcsec": float(np.abs(env - pre_env).max()
+                                                                      / AS),
+            "pairs_loaded_per_position": np.asarray(lc.n_loaded).tolist(),
+            "max_p_max_MPa": float(eff.max_p_max), "mean_efficiency": float(eff.mean_efficiency),
+            "valid_positions": int(np.sum(np.asarray(eff.valid))), "positions": int(te_l.size),
+            "warnings": gj.efficiency_warnings(eff, res), "seconds_incl_compile": sec})
+    _figure_te(des, res_m, res_0, curves)
     _figure_paths(des, res_0, res_m)
     return {"preset": out}
 
@@ -171,14 +178,13 @@ def A_window(res):
     return np.arange(mid - SPP // 2, mid - SPP // 2 + SPP)
 
 
-def _figure_te(des, res_m, res_0, te_l, pre_env, res_loaded):
+def _figure_te(des, res_m, res_0, curves):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(1, 2, figsize=(11, 4))
     phi = np.asarray(res_m.path.phi1)
     mid = phi[phi.shape[0] // 2]
-    pre = np.asarray(A.preset_te(des, res_m))
     for k, col in zip((-1, 0, 1), ("C1", "C0", "C2")):
         tp = np.asarray(res_m.multi.te_pairs)[k + 1]
         ax[0].plot(np.degrees(phi - mid), tp / AS, col, label=f"TCA pair {k:+d}")
@@ -190,15 +196,17 @@ def _figure_te(des, res_m, res_0, te_l, pre_env, res_loaded):
     ax[0].set_ylabel("TE, gear angle (arcsec)")
     ax[0].set_title("unloaded TE of the modified pair (drive)")
     ax[0].legend(fontsize=8)
-    w = A_window(res_loaded)
-    x = np.degrees(np.asarray(res_loaded.path.phi1)[w] - mid)
-    ax[1].plot(x, pre_env / AS, "k-", label="preset envelope")
-    ax[1].plot(x, (te_l - np.mean(te_l - pre_env)) / AS, "C3--",
-               label=f"loaded TE ({TORQUE_NM:g} N m), mean deflection removed")
+    first = True
+    for T, (te_l, pre_env, res) in curves.items():
+        x = np.degrees(np.asarray(res.path.phi1)[A_window(res)] - mid)
+        if first:
+            ax[1].plot(x, pre_env / AS, "k-", lw=2, label="preset envelope")
+            first = False
+        ax[1].plot(x, te_l / AS, "--", label=f"loaded TE, {T:g} N m (mean deflection removed)")
     ax[1].set_xlabel("pinion angle (deg)")
     ax[1].set_ylabel("TE (arcsec)")
     ax[1].set_title("loaded TE against the preset (one mesh cycle)")
-    ax[1].legend(fontsize=8)
+    ax[1].legend(fontsize=7)
     fig.tight_layout()
     atomic_write_figure(fig, OUT / "preset_te_bevel_te.png")
 

@@ -171,3 +171,15 @@ def test_design_file_validation_names_key():
     f = gj.design_from_dict(data)
     assert isinstance(f, gj.PresetBevelFile) and f.teeth("gear") == 30
     assert gj.family_of(f).family == "preset_bevel"
+
+
+def test_constructor_matches_design_file(des):
+    d = gj.PresetBevelDesign.create(z1=10, z2=30, beta_deg=35, alpha_n_deg=20, shaft_angle_deg=90,
+                                    module_t=7, face_width=30, rho1=16, rho2=16, addendum=4.5,
+                                    dedendum=4.5, preset_te_arcsec=36)
+    for a, b in zip(jax.tree_util.tree_leaves(d), jax.tree_util.tree_leaves(des)):
+        assert float(a) == float(b)
+    with pytest.raises(ValueError, match="beta"):
+        gj.PresetBevelDesign.create(z1=10, z2=30, beta_deg=70, alpha_n_deg=20,
+                                    shaft_angle_deg=90, module_t=7, face_width=30, rho1=16,
+                                    rho2=16, addendum=4.5, dedendum=4.5)
