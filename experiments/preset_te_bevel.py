@@ -370,13 +370,13 @@ def part_optimise():
                           "te_ptp_arcsec": float(res.multi.ptp / AS),
                           "jump_arcsec": max(0.0, max(g)), "flags": res.flags()})
     hist = np.asarray(opt.history)
-    _figure_opt(hist, np.asarray(opt.xs) * np.asarray(scale))
+    _figure_opt(hist, np.asarray(opt.x_history) * np.asarray(scale))
     out = {"set": OPT_SET, "tau_arcsec": TAU, "w_hinge": W_HINGE, "w_height": W_H,
            "start": {"kappa": k0, "rho1": 16.0, "rho2": 16.0, "objective": float(hist[0])},
            "final": {"kappa": float(best.kappa), "rho1": float(best.rho1), "rho2": float(best.rho2),
                      "preset_pinion_arcsec": float(best.kappa) * (t0 - tm) ** 2 / AS,
                      "objective": float(opt.value)},
-           "status": gj.status_message(opt.status),
+           "status": opt.message, "final_grad_norm": float(opt.grad_norm),
            "steps": int(opt.steps), "history": hist.tolist(), "seconds_incl_compile": sec,
            "forward_check": check}
     return {"optimisation": out}
@@ -404,6 +404,11 @@ PARTS = {"rolling": part_rolling, "preset": part_preset, "robust": part_robust,
 
 
 def main(argv):
+    import os
+    # keep compiled programs between runs of the parts (several minutes each)
+    jax.config.update("jax_compilation_cache_dir",
+                      os.environ.get("PRESET_TE_CACHE", "/tmp/preset_te_bevel_jax_cache"))
+    jax.config.update("jax_persistent_cache_min_compile_time_secs", 5.0)
     names = argv or list(PARTS)
     data = json.loads(JSON.read_text()) if JSON.exists() else {}
     for n in names:
