@@ -219,14 +219,20 @@ def _figure_paths(des, res_0, res_m):
     Ai, _, Ao = (float(v) for v in G.cone_distances(des))
     ha, hf = float(des.addendum), float(des.dedendum)
     ax.plot([Ai, Ao, Ao, Ai, Ai], [-hf, -hf, ha, ha, -hf], "k-", lw=1)
-    for res, lab, col in ((res_0, "unmodified", "C0"), (res_m, "preset 36 arcsec", "C3")):
+    cases = [(res_0, "unmodified", "C0"), (res_m, "preset 36 arcsec", "C3")]
+    if JSON.exists() and "optimisation" in json.loads(JSON.read_text()):
+        fin = json.loads(JSON.read_text())["optimisation"]["final"]
+        best = dataclasses.replace(des, kappa=jnp.asarray(fin["kappa"]),
+                                   rho1=jnp.asarray(fin["rho1"]), rho2=jnp.asarray(fin["rho2"]))
+        cases.append((tca(best), "optimised (kappa, rho1, rho2)", "C2"))
+    for res, lab, col in cases:
         carry = (np.asarray(res.multi.active) == 1) & np.asarray(res.on_flank)
         if res is res_0:
             carry = np.asarray(res.on_flank)
         L, h = np.asarray(res.coords["L1"]), np.asarray(res.coords["h1"])
         ax.plot(L[carry], 10 * h[carry], "o-", color=col, ms=3, label=lab + " (h x10)")
     ax.set_xlabel("cone distance on the pinion (mm): toe -> heel")
-    ax.set_ylabel("height above pitch cone (mm)")
+    ax.set_ylabel("height above pitch cone (mm; paths x10)")
     ax.set_title("contact path carrying the load (pair 0, unloaded envelope)")
     ax.legend(fontsize=8)
     fig.tight_layout()
