@@ -71,6 +71,10 @@ from gearjax.gears.hypoid.tca import prepare as prepare_hypoid  # noqa: E402
 from gearjax.gears.hypoid import synthesis  # noqa: E402
 from gearjax.gears.hypoid.synthesis import Targets, synthesise  # noqa: E402
 from gearjax.gears.hypoid.synthesis import start as synthesis_start  # noqa: E402
+from gearjax.gears.preset_bevel.geometry import PresetBevelDesign  # noqa: E402
+from gearjax.gears.preset_bevel.design_file import PresetBevelFile  # noqa: E402
+from gearjax.gears.preset_bevel.design_file import flank_grid as preset_bevel_flank_grid  # noqa: E402
+from gearjax.gears.preset_bevel import analysis as preset_bevel_analysis  # noqa: E402
 # -- lubrication and friction --------------------------------------------------------
 from gearjax.tribology import (OILS, FrictionResult, Oil, Surface, friction_coefficient,  # noqa: E402
                                friction_traced, get_oil, make_oil, make_surface, mesh_losses,
@@ -176,4 +180,6 @@ __all__ = [
     "field_names", "get_fields", "with_fields",
     # frames
     "rot_x", "rot_y", "rot_z", "rot_axis", "translate",
+    # pure-rolling bevel pairs with a preset TE
+    "PresetBevelDesign", "PresetBevelFile", "preset_bevel_flank_grid", "preset_bevel_analysis",
 ]
