@@ -57,7 +57,8 @@ def _crossing_case():
 def test_flags_all_clear_for_a_hand_over_where_the_te_curves_cross():
     f = _result(*_crossing_case()).flags()
     assert f == dict(converged=True, reference_on_flank=True, edge_contact=False,
-                     low_contact_ratio=False, face_end_contact=False, large_te=False)
+                     low_contact_ratio=False, face_end_contact=False, tip_contact=False,
+                     large_te=False)
     assert _result(*_crossing_case()).warnings() == []
 
 
