@@ -1,4 +1,4 @@
-"""Edge contact at the face ends of tooth flanks (toe and heel), found by the TCA.
+"""Edge contact at the face ends (toe, heel) and tip edges of tooth flanks, found by the TCA.
 
 The surface contact of :func:`gearjax.tca.contact_path` is a tangency of the two
 flanks.  Where that tangency lies beyond a face end (an uncrowned pair under a
@@ -38,9 +38,9 @@ edge contact with respect to every design field follow).
 
 **Which contact is made.**  The teeth are rigid: at a pinion angle the gear
 turns until the first pair of points touches.  The candidates are the surface
-contact (valid where it lies inside both flanks) and the four face-end contacts
-(valid where the edge point lies inside the other boundaries of its flank --
-tip, root -- and the point of flank ``j`` inside flank ``j``).  The contact made
+contact (valid where it lies inside both flanks) and the edge contacts -- four face
+ends, two tips -- (valid where the edge point lies inside the other boundaries of its
+flank -- tip or face width, root -- and the point of flank ``j`` inside flank ``j``).  The contact made
 is the candidate furthest ahead in the sense of the load, ``max s TE`` with
 ``s = +1`` on the drive side and ``-1`` on the coast side -- the rule of the TE
 envelope of consecutive pairs (:func:`gearjax.tca.multi_pair`).  Where the surface
@@ -61,9 +61,25 @@ load concentrates on the edge); the path reports the semi-axes as NaN there and
 marks the point in ``edge_kind`` (its major axis and Weingarten maps are those of
 the surface solve at that angle, kept finite so that no NaN enters a derivative;
 the kinematics at edge points are NaN, :func:`gearjax.tca_result.contact_kinematics`).
-Tip and root edges are not solved as contacts: a contact path that reaches them
-leaves the flank (``margin < 0``), which the contact ratio, the TE envelope and
-the quality flags of :class:`gearjax.tca_result.TCAResult` report.
+**Tip edges** (with ``tips``).  The same system with the tip function ``t_k(q)``
+(mm, zero on the tip surface -- addendum cylinder ``r_a - |q_xy|`` of an involute
+member, the face cone of a bevel member -- and positive below it) in place of
+``g_k``: the contact of a member's tip edge with the mating flank off the path of
+contact (premature contact of an incoming pair, prolonged contact of an outgoing
+one: the corner contacts of a base-pitch mismatch).  With the TE ``f(r)`` at which
+the profile point at radius ``r`` touches, it is the end ``r = r_a`` of ``max f``
+over the flank.  Two more candidates (pinion tip, gear tip) in the same ``vmap``.
+A spur tip edge is parallel to the mating generatrix: the tangency equation vanishes
+identically, so in line-contact mode a tip edge is solved in the face-width section
+of the surface path (``v1 = v1`` of the path replaces the tangency: the tip corner of
+that transverse profile).  A tip candidate starts at the converged grid point where
+the surface contact is nearest its tip (the face ends at the reference).  Root
+boundaries are not edges: a generated flank joins its fillet with a common tangent
+plane; a tip candidate whose mating point lies below the mating root boundary is
+not valid (tip/fillet interference, the fillet is not modelled), and a contact path
+that reaches a root boundary leaves the flank (``margin < 0``), which the contact
+ratio, the TE envelope and the quality flags report.  Corner contact (tip edge x
+face end) is not solved.
 
 Units: mm, rad.
 """
@@ -98,15 +114,16 @@ EDGE_LEAD = 1e-9
 
 
 class EdgeContact(NamedTuple):
-    """The face-end contacts beside a surface contact path (arrays over the grid).
+    """The edge contacts beside a surface contact path (arrays over the grid; ``K`` = 4
+    face ends, 6 with the tip edges, in the order of :data:`EDGE_NAMES`).
 
     kind : (N,) int, -1 where the contact is the surface contact, else the index into
-        :data:`EDGE_NAMES` of the face end carrying the contact.
-    te : (4, N) TE of each face-end contact (rad, the path's reference), NaN where
+        :data:`EDGE_NAMES` of the edge carrying the contact.
+    te : (K, N) TE of each edge contact (rad, the path's reference), NaN where
         that candidate is not valid.
-    valid : (4, N) the face-end contact converged and lies inside the other
+    valid : (K, N) the edge contact converged and lies inside the other
         boundaries of both flanks.
-    residual : (4, N) max |F| of the edge-contact solves.
+    residual : (K, N) max |F| of the edge-contact solves.
     """
 
     kind: jax.Array

@@ -187,7 +187,7 @@ class ContactPath(NamedTuple):
         generated flank (:class:`~gearjax.surfaces.GeneratedSurface`; NaN for another
         flank), solved with the contact (:func:`contact_system`).
     edge_kind : (N,) int, -1 where the contact is a tangency of the two flanks, else
-        the face end carrying it (index into :data:`gearjax.edge_contact.EDGE_NAMES`;
+        the edge (face end or tip) carrying it (index into :data:`gearjax.edge_contact.EDGE_NAMES`;
         there the semi-axes are NaN: no Hertz ellipse at an edge).  ``None`` where face ends were not examined.
     """
 
