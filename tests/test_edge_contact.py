@@ -9,6 +9,9 @@ transverse profile normal ``n = (+-cos aw, sin aw, 0)`` (the line of action) tha
 so the uncrowned pair touches at the face end that leads, ahead of the mid-face
 section by ``(b/2) dg cos aw / r_b2`` (Litvin & Fuentes, Gear Geometry and Applied
 Theory, ch. 15: a crossing of the axes of unmodified gears gives edge contact).
+
+Tip edges: a spur pair with a base-pitch mismatch touches at a tooth tip off the line
+of action; reference: the closed form of the plane involutes (below, before the tests).
 """
 
 import json
@@ -23,6 +26,7 @@ from gearjax import ARCSEC
 from gearjax.cli import main
 from gearjax.edge_contact import EDGE_NAMES
 from gearjax.gears.involute import tca as itca
+from gearjax.gears.involute.geometry import generated_flank
 
 B = 30.0
 PAIR = gj.InvolutePair.create(20, 40, 4.0, 20.0, 0.0, 0.0, 0.0)
@@ -245,7 +249,7 @@ def mismatch(traced):
         mid = path.phi1.shape[0] // 2
         # the working-flank sides in the body frames, from one point of each flank
         r1 = itca.crowned_pinion_flank(des, -1)
-        r2 = itca.generated_flank(PAIR.module, PAIR.pressure_angle, 0.0, 0.0, 40, -1)
+        r2 = generated_flank(PAIR.module, PAIR.pressure_angle, 0.0, 0.0, 40, -1)
         cf = _ClosedFormSpur(20, 40, 4.0, 20.0, da, 120.0, (1.0, 1.0))
         sig = []
         for i, (r, uv) in enumerate(((r1, path.uv1[mid]), (r2, path.uv2[mid]))):
