@@ -85,7 +85,8 @@ HELICAL = gj.InvoluteTCA.create(gj.InvolutePair.create(20, 40, 4.0, 20.0, 15.0, 
 
 @pytest.mark.parametrize("des", [SPUR, HELICAL], ids=["spur", "helical"])
 def test_aligned_conjugate_pair_has_no_edge_contact_and_is_unchanged(traced, des):
-    """A conjugate pair touches along lines across the whole face: no edge contact.  For
+    """A conjugate pair touches along lines across the whole face: no edge contact (face
+    end or tip).  For
     the helical pair the face ends stay on the flanks after the solved mid-face section
     has left them -- those face-end points lie on its contact line (same TE)."""
     mis = _mis(0.0)
@@ -95,6 +96,9 @@ def test_aligned_conjugate_pair_has_no_edge_contact_and_is_unchanged(traced, des
     np.testing.assert_array_equal(np.asarray(path.te), np.asarray(ref.te))
     np.testing.assert_array_equal(np.asarray(margin), np.asarray(ref_margin))
     assert float(multi.contact_ratio) == float(ref_multi.contact_ratio)
+    # no spurious tip contact: a tip corner off the line of action has clearance, so
+    # the TE envelope is the same to the last bit with and without the edge solve
+    np.testing.assert_array_equal(np.asarray(multi.envelope), np.asarray(ref_multi.envelope))
 
 
 def _d_mis(traced, des, mis, direction):
