@@ -326,7 +326,11 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
                      jnp.minimum(face1, jnp.minimum(tip1, root1)))
     other = jnp.minimum(jnp.minimum(own, own_root), mate)
     valid = conv & (other >= 0.0)
-    te = path.te[None, :] + asm.ratio_sign * (ph2 - path.phi2[None, :])
+    # TE from the reference contact of the path (not from the path's own value at each
+    # angle: where the surface solve failed that may be NaN, and an edge contact there
+    # is still a contact)
+    te = (path.te[mid] + asm.ratio_sign * (ph2 - path.phi2[mid])
+          - (asm.z1 / asm.z2) * (path.phi1 - path.phi1[mid])[None, :])
     sgn = jnp.where(drive, 1.0, -1.0)
     surf_ok = (margin >= 0.0) & path.converged
     key_s = jnp.where(surf_ok, sgn * path.te, -jnp.inf)
