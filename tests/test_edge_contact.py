@@ -345,3 +345,24 @@ def test_tip_contact_te_derivative_matches_central_differences(traced, mismatch)
     d_fd = (up - dn) / (2 * h)
     assert abs(float(d_fd)) > 1e-5                       # rad/mm: not a trivial zero
     np.testing.assert_allclose(float(dp.te[j]), float(d_fd), rtol=1e-6)
+
+
+def test_hypoid_tip_edge_function_is_the_face_cone():
+    """The bevel/hypoid tip-edge function is zero on the pinion's face cone (the line
+    heel-tip to toe-tip corner of its axial outline, from the blank) and grows into
+    the tooth as the normal distance, cos(face angle) per mm of radius; the margins
+    give it as the tip part.  (No TCA: the edge system with it is the one above.)"""
+    from gearjax.gears.hypoid.pair import hypoid_face_ends
+    pair = gj.pair_flanks(gj.load_design(gj.example_path("spiral_bevel_10x30_synthesised")),
+                          "drive")
+    parts, g1, g2, (t1, t2) = hypoid_face_ends(pair)
+    corners = gj.pinion_outline(pair)["outline"]
+    z, r = 0.5 * (corners[2] + corners[3])               # mid face on the face cone
+    q = jnp.array([r, 0.0, z])
+    assert abs(float(t1(q))) < 1e-9
+    d = 0.3
+    cos_g = float(np.cos(pair.pinion.blank.face_angle))
+    assert float(t1(q - jnp.array([d, 0.0, 0.0]))) == pytest.approx(d * cos_g, rel=1e-12)
+    f1, tip1, root1, *_ = parts(q[None] - jnp.array([[d, 0.0, 0.0]]), q[None])
+    assert float(tip1[0]) == pytest.approx(d * cos_g, rel=1e-12)
+    assert float(f1[0]) > 0 and float(root1[0]) > 0
