@@ -1,4 +1,4 @@
-"""Edge contact at the face ends of tooth flanks (toe and heel), found by the TCA.
+"""Edge contact at the face ends (toe, heel) and tip edges of tooth flanks, found by the TCA.
 
 The surface contact of :func:`gearjax.tca.contact_path` is a tangency of the two
 flanks.  Where that tangency lies beyond a face end (an uncrowned pair under a
@@ -38,9 +38,9 @@ edge contact with respect to every design field follow).
 
 **Which contact is made.**  The teeth are rigid: at a pinion angle the gear
 turns until the first pair of points touches.  The candidates are the surface
-contact (valid where it lies inside both flanks) and the four face-end contacts
-(valid where the edge point lies inside the other boundaries of its flank --
-tip, root -- and the point of flank ``j`` inside flank ``j``).  The contact made
+contact (valid where it lies inside both flanks) and the edge contacts -- four face
+ends, two tips -- (valid where the edge point lies inside the other boundaries of its
+flank -- tip or face width, root -- and the point of flank ``j`` inside flank ``j``).  The contact made
 is the candidate furthest ahead in the sense of the load, ``max s TE`` with
 ``s = +1`` on the drive side and ``-1`` on the coast side -- the rule of the TE
 envelope of consecutive pairs (:func:`gearjax.tca.multi_pair`).  Where the surface
@@ -61,9 +61,25 @@ load concentrates on the edge); the path reports the semi-axes as NaN there and
 marks the point in ``edge_kind`` (its major axis and Weingarten maps are those of
 the surface solve at that angle, kept finite so that no NaN enters a derivative;
 the kinematics at edge points are NaN, :func:`gearjax.tca_result.contact_kinematics`).
-Tip and root edges are not solved as contacts: a contact path that reaches them
-leaves the flank (``margin < 0``), which the contact ratio, the TE envelope and
-the quality flags of :class:`gearjax.tca_result.TCAResult` report.
+**Tip edges** (with ``tips``).  The same system with the tip function ``t_k(q)``
+(mm, zero on the tip surface -- addendum cylinder ``r_a - |q_xy|`` of an involute
+member, the face cone of a bevel member -- and positive below it) in place of
+``g_k``: the contact of a member's tip edge with the mating flank off the path of
+contact (premature contact of an incoming pair, prolonged contact of an outgoing
+one: the corner contacts of a base-pitch mismatch).  With the TE ``f(r)`` at which
+the profile point at radius ``r`` touches, it is the end ``r = r_a`` of ``max f``
+over the flank.  Two more candidates (pinion tip, gear tip) in the same ``vmap``.
+A spur tip edge is parallel to the mating generatrix: the tangency equation vanishes
+identically, so in line-contact mode a tip edge is solved in the face-width section
+of the surface path (``v1 = v1`` of the path replaces the tangency: the tip corner of
+that transverse profile).  A tip candidate starts at the converged grid point where
+the surface contact is nearest its tip (the face ends at the reference).  Root
+boundaries are not edges: a generated flank joins its fillet with a common tangent
+plane; a tip candidate whose mating point lies below the mating root boundary is
+not valid (tip/fillet interference, the fillet is not modelled), and a contact path
+that reaches a root boundary leaves the flank (``margin < 0``), which the contact
+ratio, the TE envelope and the quality flags report.  Corner contact (tip edge x
+face end) is not solved.
 
 Units: mm, rad.
 """
@@ -80,27 +96,34 @@ from gearjax.frames import matrix_z
 from gearjax.newton import newton_solve
 from gearjax.tca import ContactPath, contact_system, flank_at, gear_mount
 
-__all__ = ["EDGE_NAMES", "EDGE_LEAD", "EdgeContact", "edge_contact_system", "face_end_contact"]
+__all__ = ["EDGE_NAMES", "FACE_END_KINDS", "TIP_KINDS", "EDGE_LEAD", "EdgeContact", "edge_contact_system", "face_end_contact"]
 
-#: names of the four face ends, in the order of :attr:`EdgeContact.kind`
-EDGE_NAMES = ("pinion toe", "pinion heel", "gear toe", "gear heel")
-_PINION = np.array([1.0, 1.0, 0.0, 0.0])
-_END = np.array([-1.0, 1.0, -1.0, 1.0])
+#: names of the edges, in the order of :attr:`EdgeContact.kind`: the four face ends,
+#: then the tip edges of pinion and gear (appended: the face-end indices 0-3 keep
+#: their meaning)
+EDGE_NAMES = ("pinion toe", "pinion heel", "gear toe", "gear heel", "pinion tip", "gear tip")
+#: indices into :data:`EDGE_NAMES` of the face ends (toe/heel) and of the tip edges
+FACE_END_KINDS = (0, 1, 2, 3)
+TIP_KINDS = (4, 5)
+_PINION = np.array([1.0, 1.0, 0.0, 0.0, 1.0, 0.0])
+_END = np.array([-1.0, 1.0, -1.0, 1.0, 0.0, 0.0])
+_TIP = np.array([0.0, 0.0, 0.0, 0.0, 1.0, 1.0])
 
 #: rad: an edge contact replaces the surface contact only when it is this far ahead
 EDGE_LEAD = 1e-9
 
 
 class EdgeContact(NamedTuple):
-    """The face-end contacts beside a surface contact path (arrays over the grid).
+    """The edge contacts beside a surface contact path (arrays over the grid; ``K`` = 4
+    face ends, 6 with the tip edges, in the order of :data:`EDGE_NAMES`).
 
     kind : (N,) int, -1 where the contact is the surface contact, else the index into
-        :data:`EDGE_NAMES` of the face end carrying the contact.
-    te : (4, N) TE of each face-end contact (rad, the path's reference), NaN where
+        :data:`EDGE_NAMES` of the edge carrying the contact.
+    te : (K, N) TE of each edge contact (rad, the path's reference), NaN where
         that candidate is not valid.
-    valid : (4, N) the face-end contact converged and lies inside the other
+    valid : (K, N) the edge contact converged and lies inside the other
         boundaries of both flanks.
-    residual : (4, N) max |F| of the edge-contact solves.
+    residual : (K, N) max |F| of the edge-contact solves.
     """
 
     kind: jax.Array
@@ -109,17 +132,30 @@ class EdgeContact(NamedTuple):
     residual: jax.Array
 
 
-def edge_contact_system(r1: Callable, r2: Callable, asm, mis, g1: Callable, g2: Callable):
+def edge_contact_system(r1: Callable, r2: Callable, asm, mis, g1: Callable, g2: Callable,
+                        t1: Callable | None = None, t2: Callable | None = None, *,
+                        line_contact: bool = False, v1_fixed=0.0):
     """The edge-contact system ``F(z, theta)`` of the module docstring.
 
-    ``theta = (phi1, s, g0, pinion, e)``: pinion angle, homotopy level, ``g_k`` at the
-    start point, 1.0 for an edge of the pinion (0.0: of the gear), end ``e``.  The
-    unknown ``z`` is packed as in :func:`gearjax.tca.contact_system` (point contact).
-    Returns ``(F, cs)`` with ``cs`` that :class:`~gearjax.tca.ContactSystem`.
+    ``theta = (phi1, s, g0, pinion, e, tip)``: pinion angle, homotopy level, the edge
+    function at the start point, 1.0 for an edge of the pinion (0.0: of the gear), face
+    end ``e`` and 1.0 for the tip edge (then ``t_k(q)`` replaces ``g_k(q, e)``; ``t1``,
+    ``t2`` default to the face ends).  With ``line_contact`` the tip-edge candidates
+    take the line-contact treatment: the edge tangency is replaced by ``v1 = v1_fixed``
+    (one face-width section, that of the surface path).  The unknown ``z`` is packed as
+    in :func:`gearjax.tca.contact_system` (point contact).  Returns ``(F, cs)`` with
+    ``cs`` that :class:`~gearjax.tca.ContactSystem`.
     """
     R, c = gear_mount(asm, mis)
     cs = contact_system(r1, r2, asm, mis, False)
     ez = jnp.array([0.0, 0.0, 1.0])
+
+    def edge_fn(g, t):
+        if t is None:
+            return lambda q, e, tip: g(q, e)
+        return lambda q, e, tip: jnp.where(tip > 0.5, t(q), g(q, e))
+
+    h1, h2 = edge_fn(g1, t1), edge_fn(g2, t2)
 
     def tangency(n_other, Rk, m, grad_g):
         t = Rk @ jnp.cross(m, grad_g)
@@ -127,7 +163,7 @@ def edge_contact_system(r1: Callable, r2: Callable, asm, mis, g1: Callable, g2: 
         return jnp.dot(n_other, t) / jnp.where(nt > 0.0, nt, 1.0)
 
     def F(z, theta):
-        ph1, s, g0, pinion, e = theta
+        ph1, s, g0, pinion, e, tip = theta
         x, psi1, psi2 = cs.split(z)
         uv1, uv2, ph2 = cs.unpack(x)
         q1, m1, f1 = flank_at(r1, uv1, psi1)
@@ -136,11 +172,15 @@ def edge_contact_system(r1: Callable, r2: Callable, asm, mis, g1: Callable, g2: 
         R2 = R @ matrix_z(ph2)
         p1 = R1 @ q1 + mis.dP * ez
         p2 = c + R2 @ q2
-        ga, da = jax.value_and_grad(g1)(q1, e)
-        gb, db = jax.value_and_grad(g2)(q2, e)
+        ga, da = jax.value_and_grad(h1)(q1, e, tip)
+        gb, db = jax.value_and_grad(h2)(q2, e, tip)
         is1 = pinion > 0.5
         on_edge = jnp.where(is1, ga, gb) - s * g0
         tang = jnp.where(is1, tangency(R2 @ m2, R1, m1, da), tangency(R1 @ m1, R2, m2, db))
+        if line_contact:
+            # a tip edge parallel to the mating generatrix (spur) touches along a
+            # line: fix the face-width section instead of the (degenerate) tangency
+            tang = jnp.where(tip > 0.5, uv1[1] - v1_fixed, tang)
         mesh = [jnp.reshape(f, (1,)) for f in (f1, f2) if f is not None]
         return jnp.concatenate([p1 - p2, jnp.stack([on_edge, tang])] + mesh)
 
@@ -174,20 +214,24 @@ def _continue(F, z0, thetas, fresh, n_homotopy, tol, max_steps):
 
 def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, margin,
                      margin_parts: Callable, g1: Callable, g2: Callable, *, drive,
-                     steps_per_pitch: int, line_contact: bool = False, tol: float = 1e-11,
-                     max_steps: int = 30, n_homotopy: int = 8):
-    """Face-end contacts beside ``path`` and the contact actually made (traceable).
+                     steps_per_pitch: int, line_contact: bool = False, tips=None,
+                     tol: float = 1e-11, max_steps: int = 30, n_homotopy: int = 8):
+    """Edge contacts (face ends, and tip edges with ``tips``) beside ``path`` and the
+    contact actually made (traceable).
 
     ``path``, ``margin`` : the surface contact path and its boundary margin (mm).
-    ``margin_parts(p1_body, p2_body) -> (face1, rest1, face2, rest2)`` : boundary
-    margins (mm, >= 0 inside) of each member's face width and of its other boundaries
-    (tip, root) at body-frame points (N, 3).  ``g1, g2`` : face-end functions of pinion
-    and gear (module docstring).  ``drive`` : True on the drive side (may be traced).
+    ``margin_parts(p1_body, p2_body) -> (face1, tip1, root1, face2, tip2, root2)`` :
+    boundary margins (mm, >= 0 inside) of each member's face width, tip and root (form
+    circle / fillet) boundaries at body-frame points (N, 3).  ``g1, g2`` : face-end
+    functions of pinion and gear (module docstring).  ``tips = (t1, t2)`` : tip-edge
+    functions ``t_k(q)`` (mm, zero on the tip surface, > 0 below it) of pinion and
+    gear, or ``None`` (face ends only).  ``drive`` : True on the drive side (may be traced).
     ``steps_per_pitch`` : grid steps per angular pitch (the neighbouring tooth pairs
     are pair 0 shifted by that many steps).
     ``line_contact`` : ``path`` was solved in line-contact mode (one face-width section):
     a face-end contact with the TE of that section lies on its contact line and is
-    not an edge contact.
+    not an edge contact; the tip edges are solved in that section
+    (:func:`edge_contact_system`).
 
     Returns ``(path, margin, edges)``: the path with the contact made at every grid
     point (surface or edge), its margin (>= 0 on the flanks; 0 on the edge's own face
@@ -195,44 +239,70 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
     """
     n = path.phi1.shape[0]
     mid = n // 2
-    F, cs = edge_contact_system(r1, r2, asm, mis, g1, g2)
+    t1, t2 = (None, None) if tips is None else tips
+    nc = 4 if tips is None else 6
+    v1_fixed = jax.lax.stop_gradient(path.uv1[mid, 1])
+    F, cs = edge_contact_system(r1, r2, asm, mis, g1, g2, t1, t2, line_contact=line_contact,
+                                v1_fixed=v1_fixed)
     R, c = gear_mount(asm, mis)
-    x0 = jnp.concatenate([path.uv1[mid], path.uv2[mid], path.phi2[mid][None]])
-    psi_mid = [None if p is None else p[mid] for p in (path.psi1, path.psi2)]
-    z_ref = jax.lax.stop_gradient(cs.join(x0, *psi_mid))
-    ph_mid = path.phi1[mid]
     s_levels = jnp.linspace(1.0, 0.0, n_homotopy + 1)[1:]
-    # each direction away from the reference: the homotopy s = 1 -> 0 at the reference
-    # angle, then the continuation along the grid -- one scan, one Newton in the program
     k = n_homotopy
-    phis = jnp.stack([jnp.concatenate([jnp.full((k,), ph_mid), path.phi1[mid + 1:]]),
-                      jnp.concatenate([jnp.full((k,), ph_mid), path.phi1[:mid][::-1]])])
-    levels = jnp.concatenate([s_levels, jnp.zeros(mid)])
-    # the linear predictor starts afresh at the first angle step (a constant predictor)
-    fresh = jnp.concatenate([jnp.zeros(k, bool), jnp.ones(1, bool), jnp.zeros(mid - 1, bool)])
+    steps = np.arange(n - 1)
+    levels = jnp.concatenate([s_levels, jnp.zeros(n - 1)])
+    cols = jnp.arange(n)
 
-    def one_edge(pinion, e):
-        g0 = jnp.where(pinion > 0.5, g1(path.p1_body[mid], e), g2(path.p2_body[mid], e))
-        g0 = jax.lax.stop_gradient(g0)
+    def start_value(g, t, q, e, tip):
+        return g(q, e) if t is None else jnp.where(tip > 0.5, t(q), g(q, e))
 
-        def run(ph):
-            return _continue(F, z_ref, (ph, levels, g0 + 0.0 * levels, pinion + 0.0 * levels,
-                                        e + 0.0 * levels), fresh, k, tol, max_steps)
+    def edge_values(g, t, q, e, tip):
+        return jax.vmap(lambda qq: start_value(g, t, qq, e, tip))(q)
 
-        sols = jax.vmap(run)(phis)
-        at_ref = jax.tree_util.tree_map(lambda a: a[0, k - 1], sols)
-        ok_ref = at_ref.converged & sols.converged[1, k - 1]
+    def one_edge(pinion, e, tip):
+        # the start: the surface contact at the reference (face ends) or, for a tip
+        # edge, at the converged grid point where the surface contact is nearest that
+        # tip (the homotopy is then short and starts on the branch the corner takes
+        # where the contact path leaves the flank over the tip)
+        gv = jnp.where(pinion > 0.5, edge_values(g1, t1, path.p1_body, e, tip),
+                       edge_values(g2, t2, path.p2_body, e, tip))
+        gv = jax.lax.stop_gradient(gv)
+        near = jnp.argmin(jnp.where(path.converged, jnp.abs(gv), jnp.inf))
+        i0 = jnp.where((tip > 0.5) & jnp.any(path.converged), near, mid)
+        g0 = gv[i0]
+        x0 = jnp.concatenate([path.uv1[i0], path.uv2[i0], path.phi2[i0][None]])
+        psi0 = [None if p is None else p[i0] for p in (path.psi1, path.psi2)]
+        z0 = jax.lax.stop_gradient(cs.join(x0, *psi0))
+        # each direction away from the start: the homotopy s = 1 -> 0 at the start
+        # angle, then the continuation along the grid (padded at the grid's end with
+        # the last angle) -- one scan, one Newton in the program
+        fwd = i0 + 1 + steps
+        bwd = i0 - 1 - steps
+        ph0 = jnp.full((k,), path.phi1[i0])
+        phis = jnp.stack([jnp.concatenate([ph0, path.phi1[jnp.clip(fwd, 0, n - 1)]]),
+                          jnp.concatenate([ph0, path.phi1[jnp.clip(bwd, 0, n - 1)]])])
+        # a constant predictor at the first angle step and on the padding, the linear
+        # predictor of the two previous solutions elsewhere
+        pad = jnp.stack([fwd > n - 1, bwd < 0])
+        fresh = jnp.concatenate([jnp.zeros((2, k), bool),
+                                 pad | (steps == 0)[None, :]], axis=1)
+        const = [v + 0.0 * levels for v in (g0, pinion, e, tip)]
 
-        def whole(field, ref_val):
-            two = field[:, k:]
-            return jnp.concatenate([two[1][::-1], ref_val[None], two[0]], axis=0)
+        def run(ph, fr):
+            return _continue(F, z0, (ph, levels, *const), fr, k, tol, max_steps)
 
-        Z = whole(sols.x, at_ref.x)
-        conv = whole(sols.converged, at_ref.converged) & ok_ref
-        res = whole(sols.residual, at_ref.residual)
-        return Z, conv, res
+        sols = jax.vmap(run)(phis, fresh)
+        ok_ref = sols.converged[0, k - 1] & sols.converged[1, k - 1]
+        pos = jnp.where(cols < i0, k + i0 - cols - 1,
+                        jnp.where(cols > i0, k + cols - i0 - 1, k - 1))
+        way = jnp.where(cols < i0, 1, 0)
 
-    Z, conv, res = jax.vmap(one_edge)(jnp.asarray(_PINION), jnp.asarray(_END))
+        def whole(field):
+            return field[way, pos]
+
+        return whole(sols.x), whole(sols.converged) & ok_ref, whole(sols.residual)
+
+    pin_np, tip_np = _PINION[:nc], _TIP[:nc]
+    Z, conv, res = jax.vmap(one_edge)(jnp.asarray(pin_np), jnp.asarray(_END[:nc]),
+                                      jnp.asarray(tip_np))
 
     def post(z, ph1):
         x, psi1, psi2 = cs.split(z)
@@ -245,12 +315,22 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
 
     (ph2, uv1, uv2, q1, q2, n1, n2, psi1, psi2) = jax.vmap(
         lambda zz: jax.vmap(post)(zz, path.phi1))(Z)
-    face1, rest1, face2, rest2 = jax.vmap(margin_parts)(q1, q2)
-    pin = _PINION[:, None] > 0.5
-    other = jnp.where(pin, jnp.minimum(rest1, jnp.minimum(face2, rest2)),
-                      jnp.minimum(face1, jnp.minimum(rest1, rest2)))
+    face1, tip1, root1, face2, tip2, root2 = jax.vmap(margin_parts)(q1, q2)
+    pin = pin_np[:, None] > 0.5
+    is_tip = tip_np[:, None] > 0.5
+    # the edge point inside the other boundaries of its own flank (a face end: tip and
+    # root; a tip edge: face width and root) and the mating point inside its flank
+    own_root = jnp.where(pin, root1, root2)
+    own = jnp.where(is_tip, jnp.where(pin, face1, face2), jnp.where(pin, tip1, tip2))
+    mate = jnp.where(pin, jnp.minimum(face2, jnp.minimum(tip2, root2)),
+                     jnp.minimum(face1, jnp.minimum(tip1, root1)))
+    other = jnp.minimum(jnp.minimum(own, own_root), mate)
     valid = conv & (other >= 0.0)
-    te = path.te[None, :] + asm.ratio_sign * (ph2 - path.phi2[None, :])
+    # TE from the reference contact of the path (not from the path's own value at each
+    # angle: where the surface solve failed that may be NaN, and an edge contact there
+    # is still a contact)
+    te = (path.te[mid] + asm.ratio_sign * (ph2 - path.phi2[mid])
+          - (asm.z1 / asm.z2) * (path.phi1 - path.phi1[mid])[None, :])
     sgn = jnp.where(drive, 1.0, -1.0)
     surf_ok = (margin >= 0.0) & path.converged
     key_s = jnp.where(surf_ok, sgn * path.te, -jnp.inf)

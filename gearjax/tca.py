@@ -187,7 +187,7 @@ class ContactPath(NamedTuple):
         generated flank (:class:`~gearjax.surfaces.GeneratedSurface`; NaN for another
         flank), solved with the contact (:func:`contact_system`).
     edge_kind : (N,) int, -1 where the contact is a tangency of the two flanks, else
-        the face end carrying it (index into :data:`gearjax.edge_contact.EDGE_NAMES`;
+        the edge (face end or tip) carrying it (index into :data:`gearjax.edge_contact.EDGE_NAMES`;
         there the semi-axes are NaN: no Hertz ellipse at an edge).  ``None`` where face ends were not examined.
     """
 
@@ -540,7 +540,8 @@ class MultiPair(NamedTuple):
         (linear interpolation between grid points; NaN if none).
     contact_ratio : length of the pinion-angle interval in which pair 0 is on the
         flank, divided by the angular pitch 2 pi/z1 (boundary crossings
-        interpolated linearly in the boundary margin).
+        interpolated linearly in the boundary margin); NaN (not found) unless pair 0
+        enters the flanks before it leaves them within the grid.
     """
 
     te_pairs: jnp.ndarray
@@ -622,7 +623,9 @@ def multi_pair(path: ContactPath, margin, steps_per_pitch: int, z1: int, drive: 
     transfer = jnp.stack([_crossing(path.phi1, d_in), _crossing(path.phi1, d_out)])
     lo = _crossing(path.phi1, jnp.where(path.converged, margin, -1.0))
     hi = _crossing(path.phi1[::-1], jnp.where(path.converged, margin, -1.0)[::-1])
-    cr = (hi - lo) / (2.0 * jnp.pi / z1)
+    # not found (NaN) unless pair 0 enters before it leaves: where it touches in several
+    # intervals that reach the ends of the grid, its first entry may follow its last exit
+    cr = jnp.where(hi > lo, (hi - lo) / (2.0 * jnp.pi / z1), jnp.nan)
     return MultiPair(te_pairs, inside, env, active, ptp, transfer, cr)
 
 

@@ -58,7 +58,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax.edge_contact import EDGE_NAMES
+from gearjax.edge_contact import EDGE_NAMES, FACE_END_KINDS, TIP_KINDS
 from gearjax.fields import strong_float64
 from gearjax.frames import matrix_z
 from gearjax.surfaces import local_geometry
@@ -279,7 +279,8 @@ class TCAResult:
 
     @property
     def edge_points(self):
-        """(N,) pair 0 touches at a face end (edge contact; ``path.edge_kind``)."""
+        """(N,) pair 0 touches at an edge: a face end or a tooth tip (edge contact;
+        ``path.edge_kind``)."""
         if self.path.edge_kind is None:
             return jnp.zeros(self.path.phi1.shape, bool)
         return (self.margin >= 0.0) & self.path.converged & (self.path.edge_kind >= 0)
@@ -320,6 +321,10 @@ class TCAResult:
             envelope) at a face end of a flank -- toe or heel of pinion or gear
             (``path.edge_kind``, :mod:`gearjax.edge_contact`): the bearing has run
             off the face, e.g. an uncrowned pair under a shaft-angle error.
+        tip_contact : pair 0 carries the load at the tip edge of pinion or gear
+            (corner contact off the line of action: premature contact at the start
+            of mesh or prolonged contact at its end, e.g. under a base-pitch
+            mismatch).  Also raises ``edge_contact``.
         low_contact_ratio : contact ratio below 1 (or not found): gaps in the
             envelope, the motion is not transmitted continuously.
         large_te : the TE envelope's peak-to-peak exceeds :data:`LARGE_TE_ARCSEC`
@@ -350,16 +355,19 @@ class TCAResult:
                 same = both & (np.abs(te[a, sl] - te[b, sl]) < _SAME_TE)
             edge = edge or not (crossing or bool(same.any()))
         face_end = bool(self.face_ends_loaded())
+        tip = bool(self.tips_loaded())
         cr = float(self.multi.contact_ratio)
         ptp = float(self.multi.ptp) / ARCSEC
         return dict(converged=ok, reference_on_flank=bool(on[on.shape[0] // 2]),
-                    edge_contact=bool(edge) or face_end, face_end_contact=face_end,
+                    edge_contact=bool(edge) or face_end or tip, face_end_contact=face_end,
+                    tip_contact=tip,
                     low_contact_ratio=not (np.isfinite(cr) and cr >= 1.0),
                     large_te=bool(np.isfinite(ptp) and ptp > LARGE_TE_ARCSEC))
 
-    def face_ends_loaded(self) -> list[str]:
-        """Names (:data:`gearjax.edge_contact.EDGE_NAMES`) of the face ends at which
-        tooth pair 0 carries the load somewhere on the grid (concrete; empty if none)."""
+    def edges_loaded(self) -> list[str]:
+        """Names (:data:`gearjax.edge_contact.EDGE_NAMES`) of the edges (face ends and
+        tips) at which tooth pair 0 carries the load somewhere on the grid (concrete;
+        empty if none)."""
         kinds = self.path.edge_kind
         if kinds is None:
             return []
@@ -367,6 +375,14 @@ class TCAResult:
         k0 = np.asarray(self.multi.inside).shape[0] // 2
         carrying = np.asarray(self.multi.inside)[k0] & (np.asarray(self.multi.active) == k0)
         return [EDGE_NAMES[k] for k in sorted(set(kinds[carrying & (kinds >= 0)].tolist()))]
+
+    def face_ends_loaded(self) -> list[str]:
+        """The face ends (toe/heel) among :meth:`edges_loaded`."""
+        return [n for n in self.edges_loaded() if EDGE_NAMES.index(n) in FACE_END_KINDS]
+
+    def tips_loaded(self) -> list[str]:
+        """The tip edges among :meth:`edges_loaded`."""
+        return [n for n in self.edges_loaded() if EDGE_NAMES.index(n) in TIP_KINDS]
 
     def warnings(self) -> list[str]:
         """Human-readable warnings for the flags that are raised (empty if none)."""
@@ -379,7 +395,11 @@ class TCAResult:
         if f["face_end_contact"]:
             out.append("edge contact at the " + ", ".join(self.face_ends_loaded())
                        + ": the bearing runs off the face (no Hertz ellipse there)")
-        elif f["edge_contact"]:
+        if f["tip_contact"]:
+            out.append("tip contact at the " + ", ".join(self.tips_loaded())
+                       + ": a tooth tip touches the mating flank off the path of contact "
+                       "(corner contact, no Hertz ellipse there)")
+        if f["edge_contact"] and not (f["face_end_contact"] or f["tip_contact"]):
             out.append("edge contact: a tooth pair carries the load up to a flank boundary")
         if f["low_contact_ratio"]:
             cr = float(self.multi.contact_ratio)

@@ -9,6 +9,9 @@ transverse profile normal ``n = (+-cos aw, sin aw, 0)`` (the line of action) tha
 so the uncrowned pair touches at the face end that leads, ahead of the mid-face
 section by ``(b/2) dg cos aw / r_b2`` (Litvin & Fuentes, Gear Geometry and Applied
 Theory, ch. 15: a crossing of the axes of unmodified gears gives edge contact).
+
+Tip edges: a spur pair with a base-pitch mismatch touches at a tooth tip off the line
+of action; reference: the closed form of the plane involutes (below, before the tests).
 """
 
 import json
@@ -23,6 +26,7 @@ from gearjax import ARCSEC
 from gearjax.cli import main
 from gearjax.edge_contact import EDGE_NAMES
 from gearjax.gears.involute import tca as itca
+from gearjax.gears.involute.geometry import generated_flank
 
 B = 30.0
 PAIR = gj.InvolutePair.create(20, 40, 4.0, 20.0, 0.0, 0.0, 0.0)
@@ -81,7 +85,8 @@ HELICAL = gj.InvoluteTCA.create(gj.InvolutePair.create(20, 40, 4.0, 20.0, 15.0, 
 
 @pytest.mark.parametrize("des", [SPUR, HELICAL], ids=["spur", "helical"])
 def test_aligned_conjugate_pair_has_no_edge_contact_and_is_unchanged(traced, des):
-    """A conjugate pair touches along lines across the whole face: no edge contact.  For
+    """A conjugate pair touches along lines across the whole face: no edge contact (face
+    end or tip).  For
     the helical pair the face ends stay on the flanks after the solved mid-face section
     has left them -- those face-end points lie on its contact line (same TE)."""
     mis = _mis(0.0)
@@ -91,11 +96,23 @@ def test_aligned_conjugate_pair_has_no_edge_contact_and_is_unchanged(traced, des
     np.testing.assert_array_equal(np.asarray(path.te), np.asarray(ref.te))
     np.testing.assert_array_equal(np.asarray(margin), np.asarray(ref_margin))
     assert float(multi.contact_ratio) == float(ref_multi.contact_ratio)
+    # no spurious tip contact: a tip corner off the line of action has clearance, so
+    # the TE envelope is the same to the last bit with and without the edge solve
+    np.testing.assert_array_equal(np.asarray(multi.envelope), np.asarray(ref_multi.envelope))
+
+
+def _d_mis(traced, des, mis, direction):
+    """The TCA with edges and its derivative along a misalignment ``direction`` (a
+    Misalignment of tangents): forward mode through the implicit derivative of every
+    solve; one compiled derivative program for every direction and design."""
+    t = gj.Misalignment(*(jnp.asarray(v, float) for v in direction))
+    return jax.jvp(lambda m: traced[True](des, m), (mis,), (t,))
 
 
 def test_edge_te_derivative_matches_closed_form_and_differences(traced):
     """d(TE at an edge contact)/d(crossing angle) by the implicit derivative of the
-    edge-contact solve, against central differences and the closed form."""
+    edge-contact solve, against central differences and the closed form.  (The TE of
+    the mid-face section at the reference, subtracted, is 0 by definition.)"""
     def te_mid(dg):
         path, _, _ = traced[True](SPUR, _mis(dg))
         sec, _, _ = traced[False](SPUR, _mis(dg))
@@ -104,7 +121,9 @@ def test_edge_te_derivative_matches_closed_form_and_differences(traced):
 
     val, kind = te_mid(DG)
     assert int(kind) >= 0
-    d_ad = jax.jacfwd(lambda g: te_mid(g)[0])(jnp.asarray(DG))
+    (path, _, _), (d_path, _, _) = _d_mis(traced, SPUR, _mis(DG), (0.0, 0.0, 0.0, 1.0))
+    mid = path.te.shape[0] // 2
+    d_ad = d_path.te[mid]
     h = 1e-6
     d_fd = (te_mid(DG + h)[0] - te_mid(DG - h)[0]) / (2 * h)
     assert np.isfinite(float(d_ad))
@@ -141,3 +160,209 @@ def test_cli_warns_on_edge_contact(capsys):
     assert "edge contact at the" in out.err
     q = json.loads(out.out)["quality"]
     assert q["face_end_contact"] and q["edge_contact"]
+
+
+# -- tip edges: premature and prolonged contact under a base-pitch mismatch ------------
+#
+# Closed form (plane involute geometry of the rack-generated spur pair, independent of
+# the TCA): tooth i (1 pinion, 2 gear; body frame, tooth centred on +y) has pitch radius
+# r_i = z_i m/2, generating pressure angle a_i (pinion alpha + dalpha), base radius
+# r_bi = r_i cos a_i, tooth thickness s_i = m (pi/2 + 2 x_i tan a_i), tip radius
+# r_ai = r_i + m (1 + x_i), form radius of the straight rack flank
+# r_Fi = sqrt(r_bi^2 + (r_i sin a_i - m (1 - x_i)/sin a_i)^2); its working flank point
+# at radius R lies at the polar angle pi/2 + sig_i psi_i(R) with the half angular
+# thickness psi_i(R) = s_i/(2 r_i) + inv a_i - inv(arccos(r_bi/R)).  Mounted (pinion
+# turned by phi1 about the origin, gear by phi2 about (0, a)), the gear angle at which
+#   * the flanks touch: the pinion point whose normal is the inner common tangent of
+#     the base circles, a sin(tau) = r_b1 + r_b2 (explicit);
+#   * the gear's tip corner touches the pinion flank: the pinion point at distance r_a2
+#     from the gear centre (one scalar root in R), then phi2 explicit;
+#   * the pinion's tip corner touches the gear flank: explicit;
+# each candidate valid where both points lie on their flanks (r_F <= R <= r_a).  The
+# rigid teeth touch at the candidate furthest ahead (drive: max TE over the candidates
+# of the pairs k = -1, 0, 1, pair k = pair 0 shifted by k pinion pitches).
+
+def _inv(a):
+    return np.tan(a) - a
+
+
+class _ClosedFormSpur:
+    def __init__(self, z1, z2, m, alpha_deg, dalpha_deg, a, sig):
+        self.a, self.sig, self.g = a, sig, []
+        for z, alp in ((z1, np.radians(alpha_deg + dalpha_deg)), (z2, np.radians(alpha_deg))):
+            r = 0.5 * z * m
+            rb = r * np.cos(alp)
+            self.g.append(dict(r=r, rb=rb, s=0.5 * np.pi * m, ra=r + m, alp=alp,
+                               rF=np.hypot(rb, r * np.sin(alp) - m / np.sin(alp))))
+
+    def psi(self, i, R):
+        g = self.g[i]
+        return g["s"] / (2 * g["r"]) + _inv(g["alp"]) - _inv(np.arccos(g["rb"] / R))
+
+    def pinion_point(self, ph1, R):
+        t = ph1 + 0.5 * np.pi + self.sig[0] * self.psi(0, R)
+        return R * np.array([np.cos(t), np.sin(t)])
+
+    def gear_angle(self, X):
+        """Gear angle that puts its working flank through the fixed point X, and the
+        radius of that gear point."""
+        d = X - np.array([0.0, self.a])
+        R2 = np.hypot(*d)
+        return np.arctan2(d[1], d[0]) - 0.5 * np.pi - self.sig[1] * self.psi(1, R2), R2
+
+    def on(self, i, R):
+        return self.g[i]["rF"] <= R <= self.g[i]["ra"]
+
+    def candidates(self, ph1):
+        """{name: phi2} of the valid contacts of pair 0 at pinion angle ph1."""
+        from scipy.optimize import brentq
+        g1, g2 = self.g
+        out = {}
+        thb = ph1 + 0.5 * np.pi + self.sig[0] * (g1["s"] / (2 * g1["r"]) + _inv(g1["alp"]))
+        base = np.arcsin((g1["rb"] + g2["rb"]) / self.a)
+        for tau in (base, np.pi - base):
+            t = self.sig[0] * np.angle(np.exp(1j * (thb - tau)))     # roll angle
+            if t > 0:
+                R = g1["rb"] * np.hypot(1.0, t)
+                ph2, R2 = self.gear_angle(self.pinion_point(ph1, R))
+                if self.on(0, R) and self.on(1, R2):
+                    out["surface"] = ph2
+        f = lambda R: np.hypot(*(self.pinion_point(ph1, R) - [0.0, self.a])) - g2["ra"]
+        Rs = np.linspace(g1["rF"], g1["ra"], 41)
+        fs = np.array([f(R) for R in Rs])
+        for i in np.nonzero(np.sign(fs[:-1]) != np.sign(fs[1:]))[0]:
+            R = brentq(f, Rs[i], Rs[i + 1], xtol=1e-14, rtol=1e-15)
+            out["gear tip"] = self.gear_angle(self.pinion_point(ph1, R))[0]
+        ph2, R2 = self.gear_angle(self.pinion_point(ph1, g1["ra"]))
+        if self.on(1, R2):
+            out["pinion tip"] = ph2
+        return out
+
+
+@pytest.fixture(scope="module")
+def mismatch(traced):
+    """The spur pair 20/40 with the pinion's pressure angle changed by +-1 deg (base
+    pitch of the pinion smaller / larger than the gear's), the TCA with and without
+    edges and the closed form."""
+    out = {}
+    for da in (1.0, -1.0):
+        des = gj.InvoluteTCA.create(PAIR, B, dalpha_deg=da)
+        res = traced[True](des, _mis(0.0))
+        plain = traced[False](des, _mis(0.0))
+        path = res[0]
+        mid = path.phi1.shape[0] // 2
+        # the working-flank sides in the body frames, from one point of each flank
+        r1 = itca.crowned_pinion_flank(des, -1)
+        r2 = generated_flank(PAIR.module, PAIR.pressure_angle, 0.0, 0.0, 40, -1)
+        cf = _ClosedFormSpur(20, 40, 4.0, 20.0, da, 120.0, (1.0, 1.0))
+        sig = []
+        for i, (r, uv) in enumerate(((r1, path.uv1[mid]), (r2, path.uv2[mid]))):
+            q = np.asarray(r(uv))
+            sig.append((np.arctan2(q[1], q[0]) - 0.5 * np.pi) / cf.psi(i, np.hypot(q[0], q[1])))
+        np.testing.assert_allclose(np.abs(sig), 1.0, atol=1e-9)   # the closed-form flanks
+        cf.sig = tuple(np.sign(sig))
+        out[da] = (des, res, plain, cf)
+    return out
+
+
+def _closed_form_te(cf, phi, mid, with_tips=True):
+    """Candidates' TE (rad) of pair 0 at the angles ``phi`` (reference: the surface
+    contact at phi[mid]), and the envelope over pairs -1, 0, 1 at ``phi``."""
+    ph2_ref = cf.candidates(phi[mid])["surface"]
+    pitch = 2 * np.pi / 20
+
+    def te(ph1):
+        c = cf.candidates(ph1)
+        if not with_tips:
+            c.pop("gear tip", None), c.pop("pinion tip", None)
+        return {k: -np.angle(np.exp(1j * (v - ph2_ref))) - 0.5 * (ph1 - phi[mid])
+                for k, v in c.items()}
+
+    pair0 = [te(p) for p in phi]
+    env = np.array([max([v for k in (-1, 0, 1) for v in te(p - k * pitch).values()],
+                        default=np.nan) for p in phi])
+    return pair0, env
+
+
+@pytest.mark.parametrize("da,tip", [(1.0, "gear tip"), (-1.0, "pinion tip")],
+                         ids=["premature", "prolonged"])
+def test_tip_contact_under_a_base_pitch_mismatch_matches_the_closed_form(mismatch, da, tip):
+    """Pinion base pitch smaller (dalpha > 0): the incoming pair's gear tip hits the
+    pinion flank before the line of action (premature contact); larger: the outgoing
+    pair's pinion tip stays on the gear flank after it (prolonged contact).  The TCA
+    finds that corner contact, at the TE of the closed form, and the envelope over a
+    pitch is the closed form's (the sawtooth of the flank contacts alone is not)."""
+    des, (path, margin, multi), (_, _, plain), cf = mismatch[da]
+    phi = np.asarray(path.phi1)
+    n = phi.shape[0]
+    mid = n // 2
+    pair0, env = _closed_form_te(cf, phi, mid)
+    kind = np.asarray(path.edge_kind)
+    carried = (np.asarray(margin) >= 0.0) & (kind >= 0)
+    assert {EDGE_NAMES[k] for k in kind[carried]} == {tip}
+    assert carried.sum() >= 3
+    te = np.asarray(path.te)
+    for j in np.nonzero(carried)[0]:
+        assert abs(te[j] - pair0[j][tip]) / ARCSEC < 1e-6, (j, te[j] / ARCSEC, pair0[j])
+    # the corner: the touching point of the tip's member lies on its tip circle
+    radial = np.asarray(path.radial2 if tip == "gear tip" else path.radial1)[carried]
+    np.testing.assert_allclose(radial, cf.g[1 if tip == "gear tip" else 0]["ra"], atol=1e-9)
+    window = np.abs(np.arange(n) - mid) <= 12
+    np.testing.assert_allclose(np.asarray(multi.envelope)[window] / ARCSEC,
+                               env[window] / ARCSEC, rtol=0, atol=1e-6)
+    assert float(multi.ptp) / ARCSEC == pytest.approx(np.ptp(env[window]) / ARCSEC, abs=1e-6)
+    # without the tip candidates: the sawtooth of the flank contacts alone
+    _, saw = _closed_form_te(cf, phi, mid, with_tips=False)
+    np.testing.assert_allclose(np.asarray(plain.envelope)[window] / ARCSEC,
+                               saw[window] / ARCSEC, rtol=0, atol=1e-6)
+    assert np.max(np.abs(env - saw)[window]) / ARCSEC > 50.0
+    res = gj.TCAResult(path, margin, multi, {}, None, "drive", "involute")
+    f = res.flags()
+    assert f["tip_contact"] and f["edge_contact"] and not f["face_end_contact"]
+    assert res.tips_loaded() == [tip]
+    assert any(w.startswith(f"tip contact at the {tip}") for w in res.warnings())
+
+
+def test_tip_contact_te_derivative_matches_central_differences(traced, mismatch):
+    """d(TE at a premature gear-tip contact)/d(centre-distance change dE) through the
+    implicit derivative of the tip-edge solve, against central differences; the
+    derivative of the envelope's peak-to-peak is finite (NaN-free where valid)."""
+    des, (path, margin, _), _, _ = mismatch[1.0]
+    tip = EDGE_NAMES.index("gear tip")
+    j = int(np.nonzero((np.asarray(path.edge_kind) == tip) & (np.asarray(margin) >= 0))[0][1])
+
+    def f(de):
+        p, m, mu = traced[True](des, gj.Misalignment(*(jnp.asarray(v, float)
+                                                       for v in (de, 0.0, 0.0, 0.0))))
+        return p.te[j], p.edge_kind[j], m[j]
+
+    (p0, m0, mu0), (dp, _, dmu) = _d_mis(traced, des, _mis(0.0), (1.0, 0.0, 0.0, 0.0))
+    assert int(p0.edge_kind[j]) == tip
+    assert np.isfinite(float(dp.te[j])) and np.isfinite(float(dmu.ptp))
+    h = 1e-5
+    (up, k_up, m_up), (dn, k_dn, m_dn) = f(h), f(-h)
+    assert int(k_up) == int(k_dn) == tip and float(m_up) >= 0 and float(m_dn) >= 0
+    d_fd = (up - dn) / (2 * h)
+    assert abs(float(d_fd)) > 1e-5                       # rad/mm: not a trivial zero
+    np.testing.assert_allclose(float(dp.te[j]), float(d_fd), rtol=1e-6)
+
+
+def test_hypoid_tip_edge_function_is_the_face_cone():
+    """The bevel/hypoid tip-edge function is zero on the pinion's face cone (the line
+    heel-tip to toe-tip corner of its axial outline, from the blank) and grows into
+    the tooth as the normal distance, cos(face angle) per mm of radius; the margins
+    give it as the tip part.  (No TCA: the edge system with it is the one above.)"""
+    from gearjax.gears.hypoid.pair import hypoid_face_ends
+    pair = gj.pair_flanks(gj.load_design(gj.example_path("spiral_bevel_10x30_synthesised")),
+                          "drive")
+    parts, g1, g2, (t1, t2) = hypoid_face_ends(pair)
+    corners = gj.pinion_outline(pair)["outline"]
+    z, r = 0.5 * (corners[2] + corners[3])               # mid face on the face cone
+    q = jnp.array([r, 0.0, z])
+    assert abs(float(t1(q))) < 1e-9
+    d = 0.3
+    cos_g = float(np.cos(pair.pinion.blank.face_angle))
+    assert float(t1(q - jnp.array([d, 0.0, 0.0]))) == pytest.approx(d * cos_g, rel=1e-12)
+    f1, tip1, root1, *_ = parts(q[None] - jnp.array([[d, 0.0, 0.0]]), q[None])
+    assert float(tip1[0]) == pytest.approx(d * cos_g, rel=1e-12)
+    assert float(f1[0]) > 0 and float(root1[0]) > 0

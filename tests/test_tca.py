@@ -13,8 +13,9 @@ import pytest
 
 from gearjax.errors import ConvergenceError
 from gearjax.gears.involute.geometry import InvolutePair, generated_flank, pair_geometry
+from gearjax.edge_contact import EDGE_NAMES
 from gearjax.tca import (ARCSEC, Misalignment, NoContactError, contact_path,
-                         ellipse_from_weingarten)
+                         ellipse_from_weingarten, multi_pair)
 from gearjax.gears.involute.tca import (InvoluteTCA, crowned_pinion_flank, involute_tca,
                                   misalignment_sensitivity, tca_summary, SUMMARY_KEYS)
 
@@ -138,15 +139,33 @@ def test_base_pitch_mismatch_gives_exact_linear_te(pair, side):
     radian, the coast contact towards it, so |phi_{lo,hi} - phi1_0| = (L1_0 - L1_A)/rb1.
     A transfer set by a flank boundary is reported at the grid point next to it on the
     flank side (the TE difference of the two pairs, ~1e-5 rad, is the end of the step
-    where both are on): 0 <= distance < one step (measured 0.57 step)."""
+    where both are on): 0 <= distance < one step (measured 0.57 step).
+
+    The rigid teeth also touch off the line of action, at a tooth tip (premature
+    contact of the incoming pair: the TCA solves it, tests/test_edge_contact.py checks
+    it against its closed form); the flank contacts alone -- the line of action, the
+    saw-tooth and its transfer points -- are checked here on the surface points (the
+    envelope of the flank contacts is formed again without the tip points)."""
     dal = 0.05
     des = InvoluteTCA.create(pair, 20.0, dalpha_deg=dal)
-    path, margin, multi = involute_tca(des, side=side)
+    path, margin, multi_all = involute_tca(des, side=side)
     g = _textbook(dal)
     slope = g["rb1"] / g["rb2"] - Z1 / Z2
     theory = slope * (np.asarray(path.phi1) - float(path.phi1[MID]))
     assert np.max(np.abs(theory)) / ARCSEC > 10.0            # a real, visible error
-    np.testing.assert_allclose(np.asarray(path.te) / ARCSEC, theory / ARCSEC, atol=1e-6)
+    kind = np.asarray(path.edge_kind)
+    surf = kind < 0
+    assert set(kind[~surf].tolist()) <= {EDGE_NAMES.index("pinion tip"),
+                                         EDGE_NAMES.index("gear tip")}
+    np.testing.assert_allclose(np.asarray(path.te)[surf] / ARCSEC, theory[surf] / ARCSEC,
+                               atol=1e-6)
+    # the flank contacts alone (tip points off the flank, as without the tip solve);
+    # with them the envelope only lies further in the sense of the load
+    margin = np.where(surf, np.asarray(margin), -1.0)
+    path = path._replace(te=jnp.where(jnp.asarray(surf), path.te, jnp.asarray(theory)))
+    multi = multi_pair(path, jnp.asarray(margin), 24, Z1, drive=(side == -1))
+    gap = -side * (np.asarray(multi_all.envelope) - np.asarray(multi.envelope))
+    assert np.all(gap[np.isfinite(gap)] >= -1e-15)
     # linear TE: the envelope is a saw-tooth of height |slope| * pitch; sampled on the
     # grid (24 steps per pitch) its peak-to-peak is |slope| * (pitch - step)
     pitch = 2 * np.pi / Z1

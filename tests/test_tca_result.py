@@ -57,7 +57,8 @@ def _crossing_case():
 def test_flags_all_clear_for_a_hand_over_where_the_te_curves_cross():
     f = _result(*_crossing_case()).flags()
     assert f == dict(converged=True, reference_on_flank=True, edge_contact=False,
-                     low_contact_ratio=False, face_end_contact=False, large_te=False)
+                     low_contact_ratio=False, face_end_contact=False, tip_contact=False,
+                     large_te=False)
     assert _result(*_crossing_case()).warnings() == []
 
 
@@ -67,6 +68,21 @@ def test_edge_contact_when_a_pair_leaves_its_flank_at_the_hand_over():
     te[0, 2:] = np.nan
     transfer = np.array([-0.7, 0.5])
     assert _result(margin, te, inside, transfer, cr).flags()["edge_contact"]
+
+
+def test_contact_ratio_is_not_found_when_pair_0_leaves_before_it_enters():
+    """multi_pair: pair 0 on the flanks at both ends of the grid and off between (edge
+    contacts can do that): its first entry follows its last exit -- no contact ratio
+    (NaN, flagged), not a negative one; one interval inside the grid gives its length."""
+    from gearjax.tca import multi_pair
+    phi = jnp.linspace(-1.0, 1.0, N)
+    path = _result(np.ones(N), np.zeros((3, N)), np.ones((3, N), bool), [0.0, 0.0],
+                   1.0).path._replace(phi1=phi)
+    two = np.where(np.abs(np.asarray(phi)) < 0.5, -1.0, 1.0)       # on, off, on
+    assert np.isnan(float(multi_pair(path, jnp.asarray(two), 4, 10).contact_ratio))
+    one = 0.55 - np.abs(np.asarray(phi))                         # on for |phi| <= 0.55
+    cr = float(multi_pair(path, jnp.asarray(one), 4, 10).contact_ratio)
+    assert cr == pytest.approx(1.1 / (2 * np.pi / 10), rel=1e-12)
 
 
 def test_no_edge_contact_where_the_te_curves_coincide():

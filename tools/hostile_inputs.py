@@ -734,7 +734,8 @@ def build_cases() -> list[Case]:
                                             "dSigma=0.2"], "flag",
         "misaligned uncrowned involute pair (table output): edge contact")
     add("tca.poor.dalpha_uncrowned", ["tca", TCA_INV + ",dalpha=1", "--json"], "flag",
-        "pressure-angle mismatch without crowning: contact at the tip or root edge")
+        "pressure-angle mismatch without crowning: premature contact at the gear tip "
+        "(solved, tip_contact) and a saw-tooth TE")
     add("tca.poor.involute_dE_huge", ["tca", TCA_INV, "--misalign", "dE=100", "--json"], "flag",
         "pinion moved 100 mm: the flanks do not touch")
     add("tca.poor.narrow_face", ["tca", "involute:z1=20,z2=40,m=4,alpha=20,b=0.001", "--json"],

@@ -40,12 +40,13 @@ JSON_KEYS_DOC = """JSON keys:
   ellipses         {semi_major_mm, semi_minor_mm}: contact ellipse (elastic approach
                    0.00632 mm; null = infinite, line contact)
   flags            per grid point: converged, on_flank (the flanks touch inside both
-                   flank boundaries), edge (pair 0 touches at a face end: edge contact,
-                   no ellipse and no kinematics there), edge_end (null, or which face end:
-                   "pinion toe", "pinion heel", "gear toe", "gear heel"), off_flank
+                   flank boundaries), edge (pair 0 touches at an edge: a face end or a
+                   tooth tip, no ellipse and no kinematics there), edge_end (null, or
+                   which edge: "pinion toe", "pinion heel", "gear toe", "gear heel",
+                   "pinion tip", "gear tip"), off_flank
                    (converged but outside a flank boundary: no contact of pair 0)
   quality          {converged, reference_on_flank, edge_contact, face_end_contact,
-                   low_contact_ratio, large_te}: contact-quality flags of the side (each
+                   tip_contact, low_contact_ratio, large_te}: contact-quality flags of the side (each
                    raised one is also a warning on stderr; large_te: TE p-t-p > 60 arcsec)
   kinematics       with --kinematics: {u1_mm_s, u2_mm_s, u_e_mm_s, u_s_mm_s, srr, r_x_mm,
                    r_y_mm} per grid point (pinion = 1; per rad/s of pinion speed;

@@ -260,23 +260,36 @@ def _member_margins(fl: FlankSpec, crossing, p_body):
 
 
 def hypoid_face_ends(pair: HypoidPair):
-    """``(margin_parts, g1, g2)`` of :func:`gearjax.edge_contact.face_end_contact`: each
-    member's boundary margins (mm) -- face width and the others (:func:`_member_margins`)
-    -- at body points, and the face-end functions ``g(q, e) = (F/2) (xi(q) - e)`` (toe
-    ``e = -1``, heel ``e = +1``)."""
+    """``(margin_parts, g1, g2, (t1, t2))`` of :func:`gearjax.edge_contact.face_end_contact`:
+    each member's boundary margins (mm) -- face width, face cone (tip) and fillet
+    (root), as in :func:`_member_margins` -- at body points, the face-end functions
+    ``g(q, e) = (F/2) (xi(q) - e)`` (toe ``e = -1``, heel ``e = +1``) and the tip-edge
+    functions ``t(q)`` = the gap below the face cone (mm, zero on the face cone)."""
     members = ((pair.pinion, pair.pinion_crossing), (pair.gear, pair.gear_crossing))
 
+    def parts(fl, t, q):
+        xi, above_root, tip_gap = flank_coordinates(fl, t, q)
+        c = fl.cutter
+        h_fillet = c.edge_radius * (1.0 - jnp.sin(c.blade_angle))
+        return (0.5 * fl.blank.face_width * (1.0 - jnp.abs(xi)), tip_gap,
+                above_root - h_fillet)
+
     def margin_parts(q1, q2):
-        f1, r1 = jax.vmap(lambda q: _member_margins(*members[0], q)[:2])(q1)
-        f2, r2 = jax.vmap(lambda q: _member_margins(*members[1], q)[:2])(q2)
-        return f1, r1, f2, r2
+        return (jax.vmap(lambda q: parts(*members[0], q))(q1)
+                + jax.vmap(lambda q: parts(*members[1], q))(q2))
 
     def end(fl, t):
         def g(q, e):
             return 0.5 * fl.blank.face_width * (flank_coordinates(fl, t, q)[0] - e)
         return g
 
-    return margin_parts, end(*members[0]), end(*members[1])
+    def tip(fl, t):
+        def g(q):
+            return flank_coordinates(fl, t, q)[2]
+        return g
+
+    return (margin_parts, end(*members[0]), end(*members[1]),
+            (tip(*members[0]), tip(*members[1])))
 
 
 def hypoid_margin(pair: HypoidPair, path: ContactPath):

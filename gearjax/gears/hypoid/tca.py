@@ -229,15 +229,18 @@ def prepare(pair: HypoidPair, n_search: int = 181) -> Prepared:
 def hypoid_tca_traced(pair: HypoidPair, mis: Misalignment, x_ref, phi1_ref, *,
                       steps_per_pitch: int = 16, half_pitches: float = 2.0,
                       line_contact: bool = False, n_pairs: int = 5, drive: bool = True,
-                      approach=DEFAULT_APPROACH, face_ends: bool = True) -> HypoidTCA:
+                      approach=DEFAULT_APPROACH, face_ends: bool = True,
+                      tip_edges: bool = True) -> HypoidTCA:
     """Traceable TCA of a hypoid/spiral-bevel flank pair (see :func:`hypoid_tca`).
 
     Point contact: the reference contact is refined near the pinion's mean point
     (:func:`reference_contact`) and the grid is centred on its pinion angle.  Line
     contact (conjugate pairs): the grid is centred on ``phi1_ref`` and the pinion
     blade position ``s`` stays at ``x_ref[1]``.  With ``face_ends`` (default) the
-    contact at the toe and heel of both members is solved too and the contact made
-    at each pinion angle is the surface or the edge contact
+    contact at the toe and heel of both members is solved too, with ``tip_edges``
+    (default) also the contact of each member's tip edge (on its face cone) with the
+    mating flank, and the contact made at each pinion angle is the surface or the edge
+    contact
     (:func:`gearjax.edge_contact.face_end_contact`; ``path.edge_kind``).
     """
     r1 = flank_function(pair.pinion, pair.pinion_crossing)
@@ -262,10 +265,11 @@ def hypoid_tca_traced(pair: HypoidPair, mis: Misalignment, x_ref, phi1_ref, *,
                         line_contact=line_contact, approach=approach)
     margin, coords = hypoid_margin(pair, path)
     if face_ends:
-        parts, g1, g2 = hypoid_face_ends(pair)
+        parts, g1, g2, tips = hypoid_face_ends(pair)
         path, margin, _ = face_end_contact(r1, r2, asm, mis, path, margin, parts, g1, g2,
                                            drive=drive, line_contact=line_contact,
-                                           steps_per_pitch=steps_per_pitch)
+                                           steps_per_pitch=steps_per_pitch,
+                                           tips=tips if tip_edges else None)
         _, coords = hypoid_margin(pair, path)
     multi = multi_pair(path, margin, steps_per_pitch, pair.z1, drive=drive, n_pairs=n_pairs)
     return HypoidTCA(path, margin, multi, coords)

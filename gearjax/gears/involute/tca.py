@@ -167,21 +167,28 @@ def default_line_contact(des: InvoluteTCA) -> bool:
 
 
 def involute_face_ends(des: InvoluteTCA):
-    """``(margin_parts, g1, g2)`` of :func:`gearjax.edge_contact.face_end_contact`: the
-    boundary margins (face width, and tip/form circle) of each member at body points,
-    and the face-end functions ``g(q, e) = q_z - e b/2`` of pinion and gear (mm)."""
+    """``(margin_parts, g1, g2, (t1, t2))`` of :func:`gearjax.edge_contact.face_end_contact`:
+    the boundary margins (face width, tip circle, form circle) of each member at body
+    points, the face-end functions ``g(q, e) = q_z - e b/2`` of pinion and gear and
+    their tip-edge functions ``t_k(q) = r_ak - |q_xy|`` (addendum cylinder; mm)."""
     ra1, rf1, ra2, rf2, hb = _flank_limits(des)
 
     def margin_parts(q1, q2):
         r1 = jnp.linalg.norm(q1[..., :2], axis=-1)
         r2 = jnp.linalg.norm(q2[..., :2], axis=-1)
-        return (hb - jnp.abs(q1[..., 2]), jnp.minimum(ra1 - r1, r1 - rf1),
-                hb - jnp.abs(q2[..., 2]), jnp.minimum(ra2 - r2, r2 - rf2))
+        return (hb - jnp.abs(q1[..., 2]), ra1 - r1, r1 - rf1,
+                hb - jnp.abs(q2[..., 2]), ra2 - r2, r2 - rf2)
 
     def g(q, e):
         return q[2] - e * hb
 
-    return margin_parts, g, g
+    def t1(q):
+        return ra1 - jnp.linalg.norm(q[:2])
+
+    def t2(q):
+        return ra2 - jnp.linalg.norm(q[:2])
+
+    return margin_parts, g, g, (t1, t2)
 
 
 def reference_guess(des: InvoluteTCA, side: int):
@@ -225,12 +232,15 @@ def reference_guess(des: InvoluteTCA, side: int):
 def involute_tca_traced(des: InvoluteTCA, mis: Misalignment, *, side: int = -1,
                         steps_per_pitch: int = 24, half_pitches: float = 1.25,
                         line_contact: bool = True, n_pairs: int = 3,
-                        approach=DEFAULT_APPROACH, face_ends: bool = True):
+                        approach=DEFAULT_APPROACH, face_ends: bool = True,
+                        tip_edges: bool = True):
     """Traceable TCA of an involute pair: ``(path, margin, multi)``.
 
     With ``face_ends`` (default) the contact at the face ends of both members is
-    solved too and the contact made at each pinion angle is the surface or the edge
-    contact (:func:`gearjax.edge_contact.face_end_contact`; ``path.edge_kind``).
+    solved too, with ``tip_edges`` (default) also the contact of each member's tip
+    edge with the mating flank, and the contact made at each pinion angle is the
+    surface or the edge contact (:func:`gearjax.edge_contact.face_end_contact`;
+    ``path.edge_kind``).
 
     The grid of pinion angles is uniform with step ``2 pi/(z1 steps_per_pitch)``,
     centred on the nominal pitch-point contact, ``half_pitches`` pitches each side
@@ -249,10 +259,11 @@ def involute_tca_traced(des: InvoluteTCA, mis: Misalignment, *, side: int = -1,
     path = path._replace(converged=path.converged & ok)
     margin, _ = involute_margin(des, path)
     if face_ends:
-        parts, g1, g2 = involute_face_ends(des)
+        parts, g1, g2, tips = involute_face_ends(des)
         path, margin, _ = face_end_contact(r1, r2, asm, mis, path, margin, parts, g1, g2,
                                            drive=side < 0, line_contact=line_contact,
-                                           steps_per_pitch=steps_per_pitch)
+                                           steps_per_pitch=steps_per_pitch,
+                                           tips=tips if tip_edges else None)
     multi = multi_pair(path, margin, steps_per_pitch, p.z1, drive=(side < 0), n_pairs=n_pairs)
     return path, margin, multi
 
