@@ -20,6 +20,11 @@ tip and root lines the heights ``h = r cos delta - z sin delta`` (signed distanc
 the pitch cone, r the distance from the member's axis) ``h = +addendum`` and
 ``h = -dedendum``; margin = the smallest distance to them (mm, >= 0 inside).
 
+**Edge contact** (:func:`preset_face_ends`, for :func:`gearjax.edge_contact.face_end_contact`):
+the face-end functions ``g(q, e) = |q| - A_m - e b/2`` (mm; zero on the toe sphere
+``|q| = A_i`` for ``e = -1`` and on the heel sphere ``|q| = A_o`` for ``e = +1``) and the
+tip functions ``t(q) = addendum - h(q)`` (mm; zero on the face cone, > 0 below it).
+
 Units: mm, rad.
 """
 
@@ -35,7 +40,8 @@ from gearjax.gears.preset_bevel.geometry import (PresetBevelDesign, cone_distanc
 from gearjax.tca import Assembly
 
 __all__ = ["SIDE_FLANKS", "preset_assembly", "side_flanks", "side_phase", "drives_forward", "side_code",
-           "flank_coordinates", "preset_margin", "reference_contact"]
+           "flank_coordinates", "preset_margin", "reference_contact",
+           "preset_face_ends"]
 
 #: side -> (pinion flank, gear flank)
 SIDE_FLANKS = {"drive": ("concave", "convex"), "coast": ("convex", "concave")}
@@ -94,6 +100,29 @@ def preset_margin(des: PresetBevelDesign, p1_body, p2_body):
     parts = jnp.stack([Ao - L1, L1 - Ai, des.addendum - h1, h1 + des.dedendum,
                        Ao - L2, L2 - Ai, des.addendum - h2, h2 + des.dedendum])
     return jnp.min(parts, axis=0), {"L1": L1, "h1": h1, "L2": L2, "h2": h2}
+
+
+def preset_face_ends(des: PresetBevelDesign):
+    """``(margin_parts, g1, g2, (t1, t2))`` of :func:`gearjax.edge_contact.face_end_contact`
+    (module docstring): each member's margins (mm, >= 0 inside) to its face ends (the
+    nearer of toe and heel), tip (face cone) and root at body points (N, 3), the face-end
+    functions ``g_k(q, e)`` and the tip-edge functions ``t_k(q)`` of pinion and gear."""
+    Ai, Am, Ao = cone_distances(des)
+
+    def parts(q, member):
+        L, h = flank_coordinates(des, q, member)
+        return jnp.minimum(Ao - L, L - Ai), des.addendum - h, h + des.dedendum
+
+    def margin_parts(q1, q2):
+        return parts(q1, 1) + parts(q2, 2)
+
+    def end(q, e):
+        return jnp.linalg.norm(q) - Am - 0.5 * e * des.face_width
+
+    def tip(member):
+        return lambda q: des.addendum - flank_coordinates(des, q, member)[1]
+
+    return margin_parts, end, end, (tip(1), tip(2))
 
 
 def reference_contact(des: PresetBevelDesign, side: str):

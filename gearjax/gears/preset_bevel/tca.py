@@ -13,8 +13,13 @@ the solution is known in closed form (``u = v = 0``, ``t = phi1 - phase``, ``phi
 The result is the common :class:`gearjax.tca_result.TCAResult` (``family =
 "preset_bevel"``), ``coords`` = cone distance and height above the pitch cone of the
 contact on both members (``L1, h1, L2, h2``, mm) and the flank parameters ``t1``,
-``t2``.  Face-end (edge) contact is not solved (``path.edge_kind`` is ``None``): a
-pair whose contact reaches a face end is flagged by the margin (``edge_contact``).
+``t2``.  Edge contact is solved (:func:`gearjax.edge_contact.face_end_contact`
+with :func:`gearjax.gears.preset_bevel.pair.preset_face_ends`): where the toe or heel
+edge (sphere ``|q| = A_i, A_o``) or the tip edge (face cone) of a member touches the
+mating flank ahead of the surface contact, or carries the load where the surface
+contact has left the flanks, the path holds that edge contact (``path.edge_kind``;
+no Hertz ellipse there, the semi-axes and kinematics are NaN) and the TE envelope
+includes it.
 
 Units: mm, rad.  Reference: [Preset-TE-bevel]; [Litvin2004] ch. 9 (contact equations).
 """
@@ -28,8 +33,10 @@ import jax.numpy as jnp
 import numpy as np
 
 from gearjax.gears.preset_bevel.geometry import PresetBevelDesign, cone_distances, pitch_angles
-from gearjax.gears.preset_bevel.pair import (drives_forward, preset_assembly, preset_margin,
-                                             reference_contact, side_code, side_flanks)
+from gearjax.edge_contact import face_end_contact
+from gearjax.gears.preset_bevel.pair import (drives_forward, preset_assembly, preset_face_ends,
+                                             preset_margin, reference_contact, side_code,
+                                             side_flanks)
 from gearjax.loaded_contact import TeethOf
 from gearjax.tca import (DEFAULT_APPROACH, Misalignment, check_on_flank_converged,
                          check_tca_options, contact_path, multi_pair)
@@ -46,27 +53,40 @@ DEFAULTS = dict(steps_per_pitch=24, half_pitches=1.0, n_pairs=3)
 def preset_result_traced(des: PresetBevelDesign, mis: Misalignment, x_ref, phi1_ref, *,
                          side: str = "drive", steps_per_pitch: int = 24,
                          half_pitches: float = 1.0, n_pairs: int = 3,
-                         approach=DEFAULT_APPROACH, kinematics: bool = True) -> TCAResult:
+                         approach=DEFAULT_APPROACH, kinematics: bool = True,
+                         face_ends: bool = True) -> TCAResult:
     """Traceable TCA of ``side`` as a :class:`~gearjax.tca_result.TCAResult` (module
     docstring).  ``x_ref, phi1_ref`` from :func:`~gearjax.gears.preset_bevel.pair.
-    reference_contact` (concrete, fixed: the grid does not move with the design)."""
+    reference_contact` (concrete, fixed: the grid does not move with the design).
+    ``face_ends``: solve the edge contacts (default; ``False``: surface contact only,
+    ``path.edge_kind`` None)."""
     parts = _result_parts(des, mis, x_ref, phi1_ref, side_code(side),
                           steps_per_pitch=steps_per_pitch, half_pitches=half_pitches,
-                          n_pairs=n_pairs, approach=approach, kinematics=kinematics)
+                          n_pairs=n_pairs, approach=approach, kinematics=kinematics,
+                          face_ends=face_ends)
     return TCAResult(*parts, side, "preset_bevel")
 
 
 def _result_parts(des, mis, x_ref, phi1_ref, code, *, steps_per_pitch, half_pitches, n_pairs,
-                  approach, kinematics):
+                  approach, kinematics, face_ends=True):
     """``(path, margin, multi, coords, kinematics)``; ``code`` the side code (+1 drive,
-    -1 coast; traced: one program for both sides)."""
+    -1 coast; traced: one program for both sides).  With ``face_ends`` the edge
+    contacts (toe, heel and tip edge of both members) are solved and the contact made
+    at each grid point is the surface or an edge contact
+    (:func:`gearjax.edge_contact.face_end_contact`)."""
     h = 2.0 * np.pi / (des.z1 * steps_per_pitch)
     k = int(round(half_pitches * steps_per_pitch))
     grid = phi1_ref + h * jnp.arange(-k, k + 1, dtype=float)
     r1, r2 = side_flanks(des, code)
     asm = preset_assembly(des)
     path = contact_path(r1, r2, asm, mis, grid, x_ref, line_contact=False, approach=approach)
-    margin, coords = preset_margin(des, path.p1_body, path.p2_body)
+    margin, _ = preset_margin(des, path.p1_body, path.p2_body)
+    if face_ends:
+        parts, g1, g2, tips = preset_face_ends(des)
+        path, margin, _ = face_end_contact(r1, r2, asm, mis, path, margin, parts, g1, g2,
+                                           drive=drives_forward(code), tips=tips,
+                                           steps_per_pitch=steps_per_pitch)
+    _, coords = preset_margin(des, path.p1_body, path.p2_body)
     coords = dict(coords, t1=path.uv1[:, 1], t2=path.uv2[:, 1])
     multi = multi_pair(path, margin, steps_per_pitch, des.z1, drive=drives_forward(code),
                        n_pairs=n_pairs)
@@ -75,15 +95,15 @@ def _result_parts(des, mis, x_ref, phi1_ref, code, *, steps_per_pitch, half_pitc
     return path, margin, multi, coords, kin
 
 
-_STATIC = ("steps_per_pitch", "half_pitches", "n_pairs", "kinematics")
+_STATIC = ("steps_per_pitch", "half_pitches", "n_pairs", "kinematics", "face_ends")
 
 
 @functools.partial(jax.jit, static_argnames=_STATIC)
 def _parts_jit(des, mis, x_ref, phi1_ref, approach, code, *, steps_per_pitch, half_pitches,
-               n_pairs, kinematics):
+               n_pairs, kinematics, face_ends=True):
     return _result_parts(des, mis, x_ref, phi1_ref, code, steps_per_pitch=steps_per_pitch,
                          half_pitches=half_pitches, n_pairs=n_pairs, approach=approach,
-                         kinematics=kinematics)
+                         kinematics=kinematics, face_ends=face_ends)
 
 
 def _result_jit(des, mis, x_ref, phi1_ref, approach, *, side, **static) -> TCAResult:
