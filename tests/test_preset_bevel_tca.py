@@ -7,6 +7,7 @@ import dataclasses
 import json
 import math
 
+import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
@@ -15,6 +16,10 @@ import gearjax as gj
 from gearjax.cli import main
 from gearjax.gears.preset_bevel import analysis as A
 from gearjax.gears.preset_bevel import geometry as G
+from gearjax.gears.preset_bevel.pair import preset_assembly, reference_contact, side_flanks
+from gearjax.gears.preset_bevel.tca import preset_result_traced
+from gearjax.tca import gear_mount
+from gearjax.tca_result import strong_float64
 
 OPTS = dict(steps_per_pitch=16, half_pitches=1.0, n_pairs=3, kinematics=False)
 EX = "example:preset_te_bevel_10x30"
@@ -122,3 +127,131 @@ def test_cli_tca_and_surface(des, runs, tmp_path, capsys):
     assert main(["surface", EX, "--member", "pinion", "--flank", "convex", "--grid", "5x3",
                  "--tooth", "--out", str(stl)]) == 0
     assert stl.read_text().startswith("solid")
+
+
+# --- edge contact (toe/heel, tip edges) and the forward-mode gradient -------------------
+
+EDGE_CASES = {"dE": gj.Misalignment.create(dE=0.01), "dSigma": gj.Misalignment.create(dSigma_deg=0.5)}
+
+
+@pytest.fixture(scope="module")
+def surface_only(des):
+    """The surface-contact TCA without the edge solve (drive side) and, in the same
+    jitted program, the forward-mode derivative of (TE p-t-p, TE at one grid point)
+    along a direction ``dtheta`` of (kappa, rho1): the implicit derivatives of every
+    contact solve (one program for every design, misalignment and direction)."""
+    x_ref, phi1_ref = reference_contact(des, "drive")
+
+    @jax.jit
+    def run(d, mis, dtheta):
+        def g(th):
+            dd = dataclasses.replace(d, kappa=th[0], rho1=th[1])
+            res = preset_result_traced(dd, mis, x_ref, phi1_ref, side="drive",
+                                       face_ends=False, **OPTS)
+            return jnp.stack([res.multi.ptp, res.path.te[GRAD_POINT]]), res
+        _, dval, res = jax.jvp(g, (jnp.stack([d.kappa, d.rho1]),), (dtheta,), has_aux=True)
+        return res, dval
+
+    def call(d, mis=None, dtheta=(0.0, 0.0)):
+        mis = gj.Misalignment.zero() if mis is None else mis
+        return run(strong_float64(d), strong_float64(mis), jnp.asarray(dtheta, float))
+    return call
+
+
+GRAD_POINT = 12            # a grid point of pair 0 on the flanks, 4 steps before mid-face
+
+
+@pytest.mark.parametrize("case", ["mod", "mod_coast", "plain"])
+def test_aligned_pairs_have_no_edge_contact_and_same_envelope(des, runs, surface_only, case):
+    res = runs[case]
+    assert np.all(np.asarray(res.path.edge_kind) == -1)
+    if case == "mod_coast":
+        return                      # the reference program is the drive side's
+    d = des if case == "mod" else dataclasses.replace(des, kappa=jnp.asarray(0.0))
+    ref, _ = surface_only(d)
+    env, env0 = np.asarray(res.multi.envelope), np.asarray(ref.multi.envelope)
+    fin = np.isfinite(env0)
+    np.testing.assert_array_equal(np.isfinite(env), fin)
+    assert np.max(np.abs(env[fin] - env0[fin])) / gj.ARCSEC <= 1e-9
+
+
+def _normal(r, uv):
+    """Unit normal of the flank ``r`` at ``uv`` from its parameter derivatives."""
+    J = np.asarray(jax.jacfwd(r)(jnp.asarray(uv)))
+    n = np.cross(J[:, 0], J[:, 1])
+    return n / np.linalg.norm(n)
+
+
+@pytest.mark.parametrize("case", list(EDGE_CASES))
+def test_misaligned_pair_touches_at_a_face_end(des, surface_only, case):
+    """A misalignment beyond the robustness range of the docs pushes the bearing off a
+    face end: there the edge of one member touches the mating flank.  Checked from the
+    flank functions and the mounting directly: the edge point on the toe/heel sphere,
+    the two flank points coincide, the separation along the mating normal is zero and
+    the edge tangent lies in the mating tangent plane; the surface contact (no edge
+    solve) lies off the flanks there, and the TE envelope takes the edge contact."""
+    mis = EDGE_CASES[case]
+    res = gj.run_tca(des, mis, side="drive", strict=False, **OPTS)
+    ref, _ = surface_only(des, mis)
+    p = res.path
+    kind = np.asarray(p.edge_kind)
+    at = np.nonzero(kind >= 0)[0]
+    assert at.size >= 1 and np.all(kind[at] < 4)          # face ends (toe/heel)
+    r1, r2 = side_flanks(des, "drive")
+    R, c = (np.asarray(a) for a in gear_mount(preset_assembly(des), mis))
+    Ai, _, Ao = (float(v) for v in G.cone_distances(des))
+    for i in at:
+        k = int(kind[i])
+        uv1, uv2 = np.asarray(p.uv1[i]), np.asarray(p.uv2[i])
+        q1, q2 = np.asarray(r1(jnp.asarray(uv1))), np.asarray(r2(jnp.asarray(uv2)))
+        p1 = _rz(float(p.phi1[i])) @ q1 + float(mis.dP) * np.array([0.0, 0.0, 1.0])
+        p2 = c + R @ _rz(float(p.phi2[i])) @ q2
+        n1 = _rz(float(p.phi1[i])) @ _normal(r1, uv1)
+        n2 = R @ _rz(float(p.phi2[i])) @ _normal(r2, uv2)
+        pinion = k < 2
+        q_edge, A = (q1 if pinion else q2), (Ai if k % 2 == 0 else Ao)
+        assert abs(np.linalg.norm(q_edge) - A) <= 1e-9                # on the face end
+        assert np.linalg.norm(p1 - p2) <= 1e-9                         # common point
+        n_mate = n2 if pinion else n1
+        assert abs(np.dot(p1 - p2, n_mate)) <= 1e-9                    # separation (mm)
+        # edge tangent: along the end sphere on the edge member's flank (central
+        # differences of the flank at fixed |q| = A), in the mating tangent plane
+        r, uv, Rk = (r1, uv1, _rz(float(p.phi1[i]))) if pinion else \
+            (r2, uv2, R @ _rz(float(p.phi2[i])))
+        J = np.asarray(jax.jacfwd(r)(jnp.asarray(uv)))
+        grad_L = q_edge / np.linalg.norm(q_edge) @ J                   # d|q|/d(u, t)
+        tang = Rk @ (J @ np.array([grad_L[1], -grad_L[0]]))
+        assert abs(np.dot(tang / np.linalg.norm(tang), n_mate)) <= 1e-7
+        # the surface contact lies off the flanks here; the envelope takes the edge
+        assert float(ref.margin[i]) < 0.0
+    env = np.asarray(res.multi.envelope)
+    te_pairs = np.asarray(res.multi.te_pairs)
+    k0 = te_pairs.shape[0] // 2
+    np.testing.assert_allclose(te_pairs[k0, at], np.asarray(p.te)[at], rtol=0, atol=1e-15)
+    assert np.all(np.isfinite(env[at]))
+    # flags: the bearing runs off the face end
+    f = res.flags()
+    assert f["face_end_contact"] and f["edge_contact"]
+
+
+def _rz(a):
+    c, s = math.cos(a), math.sin(a)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def test_te_gradient_wrt_kappa_and_rho1_matches_central_differences(des, surface_only):
+    """d(TE p-t-p, TE at one grid point)/d(kappa, rho1) by forward mode (the program of
+    the reference TCA above) against central differences of the public TCA (the
+    compiled program of the other tests, relative steps 1e-4)."""
+
+    def val(**kw):
+        r = gj.run_tca(dataclasses.replace(des, **kw), side="drive", **OPTS)
+        return np.array([float(r.multi.ptp), float(r.path.te[GRAD_POINT])])
+
+    for j, name in enumerate(("kappa", "rho1")):
+        x = float(getattr(des, name))
+        h = 1e-4 * x
+        fd = (val(**{name: jnp.asarray(x + h)}) - val(**{name: jnp.asarray(x - h)})) / (2 * h)
+        assert np.all(np.abs(fd) > 0.0)
+        ad = np.asarray(surface_only(des, dtheta=np.eye(2)[j])[1])
+        np.testing.assert_allclose(ad, fd, rtol=1e-5)
