@@ -131,7 +131,9 @@ def test_cli_tca_and_surface(des, runs, tmp_path, capsys):
 
 # --- edge contact (toe/heel, tip edges) and the forward-mode gradient -------------------
 
-EDGE_CASES = {"dE": gj.Misalignment.create(dE=0.01), "dSigma": gj.Misalignment.create(dSigma_deg=0.5)}
+#: misalignments beyond the robustness range of the docs: the bearing leaves a face end
+EDGE_CASES = {"dE": gj.Misalignment.create(dE=0.01),
+              "dSigma": gj.Misalignment.create(dSigma_deg=0.5)}
 
 
 @pytest.fixture(scope="module")
@@ -242,7 +244,8 @@ def _rz(a):
 def test_te_gradient_wrt_kappa_and_rho1_matches_central_differences(des, surface_only):
     """d(TE p-t-p, TE at one grid point)/d(kappa, rho1) by forward mode (the program of
     the reference TCA above) against central differences of the public TCA (the
-    compiled program of the other tests, relative steps 1e-4)."""
+    compiled program of the other tests, relative steps 1e-3: measured 7e-9 (kappa) and
+    8e-7 (rho1) relative; 1e-4 and below lose digits to the solver tolerances)."""
 
     def val(**kw):
         r = gj.run_tca(dataclasses.replace(des, **kw), side="drive", **OPTS)
@@ -250,7 +253,7 @@ def test_te_gradient_wrt_kappa_and_rho1_matches_central_differences(des, surface
 
     for j, name in enumerate(("kappa", "rho1")):
         x = float(getattr(des, name))
-        h = 1e-4 * x
+        h = 1e-3 * x
         fd = (val(**{name: jnp.asarray(x + h)}) - val(**{name: jnp.asarray(x - h)})) / (2 * h)
         assert np.all(np.abs(fd) > 0.0)
         ad = np.asarray(surface_only(des, dtheta=np.eye(2)[j])[1])
