@@ -93,6 +93,9 @@ class VHCattPair:
     pressure_angle : blade profile angle alpha (rad) = pressure angle of the middle section.
     cutter_radius1, cutter_radius2 : nominal cutter radius R_T of the head that cuts
         the pinion / the gear (mm; blades at R_T -+ w/2, w = pi m/2).
+    blade_offset : e (mm, >= 0), the mismatch: each blade moved away from the middle
+        of the space by e (trace radii R_T -+ (w/2 + e)), the head re-positioned so
+        that every flank keeps its middle-section point (tooth thickness unchanged).
     face_width : b (mm), symmetric about the middle section.
     z1, z2 : tooth numbers (static).
 
@@ -103,18 +106,19 @@ class VHCattPair:
     pressure_angle: jnp.ndarray
     cutter_radius1: jnp.ndarray
     cutter_radius2: jnp.ndarray
+    blade_offset: jnp.ndarray
     face_width: jnp.ndarray
     z1: int = field(metadata=dict(static=True))
     z2: int = field(metadata=dict(static=True))
 
     @classmethod
     def create(cls, z1, z2, module, pressure_angle_deg, face_width, cutter_radius1,
-               cutter_radius2=None, check_form: bool = True):
+               cutter_radius2=None, blade_offset=0.0, check_form: bool = True):
         """Validated constructor (mm, degrees); ``ValueError`` names the parameter.
 
         Ranges: tooth numbers 8..400, module 0.1..50 mm, pressure angle [10, 30] deg,
         face width (0, min(20 m, R_T))  mm, cutter radii 10..1e5 mm and above 10 blade
-        spacings ``10 w = 5 pi m``.  ``cutter_radius2`` defaults to ``cutter_radius1``
+        spacings ``10 w = 5 pi m``, blade offset [0, 5 m] mm.  ``cutter_radius2`` defaults to ``cutter_radius1``
         (one head cuts both members, as in [VH-CATT] Table 1).  With ``check_form``
         the tooth form is checked (:func:`tooth_form`): pointed teeth, and undercut
         reaching the active profile, are refused.
@@ -133,10 +137,11 @@ class VHCattPair:
                 raise ValueError(f"{name} = {v:g} mm is below 10 blade spacings (5 pi m = "
                                  f"{lo:.4g} mm): allowed [{lo:.4g}, 1e5] mm")
             rt.append(v)
+        e = check_range("blade_offset", blade_offset, 0.0, 5.0 * m, unit="mm")
         bmax = min(20.0 * m, min(rt))
         b = check_range("face_width", face_width, 0.0, bmax, lo_open=True, unit="mm")
         f = float64_array
-        pair = cls(f(m), f(a * math.pi / 180.0), f(rt[0]), f(rt[1]), f(b), z1, z2)
+        pair = cls(f(m), f(a * math.pi / 180.0), f(rt[0]), f(rt[1]), f(e), f(b), z1, z2)
         if check_form:
             form = tooth_form(pair)
             for mem in MEMBERS:
@@ -176,15 +181,17 @@ class ToolData(NamedTuple):
     cos_a: jax.Array
 
 
-def tool_data(module, alpha, cutter_radius, z, hand, sigma) -> ToolData:
-    """:class:`ToolData` of flank ``sigma`` (+-1) of a member of hand ``hand`` (+-1)."""
+def tool_data(module, alpha, cutter_radius, z, hand, sigma, blade_offset=0.0) -> ToolData:
+    """:class:`ToolData` of flank ``sigma`` (+-1) of a member of hand ``hand`` (+-1):
+    trace radius ``rho0 = R_T - h sigma (w/2 + e)``, head axis ``x_c = sigma s/2 - h rho0``
+    (``s = w = pi m/2``: the flank passes through ``x = sigma s/2`` in the middle section)."""
     p = jnp.pi * module
     w = 0.5 * p
     r = 0.5 * z * module
     h = jnp.asarray(hand, float)
     s = jnp.asarray(sigma, float)
-    xc = s * 0.5 * p - h * cutter_radius
-    rho0 = cutter_radius - h * s * 0.5 * w
+    rho0 = cutter_radius - h * s * (0.5 * w + blade_offset)
+    xc = s * 0.5 * (p - w) - h * rho0
     return ToolData(r, xc, rho0, h * s, h, s, jnp.sin(alpha), jnp.cos(alpha))
 
 
@@ -217,7 +224,7 @@ def generated_flank(pair: VHCattPair, member: str, sigma) -> GeneratedSurface:
     """The flank ``sigma`` (+-1, may be a traced float) of tooth 0 of ``member``
     ("pinion"/"gear"), enveloped by its blade cone (body frame of the member)."""
     k = tool_data(pair.module, pair.pressure_angle, pair.cutter_radius(member),
-                  pair.teeth(member), HANDS[member], sigma)
+                  pair.teeth(member), HANDS[member], sigma, pair.blade_offset)
     P = jax.tree_util.Partial
     return GeneratedSurface(P(tool_family, k), P(tool_psi0, k))
 
@@ -288,7 +295,7 @@ def section_point(pair: VHCattPair, member: str, sigma, u, z):
     """Generated point (body frame) at blade coordinate ``u`` in the transverse section
     ``z`` (traceable): ``flank(u, v(u, z))``."""
     k = tool_data(pair.module, pair.pressure_angle, pair.cutter_radius(member),
-                  pair.teeth(member), HANDS[member], sigma)
+                  pair.teeth(member), HANDS[member], sigma, pair.blade_offset)
     fl = generated_flank(pair, member, sigma)
     return fl(jnp.stack([u, _v_of(k, u, z)]))
 
@@ -423,7 +430,7 @@ def _flank_grid_impl(pair, is_gear, sigma, n_z, n_u):
     mem = "gear" if is_gear else "pinion"
     geo = pair_geometry(pair)
     k = tool_data(pair.module, pair.pressure_angle, pair.cutter_radius(mem),
-                  pair.teeth(mem), HANDS[mem], sigma)
+                  pair.teeth(mem), HANDS[mem], sigma, pair.blade_offset)
     fl = generated_flank(pair, mem, sigma)
     ra = geo["ra2"] if is_gear else geo["ra1"]
     al, m = pair.pressure_angle, pair.module
