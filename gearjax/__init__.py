@@ -71,6 +71,8 @@ from gearjax.gears.hypoid.tca import prepare as prepare_hypoid  # noqa: E402
 from gearjax.gears.hypoid import synthesis  # noqa: E402
 from gearjax.gears.hypoid.synthesis import Targets, synthesise  # noqa: E402
 from gearjax.gears.hypoid.synthesis import start as synthesis_start  # noqa: E402
+from gearjax.gears.vh_catt.geometry import VHCattPair  # noqa: E402
+from gearjax.gears.vh_catt.design_file import VHCattDesign  # noqa: E402  (registers kind "vh_catt")
 # -- lubrication and friction --------------------------------------------------------
 from gearjax.tribology import (OILS, FrictionResult, Oil, Surface, friction_coefficient,  # noqa: E402
                                friction_traced, get_oil, make_oil, make_surface, mesh_losses,
@@ -151,6 +153,7 @@ __all__ = [
     "InvolutePair", "InvoluteTCA", "pair_geometry", "HypoidPair", "pair_flanks",
     "complementary_pinion", "prepare_hypoid", "pinion_outline", "involute_limits", "BlankInput", "blank_geometry",
     "blank_sensitivity",
+    "VHCattPair", "VHCattDesign",
     # flanks
     "FaceMillCutter", "make_cutter", "MachineSettings", "MemberBlank", "FlankSpec",
     "flank_surface", "generated_flank", "GeneratedSurface", "local_geometry",

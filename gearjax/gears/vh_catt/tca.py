@@ -43,7 +43,7 @@ from gearjax.tca_result import (TCAResult, check_side, contact_kinematics, regis
                                 strong_float64)
 
 __all__ = ["vh_assembly", "vh_flanks", "reference_guess", "vh_margin", "vh_tca_traced",
-           "vh_result_traced", "SUMMARY_KEYS", "tca_summary", "pair_of", "side_code"]
+           "vh_result_traced", "SUMMARY_KEYS", "tca_summary", "pair_of", "side_code", "ADAPTER"]
 
 
 def pair_of(design) -> VHCattPair:
@@ -261,5 +261,5 @@ def _no_line_contact(line_contact):
                          "differ by the blade offset); allowed: None or False")
 
 
-_ADAPTER = _Adapter()
-register_family(VHCattPair, _ADAPTER)
+ADAPTER = _Adapter()
+register_family(VHCattPair, ADAPTER)
