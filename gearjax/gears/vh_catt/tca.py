@@ -234,6 +234,12 @@ class _Adapter:
         f.pair = pair_of(des)
         return f
 
+    def outline(self, des, side="drive"):
+        """Pinion flank limits for the TCA figure (concrete floats, mm): face_half,
+        root_radius (form circle of the straight blade), tip_radius."""
+        ra1, rf1, _, _, hb = _limits(pair_of(des))
+        return dict(face_half=float(hb), root_radius=float(rf1), tip_radius=float(ra1))
+
     def mesh(self, des, *, side="drive", **_):
         """``(teeth_of, pair, pair)`` for the loaded contact (:mod:`gearjax.gears.vh_catt.mesh`)."""
         from gearjax.gears.vh_catt.mesh import vh_mesh_teeth
