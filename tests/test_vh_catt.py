@@ -147,10 +147,11 @@ def test_aligned_tca_is_the_middle_section_involute_mesh(pair, tca_runs):
         assert on.sum() > 20 and all(r.flags()[k] for k in ("converged", "reference_on_flank"))
         assert np.max(np.abs(np.asarray(r.te)[on])) / gj.ARCSEC < 1e-6
         assert np.max(np.abs(np.asarray(r.path.axial1)[on])) < 1e-9
-        # involute roll: rho1 = rho_P + rb1 (phi1 - phi1_P) on the line of action
+        # involute roll on the line of action: rho1 = rho_P +- rb1 (phi1 - phi1_P) (the
+        # drive flank rolls towards the pinion tip as phi1 grows, the coast flank back)
         phi = np.asarray(r.phi1)
         mid = phi.shape[0] // 2
-        rho = geo["rho_P"] + rb1 * (phi - phi[mid])
+        rho = geo["rho_P"] + (1.0 if side == "drive" else -1.0) * rb1 * (phi - phi[mid])
         rad = np.hypot(rb1, rho)
         assert np.max(np.abs(np.asarray(r.path.radial1)[on] - rad[on])) < 1e-8
         # contact ratio from the boundary crossings (linear interpolation on the grid)
