@@ -172,6 +172,9 @@ def main():
     trends["viscosity_factor"] = [dict(value=f, eta0_Pas=float(oil0.eta0) * f,
                                        **summary(*run(oil=oil_eta(f))))
                                   for f in (0.25, 0.5, 1.0, 2.0, 4.0)]
+    trends["viscosity_factor_10000rpm"] = [dict(value=f, eta0_Pas=float(oil0.eta0) * f,
+                                                **summary(*run(rpm=10000.0, oil=oil_eta(f))))
+                                           for f in (0.25, 0.5, 1.0, 2.0, 4.0)]
     trends["sigma_um"] = [dict(value=s, **summary(*run(sigma=s))) for s in
                           (0.1, 0.2, 0.4, 0.8, 1.6)]
     trends["torque_Nm"] = [dict(value=t, **summary(*run(torque=t))) for t in
@@ -221,6 +224,8 @@ def main():
 
 SEED = {"speed_rpm": "mu decreases; eta increases quickly at low speed, levels off",
         "viscosity_factor": "mu increases; eta: better at low speed, optimum medium viscosity",
+        "viscosity_factor_10000rpm": "(high speed, full film) mu increases with viscosity; "
+                                     "eta: optimum medium viscosity",
         "sigma_um": "mu increases; eta strongly lower at low speed, negligible in full film",
         "torque_Nm": "mu increases (at the pitch point); eta decreases"}
 
@@ -311,9 +316,9 @@ def figures(res):
     ax.set_ylabel("mean mu")
     ax.legend()
     atomic_write_figure(fig, OUT / "vh_catt_stribeck.png")
-    fig = Figure(figsize=(9, 6))
+    fig = Figure(figsize=(12, 6))
     for i, (key, rows) in enumerate(res["trends"].items()):
-        ax = fig.add_subplot(2, 2, i + 1)
+        ax = fig.add_subplot(2, 3, i + 1)
         ax.semilogx([r["value"] for r in rows], [r["eta_bar"] for r in rows], "o-")
         ax.set_xlabel(key)
         ax.set_ylabel("eta_bar")
