@@ -73,20 +73,20 @@ def test_middle_section_is_the_involute(pair, sections):
 
 def test_other_sections_are_not_involutes(pair, sections):
     """Off the middle the sections are not involutes: after the best rotation about the
-    axis the deviation from the involute grows with z (0.5 um at z = b/2 ... the
-    numbers of docs/vh_catt.md)."""
+    axis (least squares) a shape deviation from the involute is left, growing about as
+    z^2 (the numbers of docs/vh_catt.md)."""
     devs = []
+    r, rb = 0.5 * 17 * M, 0.5 * 17 * M * math.cos(ALPHA)
     for zi in (1, 2):
         P = sections["pinion", -1.0][zi]
-        r, rb = 0.5 * 17 * M, 0.5 * 17 * M * math.cos(ALPHA)
         R = np.hypot(P[:, 0], P[:, 1])
-        ok = R > rb * (1 + 1e-6)
-        phi = np.arctan2(P[ok, 1], P[ok, 0])
+        ok = R > rb + 0.05
         ref = np.array([math.pi / 2 + (math.pi * M / 2 / (2 * r) + inv(ALPHA)
                                        - inv(math.acos(rb / x))) for x in R[ok]])
-        d = R[ok] * (phi - ref)
-        devs.append(np.ptp(d - 0.0))
-    assert devs[0] > 1e-5 and devs[1] > 3.0 * devs[0]
+        dphi = np.arctan2(P[ok, 1], P[ok, 0]) - ref
+        delta = np.sum(R[ok] ** 2 * dphi) / np.sum(R[ok] ** 2)
+        devs.append(np.max(np.abs(R[ok] * (dphi - delta))))
+    assert devs[0] > 1e-4 and 3.0 < devs[1] / devs[0] < 5.0
 
 
 def test_pitch_trace_is_the_cutter_circle(pair):
