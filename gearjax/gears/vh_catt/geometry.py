@@ -61,13 +61,13 @@ import numpy as np
 
 from gearjax.errors import check_int, check_range, is_traced
 from gearjax.fields import float64_array
-from gearjax.surfaces import GeneratedSurface
+from gearjax.surfaces import GeneratedSurface, meshing_function
 
 __all__ = ["VHCattPair", "ToolData", "tool_data", "tool_point", "tool_family", "tool_psi0",
            "generated_flank", "pair_geometry", "HANDS", "MEMBERS", "SIDE_NAMES",
            "section_point", "pitch_trace_point", "involute_polar_angle", "tooth_form",
            "flank_grid", "MODULE_RANGE_MM", "CUTTER_RADIUS_RANGE_MM", "MAX_TEETH",
-           "ADDENDUM", "DEDENDUM", "BLADE_DEPTH"]
+           "ADDENDUM", "DEDENDUM", "BLADE_DEPTH", "envelope_point", "radius_point"]
 
 #: members and their hands (h = +1 pinion, -1 gear: head centres mirrored)
 MEMBERS = ("pinion", "gear")
@@ -348,6 +348,28 @@ def pitch_trace_point(pair: VHCattPair, member: str, sigma, z):
 
 #: blade-coordinate step (mm) of the finite-difference slope of the undercut check
 _DU = 1e-4
+#: Newton steps of the plain envelope solve of the checks (quadratic convergence from
+#: the rack's line-of-action start value: machine precision in 4-5 steps)
+_ENV_STEPS = 8
+
+
+def envelope_point(k: ToolData, u, z):
+    """``(point, meshing residual)`` of the generated flank at blade coordinate ``u`` in
+    section ``z`` by a plain Newton iteration on the meshing equation (fixed steps, no
+    implicit derivative rule): cheap to compile, for the concrete checks of
+    :func:`tooth_form`.  Same point as :func:`section_point` (tested)."""
+    fam = jax.tree_util.Partial(tool_family, k)
+    uv = jnp.stack([u, _v_of(k, u, z)])
+
+    def f(psi):
+        return meshing_function(fam, uv, psi)
+
+    def step(_, psi):
+        val, d = jax.jvp(f, (psi,), (jnp.ones_like(psi),))
+        return psi - val / d
+
+    psi = jax.lax.fori_loop(0, _ENV_STEPS, step, tool_psi0(k, uv))
+    return tool_family(k, uv, psi), jnp.abs(f(psi))
 
 
 @jax.jit
@@ -361,11 +383,17 @@ def _form_arrays(pair: VHCattPair):
     for mem, ra, sap in (("pinion", geo["ra1"], geo["start_radius1"]),
                          ("gear", geo["ra2"], geo["start_radius2"])):
         def one(z, sigma):
-            p, res = radius_point(pair, mem, sigma, ra, z)
+            k = tool_data(pair.module, pair.pressure_angle, pair.cutter_radius(mem),
+                          pair.teeth(mem), HANDS[mem], sigma, pair.blade_offset)
 
             def rad(u):
-                q = section_point(pair, mem, sigma, u, z)
+                q, _ = envelope_point(k, u, z)
                 return jnp.sqrt(q[0] ** 2 + q[1] ** 2)
+
+            u0 = _u_guess(pair, mem, ra)
+            u_tip, res_r = _secant(lambda u: rad(u) - ra, u0, u0 + 1e-3)
+            p, res_m = envelope_point(k, u_tip, z)
+            res = jnp.maximum(res_r, res_m)
 
             def slope(u):
                 return rad(u + _DU) - rad(u)
