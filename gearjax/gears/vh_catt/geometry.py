@@ -20,23 +20,27 @@ family is ``r_w(uv, psi) = Rz(-psi) [c(uv) - (r psi, 0, 0)]``.
 
 **Cutter cones.**  The space next to flank ``sigma`` of tooth 0 (``sigma = +1``:
 the flank at x > 0) is centred at ``x = sigma p/2`` (``p = pi m``) and cut by a head
-whose axis (parallel to y) passes through ``x_c = sigma p/2 - h R_T``, z = 0, with
+whose axis (parallel to y) passes through ``x_c = sigma s/2 - h rho_0``, z = 0, with
 the *hand* ``h = +1`` for the pinion (head centres on the -x side) and ``h = -1``
 for the gear (mirrored: the gear is the mating member, as a left-hand helical gear
 mates with a right-hand one).  The blades bound a space of width ``w = p/2`` in
-the pitch plane, so the flank cut by the blade that faces tooth 0 has the pitch-
-plane trace radius ``rho_0 = R_T - h sigma w/2`` and the cone
+the pitch plane, each moved away from the middle of the space by the blade offset
+``e`` (the head re-positioned for each flank so that the flank keeps its
+middle-section point ``x = sigma s/2``, ``s = w``), so the flank cut by the blade
+that faces tooth 0 has the pitch-plane trace radius
+``rho_0 = R_T - h sigma (w/2 + e)`` and the cone
 
     c(u, v) = (x_c + h rho cos(theta), r + u cos(alpha), rho sin(theta)),
     rho = rho_0 - h sigma u sin(alpha),   theta = v/rho_0,
 
 ``u`` (mm) along the blade from the pitch plane (towards the tip of the generated
 tooth), ``v`` (mm) along the trace.  Pinion: flank +1 convex (inside blade,
-``R_T - w/2``), flank -1 concave (outside blade, ``R_T + w/2``); gear: mirrored.
-In the pair the pinion's concave flank meets the gear's convex flank (drive) and
-vice versa (coast): with one cutter radius for both members their traces differ
-by the blade offset ``w`` (``R_T +- w/2``), which localises the contact to a point
-(the *mismatch*; ``cutter_radius1 != cutter_radius2`` adds to it).
+``R_T - w/2 - e``), flank -1 concave (outside blade, ``R_T + w/2 + e``); gear:
+mirrored.  In the pair the pinion's concave flank meets the gear's convex flank
+(drive) and vice versa (coast): their traces differ by ``w + 2e`` (for equal
+cutter radii), which localises the contact to a point (the *mismatch*: e = 0 is the
+plain dual-blade head; ``cutter_radius1 != cutter_radius2`` raises it on one side
+and lowers it on the other, docs/vh_catt.md).
 
 **What follows from it** (checked in tests/test_vh_catt.py against closed forms):
 the middle transverse section z = 0 contains the blade generator theta = 0 and
