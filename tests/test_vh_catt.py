@@ -86,7 +86,7 @@ def test_other_sections_are_not_involutes(pair, sections):
         dphi = np.arctan2(P[ok, 1], P[ok, 0]) - ref
         delta = np.sum(R[ok] ** 2 * dphi) / np.sum(R[ok] ** 2)
         devs.append(np.max(np.abs(R[ok] * (dphi - delta))))
-    assert devs[0] > 1e-4 and 3.0 < devs[1] / devs[0] < 5.0
+    assert devs[0] > 1e-5 and 3.0 < devs[1] / devs[0] < 5.0
 
 
 def test_pitch_trace_is_the_cutter_circle(pair):
