@@ -71,6 +71,10 @@ from gearjax.gears.hypoid.tca import prepare as prepare_hypoid  # noqa: E402
 from gearjax.gears.hypoid import synthesis  # noqa: E402
 from gearjax.gears.hypoid.synthesis import Targets, synthesise  # noqa: E402
 from gearjax.gears.hypoid.synthesis import start as synthesis_start  # noqa: E402
+from gearjax.gears.preset_bevel.geometry import PresetBevelDesign  # noqa: E402
+from gearjax.gears.preset_bevel.design_file import PresetBevelFile  # noqa: E402
+from gearjax.gears.preset_bevel.design_file import flank_grid as preset_bevel_flank_grid  # noqa: E402
+from gearjax.gears.preset_bevel import analysis as preset_bevel_analysis  # noqa: E402
 from gearjax.gears.vh_catt.geometry import VHCattPair  # noqa: E402
 from gearjax.gears.vh_catt.design_file import VHCattDesign  # noqa: E402  (registers kind "vh_catt")
 # -- lubrication and friction --------------------------------------------------------
@@ -179,4 +183,6 @@ __all__ = [
     "field_names", "get_fields", "with_fields",
     # frames
     "rot_x", "rot_y", "rot_z", "rot_axis", "translate",
+    # pure-rolling bevel pairs with a preset TE
+    "PresetBevelDesign", "PresetBevelFile", "preset_bevel_flank_grid", "preset_bevel_analysis",
 ]
