@@ -58,6 +58,7 @@ def run_case(F, u_e, Ry, n, angle=0.0, srr=0.2, **kw):
                                 strict=False, **kw)
     dt = time.time() - t
     sc = scales(case)
+    p_max = float(np.max(ehl_fields(res, case, grid, bool(res.x.shape[0] > grid.nx * grid.ny + 1))["p"]))
     hc, hm = (float(v) for v in hamrock_dowson(case.F, case.Rx, sc.k, case.u_e, case.eta0,
                                                case.alpha, case.E_prime))
     M, L, _ = moes_variables(case.F, case.u_e, case.Rx, case.eta0, case.alpha, case.E_prime)
@@ -66,7 +67,7 @@ def run_case(F, u_e, Ry, n, angle=0.0, srr=0.2, **kw):
                 h_min=float(res.h_min) * 1e3, hc_HD=hc * 1e3, hmin_HD=hm * 1e3,
                 hc_NVM=float(film_from_moes(case.F, case.u_e, case.Rx, case.Ry, case.eta0,
                                             case.alpha, case.E_prime)) * 1e3,
-                mu=float(res.mu), load_error=float(res.load_error),
+                mu=float(res.mu), p_max=p_max, load_error=float(res.load_error),
                 residual=float(res.residual), converged=bool(res.converged),
                 steps=int(res.steps), time_s=dt), (res, case, grid)
 
@@ -89,12 +90,45 @@ def part_moes(results):
 
 
 def part_grid(results):
+    """64², 128², 256² (and 512² with EHL_VAL_512=1); ``upwind`` from EHL_VAL_UPWIND."""
+    beta = float(os.environ.get("EHL_VAL_UPWIND", "0"))
+    key = "grid" if beta == 0.0 else f"grid_upwind{beta:g}"
+    sizes = (64, 128, 256) + ((512,) if os.environ.get("EHL_VAL_512") else ())
+    old = {r["n"]: r for r in results.get(key, []) if r.get("converged")}
     rows = []
-    for n in (64, 128, 256):
-        r, _ = run_case(100.0, 1000.0, RX, n)
+    for n in sizes:
+        if n in old and not os.environ.get("EHL_VAL_RERUN"):
+            rows.append(old[n])
+            continue
+        tol = float(os.environ.get("EHL_VAL_TOL_FINE", "1e-9")) if n > 128 else 1e-9
+        r, _ = run_case(100.0, 1000.0, RX, n, upwind=beta, tol=tol)
+        r["upwind"] = beta
+        r["tol"] = tol
         rows.append(r)
         print(json.dumps(r), flush=True)
-    results["grid"] = rows
+        results[key] = rows + [old[m] for m in sizes if m > n and m in old]
+        with open(os.path.join(OUT, "ehl_validation.json"), "w") as fh:
+            json.dump(results, fh, indent=1)
+    results[key] = rows
+
+
+def part_sou(results):
+    """First- vs second-order upwind: h_min at high M (128²) and oblique entrainment (64²)."""
+    rows = []
+    for M, n in ((500, 128), (1000, 128)):
+        F, u_e, Ry = case_for(M, 10.0)
+        for beta in (0.0, 1.0):
+            r, _ = run_case(F, u_e, Ry, n, upwind=beta)
+            r.update(upwind=beta, kind="M")
+            rows.append(r)
+            print(json.dumps(r), flush=True)
+    for ang in (0.0, 30.0):
+        for beta in (0.0, 1.0):
+            r, _ = run_case(100.0, 1000.0, RX, 64, angle=ang, upwind=beta)
+            r.update(upwind=beta, kind="angle")
+            rows.append(r)
+            print(json.dumps(r), flush=True)
+    results["sou"] = rows
 
 
 def part_rot(results):
@@ -197,7 +231,7 @@ def main(parts):
         parts = []
     for p in parts:
         {"moes": part_moes, "grid": part_grid, "fig": part_fig, "rot": part_rot,
-         "fast": part_fast}[p](results)
+         "fast": part_fast, "sou": part_sou}[p](results)
         with open(path, "w") as fh:
             json.dump(results, fh, indent=1)
     write_md(results)
@@ -212,12 +246,21 @@ def write_md(results):
         for r in results["moes"]:
             lines.append(f"| {r['M']:.0f} | {r['L']:.0f} | {r['Ry']/RX:.0f} | {r['p_h']:.0f} | {r['h_c']:.4f} | {r['hc_HD']:.4f} | {r['hc_NVM']:.4f} | {r['h_c']/r['hc_HD']:.3f} | {r['h_c']/r['hc_NVM']:.3f} | {r['h_min']:.4f} | {r['hmin_HD']:.4f} | {r['h_min']/r['hmin_HD']:.3f} | {r['load_error']:.1e} | {r['residual']:.1e} | {r['converged']} |")
         lines.append("")
-    if "grid" in results:
-        lines += ["## Grid convergence (F = 100 N, u_e = 1 m/s, M = 168, L = 14.8)", "",
-                  "| grid | h_c µm | h_min µm | μ | load err | residual | steps | time s | converged |",
-                  "|---|---|---|---|---|---|---|---|---|"]
-        for r in results["grid"]:
-            lines.append(f"| {r['n']}² | {r['h_c']:.5f} | {r['h_min']:.5f} | {r['mu']:.5f} | {r['load_error']:.1e} | {r['residual']:.1e} | {r['steps']} | {r['time_s']:.1f} | {r['converged']} |")
+    for key in sorted(k for k in results if k.startswith("grid")):
+        lines += [f"## Grid convergence (F = 100 N, u_e = 1 m/s, M = 168, L = 14.8; {key})", "",
+                  "| grid | h_c µm | h_min µm | μ | p_max MPa | load err | residual | steps | time s | converged |",
+                  "|---|---|---|---|---|---|---|---|---|---|"]
+        for r in results[key]:
+            pm = f"{r['p_max']:.0f}" if "p_max" in r else "—"
+            lines.append(f"| {r['n']}² | {r['h_c']:.5f} | {r['h_min']:.5f} | {r['mu']:.5f} | {pm} | {r['load_error']:.1e} | {r['residual']:.1e} | {r['steps']} | {r['time_s']:.1f} | {r['converged']} |")
+        lines.append("")
+    if "sou" in results:
+        lines += ["## First- (β = 0) vs second-order (β = 1) upwind Couette fluxes", "",
+                  "| case | grid | angle ° | β | h_c µm | h_min µm | h_min/HD | μ | p_max MPa | converged | time s |",
+                  "|---|---|---|---|---|---|---|---|---|---|---|"]
+        for r in results["sou"]:
+            case = f"M = {r['M']:.0f}, L = {r['L']:.0f}"
+            lines.append(f"| {case} | {r['n']}² | {r['angle']:.0f} | {r['upwind']:g} | {r['h_c']:.5f} | {r['h_min']:.5f} | {r['h_min']/r['hmin_HD']:.3f} | {r['mu']:.5f} | {r['p_max']:.0f} | {r['converged']} | {r['time_s']:.1f} |")
         lines.append("")
     if "rotation" in results:
         lines += ["## Entrainment angle (circular contact, 64²)", "",

@@ -63,13 +63,20 @@ from gearjax.gears.hypoid.cutter import FaceMillCutter, make_cutter  # noqa: E40
 from gearjax.gears.hypoid.machine import MachineSettings  # noqa: E402
 from gearjax.gears.hypoid.flank import FlankSpec, MemberBlank, flank_surface  # noqa: E402
 from gearjax.gears.hypoid.pair import HypoidPair, complementary_pinion, pair_flanks  # noqa: E402
-from gearjax.gears.hypoid.design_file import (HypoidDesign, design_from_dict,  # noqa: E402
-                                              load_design, save_design)
+from gearjax.gears.hypoid.design_file import HypoidDesign, save_design  # noqa: E402
+from gearjax.gears.hypoid.design_file import KINDS as HYPOID_KINDS  # noqa: E402
+from gearjax.io import design_from_dict, load_design  # noqa: E402  (any family, by [design] kind)
 from gearjax.gears.hypoid.tca import pinion_outline  # noqa: E402
 from gearjax.gears.hypoid.tca import prepare as prepare_hypoid  # noqa: E402
 from gearjax.gears.hypoid import synthesis  # noqa: E402
 from gearjax.gears.hypoid.synthesis import Targets, synthesise  # noqa: E402
 from gearjax.gears.hypoid.synthesis import start as synthesis_start  # noqa: E402
+from gearjax.gears.preset_bevel.geometry import PresetBevelDesign  # noqa: E402
+from gearjax.gears.preset_bevel.design_file import PresetBevelFile  # noqa: E402
+from gearjax.gears.preset_bevel.design_file import flank_grid as preset_bevel_flank_grid  # noqa: E402
+from gearjax.gears.preset_bevel import analysis as preset_bevel_analysis  # noqa: E402
+from gearjax.gears.vh_catt.geometry import VHCattPair  # noqa: E402
+from gearjax.gears.vh_catt.design_file import VHCattDesign  # noqa: E402  (registers kind "vh_catt")
 # -- lubrication and friction --------------------------------------------------------
 from gearjax.tribology import (OILS, FrictionResult, Oil, Surface, friction_coefficient,  # noqa: E402
                                friction_traced, get_oil, make_oil, make_surface, mesh_losses,
@@ -144,12 +151,13 @@ def tca_sensitivity(design, misalignment=None, *, side=None, **options):
 __all__ = [
     "__version__",
     # designs and files
-    "load_design", "save_design", "design_from_dict", "HypoidDesign", "list_examples",
+    "load_design", "save_design", "design_from_dict", "HypoidDesign", "HYPOID_KINDS", "list_examples",
     "example_path", "atomic_write",
     # pairs and blanks
     "InvolutePair", "InvoluteTCA", "pair_geometry", "HypoidPair", "pair_flanks",
     "complementary_pinion", "prepare_hypoid", "pinion_outline", "involute_limits", "BlankInput", "blank_geometry",
     "blank_sensitivity",
+    "VHCattPair", "VHCattDesign",
     # flanks
     "FaceMillCutter", "make_cutter", "MachineSettings", "MemberBlank", "FlankSpec",
     "flank_surface", "generated_flank", "GeneratedSurface", "local_geometry",
@@ -175,4 +183,6 @@ __all__ = [
     "field_names", "get_fields", "with_fields",
     # frames
     "rot_x", "rot_y", "rot_z", "rot_axis", "translate",
+    # pure-rolling bevel pairs with a preset TE
+    "PresetBevelDesign", "PresetBevelFile", "preset_bevel_flank_grid", "preset_bevel_analysis",
 ]

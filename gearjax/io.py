@@ -34,7 +34,8 @@ __all__ = ["read_toml", "check_keys", "require_key", "check_number", "check_inte
            "example_path", "atomic_write", "atomic_write_figure", "figure_bytes",
            "check_output_path", "WriteError", "finite_json", "dumps_json",
            "write_csv", "write_xyz", "write_stl_flank",
-           "write_stl_tooth", "tooth_mesh", "flank_triangles", "write_flank"]
+           "write_stl_tooth", "tooth_mesh", "flank_triangles", "write_flank",
+           "register_design_kind", "design_kinds", "design_from_dict", "load_design"]
 
 #: packaged examples renamed since (old name -> current name); still accepted
 EXAMPLE_ALIASES = {"seed000_6x39_7p5in": "hypoid_6x39_7p5in"}
@@ -406,6 +407,67 @@ def read_toml(source) -> dict:
     if not data:
         raise ValueError(f"design file {name} is empty (no tables)")
     return data
+
+
+# --------------------------------------------------------------------------------------
+# design files of every family: one loader, dispatched on [design] kind
+
+#: kind -> reader(data: dict) -> design; filled by the families when they are imported
+_DESIGN_READERS: dict = {}
+
+
+def register_design_kind(kind: str, reader) -> None:
+    """Register the reader of the design files whose ``[design] kind`` is ``kind``.
+
+    ``reader(data)`` validates a parsed design file (file units: mm, degrees) and
+    returns the family's design object, or raises ``ValueError`` naming the table
+    and the key.  The object provides ``name`` (str), ``data`` (the validated dict,
+    written back by ``save_design``) and ``defaults_lines()`` (the documented
+    defaults it relies on, printed by ``gearjax example show``).  So that the
+    contact commands take it, its type is registered with
+    ``gearjax.tca_result.register_family`` (``gearjax tca`` and ``gearjax efficiency``
+    call ``run_tca(design, mis, side=...)`` / ``mesh_efficiency``); so that
+    ``gearjax surface`` takes it, it provides ``surface_grid(member, flank, n_u, n_v)``
+    (a grid with ``points``, ``normals`` (n_u, n_v, 3), ``params`` (n_u, n_v, k), ``xi``
+    (n_u,), ``residual`` and ``converged`` (n_u, n_v): see :func:`write_csv`) and
+    ``teeth(member)`` (int).  The hypoid family registers ``hypoid`` and
+    ``spiral_bevel``.
+    """
+    _DESIGN_READERS[kind] = reader
+
+
+def design_kinds() -> tuple:
+    """The ``[design] kind`` values a design file may have (registered families)."""
+    return tuple(sorted(_DESIGN_READERS))
+
+
+def design_from_dict(data, kinds=None):
+    """A design object from a parsed design file, by its ``[design] kind``.
+
+    ``kinds`` restricts the accepted kinds (a command made for one family);
+    ``ValueError`` naming the table and the key for a missing, unknown or refused kind."""
+    if not isinstance(data, dict):
+        raise ValueError(f"a design must be a table (dict), got {_type_name(data)}")
+    des = data.get("design")
+    if not isinstance(des, dict):
+        raise ValueError("missing table [design] (with kind = one of "
+                         + ", ".join(repr(k) for k in design_kinds()) + ")")
+    kind = check_string("design", "kind", require_key("design", des, "kind"), design_kinds())
+    if kinds is not None and kind not in kinds:
+        raise ValueError(f"[design] kind = {kind!r}: this command takes "
+                         + " or ".join(repr(k) for k in kinds) + " designs")
+    return _DESIGN_READERS[kind](data)
+
+
+def load_design(source, kinds=None):
+    """Load and validate a design file of any registered family: a path or
+    ``example:NAME``.  ``ValueError`` (one line naming the file, the table and the
+    key) for any invalid input; ``kinds`` as in :func:`design_from_dict`."""
+    data = read_toml(source)
+    try:
+        return design_from_dict(data, kinds)
+    except ValueError as exc:
+        raise ValueError(f"design file {str(source)!r}: {exc}") from None
 
 
 # --------------------------------------------------------------------------------------

@@ -155,3 +155,33 @@ def test_table_from_the_same_result(run, capsys):
     for label in ("eta_bar", "mean mu", "max p_max", "P_in", "loaded TE p-t-p"):
         assert label in summary
     assert f"{100 * out['mean_efficiency']:.4f} %" in summary
+
+
+def test_ehl_check_skips_line_contacts_with_the_reason(run):
+    # the spur pair is in line contact: its equivalent ellipse (Ry/Rx ≫ 50) is outside
+    # the numerical EHL point-contact model, so every checked position is reported as
+    # skipped with the reason, with the fast model's values of the main result
+    rc, text, err, d, png = run
+    base = _strict(text)
+    assert base["ehl_check"] is None
+    out, errs = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(errs):
+        rc = main(["efficiency", *BASE, "--positions", "8", "--json", "--ehl-check", "3"])
+    assert rc == 0, errs.getvalue()
+    rows = _strict(out.getvalue())["ehl_check"]
+    assert len(rows) == 3
+    for r in rows:
+        assert "Ry/Rx" in r["skipped"] and r["mu_ehl"] is None and not r["converged"]
+        j = base["phi1_deg"].index(r["phi1_deg"])
+        k = base["pairs"].index(r["pair"])
+        assert r["mu_fast"] == pytest.approx(base["mu"][k][j], rel=1e-12)
+        assert r["load_N"] == pytest.approx(max(row[j] for row in base["load_N"]), rel=1e-12)
+
+
+@pytest.mark.parametrize("flags, name", [(["--ehl-check", "0"], "--ehl-check"),
+                                         (["--ehl-check", "2", "--ehl-grid", "8"], "--ehl-grid")])
+def test_bad_ehl_check_options_refused(capsys, monkeypatch, flags, name):
+    _no_work(monkeypatch)
+    rc = main(["efficiency", *BASE, *flags])
+    err = capsys.readouterr().err
+    assert rc == 2 and name in err and len(err.strip().splitlines()) == 1, err

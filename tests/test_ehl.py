@@ -151,6 +151,18 @@ def test_elliptic_case_film_against_hamrock_dowson():
     assert abs(float(res.h_min) / hm - 1.0) <= 0.25
 
 
+def test_pseudo_transient_continuation_changes_the_path_not_the_root(base):
+    # the shift s (J + s I) of pseudo-transient continuation (used by the nested
+    # fine-grid solve) vanishes as the residual does: from the same Hertz start it must
+    # reach the root of plain Newton (same compiled program: ptc is traced)
+    res0, case, grid = base
+    res1 = ehl_traced(case, grid, ptc=1.0)
+    assert bool(res1.converged) and float(res1.residual) <= 1e-9
+    assert int(res1.steps) != int(res0.steps) or float(res1.residual) != float(res0.residual)
+    for f in ("h_c", "h_min", "mu"):
+        assert abs(float(getattr(res1, f)) / float(getattr(res0, f)) - 1.0) <= 1e-8, f
+
+
 def test_lower_speed_pressure_tends_to_hertz(base):
     # dry-contact limit: as u_e falls (Moes M 168 -> 416) the pressure approaches the
     # Hertz pressure (48² cannot resolve much larger M: the exit constriction would
@@ -196,6 +208,79 @@ def test_mixed_lubrication_load_split_and_greenwood_tripp():
     assert abs(float(res.mu_boundary) - 0.1 * float(res.F_asperity) / 100.0) <= 1e-12
 
 
+def test_efficiency_ehl_check_passes_the_fast_models_inputs_in_its_units():
+    # gearjax efficiency --ehl-check: the numerical solve of a contact must see the
+    # fast model's inputs in the EHL's units (α in 1/GPa, σ and β in µm): at λ ≈ 1.5 the
+    # two models agree on h_c to a few per cent and on μ to tens of per cent (docs/
+    # friction.md), while a unit slip (σ or α off by 1e3) changes them by far more.
+    # A line-contact-like ellipse (Ry/Rx = 100) is skipped with the reason.  48²: the
+    # mixed program of the test above is reused.
+    from types import SimpleNamespace
+    from gearjax.commands.ehl_check import ehl_check
+    from gearjax.tribology.friction import friction_coefficient, make_surface
+    from gearjax.tribology.lubricant import make_oil
+    oil = make_oil(0.088, alpha_per_GPa=22.0, tau0_MPa=5.0)
+    surf = make_surface(0.3)
+    F, ue, us = np.array([[100.0, 100.0]]), np.array([[1000.0, 1000.0]]), np.array([[200.0, 200.0]])
+    rx, ry = np.array([[10.0, 10.0]]), np.array([[10.0, 1000.0]])
+    fr = friction_coefficient(F, ue, us, rx, ry, oil, surf)
+    eff = SimpleNamespace(phi1=np.array([0.0, 0.1]), u_e=ue, u_s=us, r_x=rx, r_y=ry, friction=fr,
+                          loaded=SimpleNamespace(load=F, p_max=fr.p_max))
+    rows = ehl_check(eff, oil, surf, 226373.6, 2, N)
+    assert len(rows) == 2 and "Ry/Rx" in rows[1]["skipped"] and rows[0]["skipped"] is None
+    r = rows[0]
+    assert r["converged"] and r["residual"] <= 1e-9
+    assert r["mu_fast"] == float(fr.mu[0, 0]) and r["h_c_fast_um"] == float(fr.h_c[0, 0]) * 1e3
+    assert abs(r["h_c_ehl_um"] / r["h_c_fast_um"] - 1.0) < 0.08, r
+    assert abs(r["mu_ehl"] / r["mu_fast"] - 1.0) < 0.3, r
+    assert 0.0 < r["phi_ehl"] < 0.5
+
+
+def test_asperity_film_factor_loads_the_asperities_at_c_a_h_c():
+    # the fast model's documented correction (docs/friction.md): with
+    # asperity_film_factor c_a the load sharing must solve
+    #   φ = π a b K_GT E' F_5/2(c_a h_c/σ) / F,  h_c = film(F(1-φ), E'(1-φ))
+    # (Johnson–Greenwood–Poon with the asperities at c_a h_c), checked here by
+    # evaluating the right-hand side independently at the returned φ; c_a < 1 must
+    # raise φ and μ; dμ/dc_a (implicit load-sharing gradient) against central
+    # differences.
+    from gearjax.contact import hertz_exact
+    from gearjax.tribology.asperity import F_n, gt_coefficient
+    from gearjax.tribology.film import film_thickness_traced
+    from gearjax.tribology.friction import friction_coefficient, friction_traced, make_surface
+    from gearjax.tribology.lubricant import make_oil
+    oil = make_oil(0.088, alpha_per_GPa=22.0, tau0_MPa=5.0)
+    F, ue, us, Rx, Ry, E = 300.0, 2000.0, 400.0, 10.0, 50.0, 226373.6
+    sig = 0.35
+    out = {}
+    for ca in (1.0, 0.8):
+        surf = make_surface(sig, asperity_film_factor=ca)
+        fr = friction_coefficient(F, ue, us, Rx, Ry, oil, surf, E)
+        hz = hertz_exact(F, Rx, Ry, E)
+        phi = float(fr.phi)
+        g1 = 1.0 / (1.0 - phi)
+        hc = float(film_thickness_traced(F / g1, Rx, hz.k, hz.a, ue, oil.eta0, oil.alpha, E / g1,
+                                         "auto")[0])
+        assert abs(float(fr.h_c) / hc - 1.0) <= 1e-10      # λ and films stay the fluid's
+        rhs = float(np.pi * hz.a * hz.b * gt_coefficient(sig * 1e-3, 1e4, 10e-3) * E
+                    * F_n(ca * hc / (sig * 1e-3), 2.5) / F)
+        assert abs(phi / rhs - 1.0) <= 1e-9, (ca, phi, rhs)
+        out[ca] = fr
+    assert float(out[0.8].phi) > 1.5 * float(out[1.0].phi) > 0.0
+    assert float(out[0.8].mu) > float(out[1.0].mu)
+
+    s0 = make_surface(sig)
+
+    @jax.jit
+    def mu(ca):
+        return friction_traced(F, ue, us, Rx, Ry, oil,
+                               dataclasses.replace(s0, asperity_film_factor=ca), E).mu
+    ad = float(jax.jit(jax.grad(mu))(jnp.asarray(0.85)))
+    h = 1e-5
+    fd = (float(mu(jnp.asarray(0.85 + h))) - float(mu(jnp.asarray(0.85 - h)))) / (2 * h)
+    assert abs(ad - fd) <= 1e-6 * abs(fd), (ad, fd)
+
+
 def test_implicit_gradients_match_central_differences(base):
     res, case, grid = base
     grads = ehl_gradients(res, case, grid)
@@ -215,6 +300,37 @@ def test_implicit_gradients_match_central_differences(base):
             assert abs(ad - fd) <= 1e-5 * abs(fd) + 1e-8 * scale, (name, out, ad, fd)
 
 
+# ---------------------------------------------------------------- upwind schemes
+
+
+@pytest.mark.parametrize("beta, order", [(0.0, 1.0), (1.0, 2.0)])
+def test_couette_difference_has_the_order_of_its_scheme(beta, order):
+    # the Couette part of the Reynolds operator (ε = 0, P = 0, ρ̄ = 1) must be
+    # -(cos θ ∂H/∂X + k⁻¹ sin θ ∂H/∂Y) of a smooth film; its error must fall like
+    # ΔX for first-order upwind (β = 0) and like ΔX² with the second-order correction
+    # (β = 1).  A wrong correction coefficient or a wrong upstream index leaves
+    # first order (or no convergence).
+    from gearjax.tribology.ehl.model import Fields, Scales, reynolds_operator
+    k, th = 1.3, 30.0
+    sc = Scales(*(jnp.asarray(1.0),) * 2, jnp.asarray(k), *(jnp.asarray(1.0),) * 7)
+    errs = []
+    for n in (40, 80):
+        g = make_grid(n, th, upwind=beta)
+        X, Y = g.nodes()
+        H = np.sin(0.7 * X + 0.3) * np.cos(0.5 * Y) + 2.0
+        dHx = 0.7 * np.cos(0.7 * X + 0.3) * np.cos(0.5 * Y)
+        dHy = -0.5 * np.sin(0.7 * X + 0.3) * np.sin(0.5 * Y)
+        c, s = math.cos(math.radians(th)), math.sin(math.radians(th))
+        ref = -(c * dHx + s / k * dHy)
+        z = jnp.zeros_like(jnp.asarray(H))
+        fl = Fields(jnp.asarray(H), z, z + 1.0, z + 1.0, z)
+        L = np.asarray(reynolds_operator(z, fl, sc, g, th))
+        inner = (np.abs(X) <= 1.5) & (np.abs(Y) <= 1.5)      # away from the edges
+        errs.append(np.max(np.abs(L - ref)[inner]))
+    observed = math.log2(errs[0] / errs[1])
+    assert abs(observed - order) < 0.25, (errs, observed)
+
+
 # ---------------------------------------------------------------- input checking
 
 
@@ -229,7 +345,7 @@ def test_non_converged_solve_raises_or_is_flagged():
     (dict(F=-1.0), "F"), (dict(u_e=0.0), "u_e"), (dict(Ry=1e4), "Ry/Rx"),
     (dict(eta0=1e-6), "eta0"), (dict(n=8), "n"), (dict(n=40.5), "n"),
     (dict(angle_deg=270.0), "angle_deg"), (dict(F=1e7), "p_max"),
-    (dict(mixed=True), "sigma_um"),
+    (dict(mixed=True), "sigma_um"), (dict(upwind=1.5), "upwind"),
 ])
 def test_bad_inputs_raise_value_error_naming_the_parameter(kw, word):
     args = dict(BASE)

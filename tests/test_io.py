@@ -27,7 +27,7 @@ def test_examples_listed_and_valid():
     names = io.list_examples()
     assert "hft_8x43" in names
     for n in names:
-        assert load_design(f"example:{n}").name == n
+        assert io.load_design(f"example:{n}").name == n     # any family, by [design] kind
 
 
 def test_round_trip_lossless(tmp_path, design):
@@ -38,7 +38,8 @@ def test_round_trip_lossless(tmp_path, design):
     assert dumps_toml(back.data) == p.read_text()
 
 
-@pytest.mark.parametrize("name", io.list_examples())
+@pytest.mark.parametrize("name", [n for n in io.list_examples() if io.read_toml(
+    f"example:{n}")["design"]["kind"] in ("hypoid", "spiral_bevel")])
 def test_round_trip_every_example(tmp_path, name):
     """Every packaged design survives save -> load unchanged (dials, inline tables,
     optional keys), and the flank settings rebuilt from the copy are identical."""

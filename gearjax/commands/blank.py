@@ -26,7 +26,8 @@ def register(sub):
 def run(args) -> int:
     from gearjax import blank_geometry, load_design
     from gearjax.progress import Progress
-    design = load_design(args.design)
+    from gearjax import HYPOID_KINDS
+    design = load_design(args.design, kinds=HYPOID_KINDS)
     with Progress(1, "blank") as bar, bar.phase("blank solve"):
         data = blank_geometry(design.blank_input())
     if args.json:

@@ -24,6 +24,8 @@ import warnings
 import numpy as np
 
 from gearjax.commands.designs import involute_design, is_involute, parse_misalign
+from gearjax.commands.ehl_check import (EHL_CHECK_KEYS_DOC, add_ehl_check_options,
+                                        check_ehl_options, ehl_check, print_ehl_check)
 from gearjax.commands.friction import PLOT_SUFFIXES, add_lubricant_options, lubricant_from_args
 
 EFFICIENCY_KEYS_DOC = """JSON keys (K tooth pairs, M positions over one mesh cycle = one pinion pitch):
@@ -61,7 +63,8 @@ EFFICIENCY_KEYS_DOC = """JSON keys (K tooth pairs, M positions over one mesh cyc
   truncated             the TCA grid or the number of pairs misses a pair in contact
   quality               contact-quality flags of the unloaded TCA (as gearjax tca)
   warnings              the warning lines (also on stderr)
-  plot                  the figure's path or null"""
+  plot                  the figure's path or null
+""" + EHL_CHECK_KEYS_DOC
 
 #: positions per mesh cycle and the grid/pair options (ranges of the TCA options)
 POSITIONS_RANGE = (4, 400)
@@ -109,6 +112,7 @@ def register(sub):
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.add_argument("--plot", default=None,
                    help="write load share, mu and P_f along the mesh (.png, .pdf or .svg)")
+    add_ehl_check_options(p)
     p.set_defaults(func=run)
 
 
@@ -250,6 +254,7 @@ def run(args) -> int:
     gj.check_operating_point(T, n)
     mis_kv, mis = parse_misalign(args.misalign)
     opts = _grid_options(args)
+    ehl_opts = check_ehl_options(args)
     if args.plot is not None:
         check_output_path(args.plot, "--plot", PLOT_SUFFIXES)
     with warnings.catch_warnings(record=True) as caught:
@@ -287,6 +292,14 @@ def run(args) -> int:
            "compliance": args.compliance, "positions": int(opts_all["steps_per_pitch"]),
            "pitches": float(opts_all["half_pitches"]), "pairs": int(opts_all["n_pairs"])}
     out = _output(eff, res, inp, warn_lines, args.plot)
+    out["ehl_check"] = None
+    if ehl_opts is not None:
+        out["ehl_check"] = ehl_check(eff, oil, surf, Ep, *ehl_opts)
+        for r in out["ehl_check"]:
+            if not r["skipped"] and not r["converged"]:
+                sys.stderr.write(f"gearjax: warning: --ehl-check: the numerical EHL solve at "
+                                 f"phi1 = {r['phi1_deg']:.4f} deg did not converge (residual "
+                                 f"{r['residual']:.2g})\n")
     status = 0
     if not any(out["valid"]) or not math.isfinite(out["mean_efficiency"]):
         sys.stderr.write(f"gearjax: error: {args.side} side: no position of the mesh cycle gives "
@@ -300,4 +313,6 @@ def run(args) -> int:
     warn_nonfinite(k for k in ("mean_efficiency", "mean_mu", "max_p_max_MPa", "power_in_W")
                    if not math.isfinite(out[k]))
     _print_table(out, args)
+    if out["ehl_check"] is not None:
+        print_ehl_check(out["ehl_check"])
     return status

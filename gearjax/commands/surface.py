@@ -36,7 +36,7 @@ def register(sub):
 
 
 def run(args) -> int:
-    from gearjax import flank_surface, load_design
+    from gearjax import HypoidDesign, flank_surface, load_design
     from gearjax.io import check_output_path, write_flank, write_stl_tooth
     from gearjax.progress import Progress
     n_xi, n_s = _grid(args.grid)
@@ -48,15 +48,21 @@ def run(args) -> int:
         if plot.resolve() == out.resolve():
             raise ValueError(f"--plot = {args.plot!r} is the same file as --out")
     design = load_design(args.design)
+    hypoid = isinstance(design, HypoidDesign)
+    if args.plot is not None and not hypoid:
+        raise ValueError(f"--plot: the axial-plane figure is drawn for hypoid and spiral-bevel "
+                         f"designs only, not for [design] kind = {design.data['design']['kind']!r}")
     flanks = ["convex", "concave"] if args.tooth else [args.flank]
     grids = {}
     with Progress(len(flanks), f"surface {args.member}") as bar:
         for f in flanks:
             with bar.phase(f"{f}: {n_xi}x{n_s} points"):
-                grids[f] = flank_surface(design.flank(args.member, f), n_xi, n_s)
+                grids[f] = (flank_surface(design.flank(args.member, f), n_xi, n_s) if hypoid
+                            else design.surface_grid(args.member, f, n_xi, n_s))
             bar.update()
     if args.tooth:
-        teeth = design.member_blank(args.member).teeth
+        teeth = (design.member_blank(args.member).teeth if hypoid
+                 else int(design.teeth(args.member)))
         write_stl_tooth(out, grids["convex"], grids["concave"], teeth,
                         name=f"{design.name}_{args.member}_tooth")
     else:

@@ -101,6 +101,17 @@ def _hypoid_side(design, mis, m, side_name, half, kin):
     return res, gj.pinion_outline(prep.pair)
 
 
+def _family_side(design, mis, m, side_name, half, kin):
+    """Any other registered family's design file: its adapter picks the flanks of the
+    side; the pinion flank outline for the plot comes from the adapter's ``outline``
+    method when it has one."""
+    import gearjax as gj
+    res = gj.run_tca(design, mis, side=side_name, steps_per_pitch=m, half_pitches=half,
+                     n_pairs=3, kinematics=kin)
+    outline = getattr(gj.family_of(design), "outline", None)
+    return res, (outline(design, side_name) if outline is not None else None)
+
+
 def _side_json(res):
     from gearjax import ARCSEC
     path, margin, multi = res.path, res.margin, res.multi
@@ -196,9 +207,10 @@ def run(args) -> int:
         involute_design(args.design)               # validate before any tracing
         solve = lambda side: _involute_side(args, mis, m, side, half, args.kinematics)
     else:
-        from gearjax import load_design
+        from gearjax import HypoidDesign, load_design
         design = load_design(args.design)
-        solve = lambda side: _hypoid_side(design, mis, m, side, half, args.kinematics)
+        side_of = _hypoid_side if isinstance(design, HypoidDesign) else _family_side
+        solve = lambda side: side_of(design, mis, m, side, half, args.kinematics)
     results, failed = {}, {}
     what = "contact solve" + (" + kinematics" if args.kinematics else "")
     with Progress(len(sides), "tca") as bar:    # stderr, terminals only

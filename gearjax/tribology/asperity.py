@@ -185,6 +185,7 @@ class _Contact(NamedTuple):
     sigma: jax.Array
     density: jax.Array
     beta: jax.Array
+    c_a: jax.Array
 
 
 def _log_cap(th):
@@ -203,7 +204,7 @@ def _film(log_gamma1, th, film_method):
 def _ls_residual(s, th, film_method):
     """R(s) = ln φ - ln(π a b K_GT E'/F_n) - ln F_5/2(h_c(F_n/γ1, E'/γ1)/σ), φ = sigmoid(s)."""
     hc = _film(jax.nn.softplus(s), th, film_method)[0]
-    return -jax.nn.softplus(-s) - _log_cap(th) - _gt_integrals(hc / th.sigma)[0]
+    return -jax.nn.softplus(-s) - _log_cap(th) - _gt_integrals(th.c_a * hc / th.sigma)[0]
 
 
 def _ls_iterate(th, film_method):
@@ -225,8 +226,9 @@ def _ls_iterate(th, film_method):
     log elsewhere: a start only).  Halley's step is bounded by ``|Δs| ≤ 2/(c σ(s))``
     upward and its denominator by 1/2.
     """
-    lam0 = _film(jnp.zeros_like(th.F), th, film_method)[0] / th.sigma
-    c = jnp.log(_film(jnp.ones_like(th.F), th, film_method)[0] / th.sigma / lam0)
+    h0 = _film(jnp.zeros_like(th.F), th, film_method)[0]
+    lam0 = th.c_a * h0 / th.sigma          # the λ of the asperity pressure (c_a: see below)
+    c = jnp.log(_film(jnp.ones_like(th.F), th, film_method)[0] / h0)
     L = _log_cap(th)
     s_ff = L + _gt_integrals(lam0, coarse=True)[0]
     y = -L
@@ -255,7 +257,7 @@ def _ls_iterate(th, film_method):
 
 
 def load_sharing_traced(F, Rx, k, a, b, u_e, eta0, alpha, E_prime, sigma, density, beta,
-                        film_method="auto"):
+                        film_method="auto", asperity_film_factor=1.0):
     """Solve the Johnson–Greenwood–Poon load sharing (elementwise over broadcast arrays).
 
     F N; Rx, a, b (Hertz semi-axes), σ, β mm; k = a/b; u_e mm/s; η0 Pa·s; α 1/MPa;
@@ -266,9 +268,18 @@ def load_sharing_traced(F, Rx, k, a, b, u_e, eta0, alpha, E_prime, sigma, densit
     for every point); the residual is then recomputed with the film formula itself
     and ``converged`` is ``|R| ≤ 1e-11`` (and finite).  ds/dθ by the implicit function
     theorem (:func:`gearjax.newton.implicit_root`).
+
+    ``asperity_film_factor`` c_a (default 1: the model above): the asperities are
+    loaded as if the separation were ``c_a h_c`` instead of the central film h_c,
+    ``F_a = π a b p_a(c_a h_c/σ)``.  An optional correction towards the numerical
+    mixed-EHL reference, where the asperities touch mostly in the exit constriction
+    and the side lobes (h < h_c); the fitted value and its range are in
+    docs/friction.md (:data:`gearjax.tribology.friction.EHL_ASPERITY_FILM_FACTOR`).
+    The reported λ and films are those of the fluid (c_a does not scale them).
     """
     th = _Contact(*jnp.broadcast_arrays(*(jnp.asarray(v, float) for v in (
-        F, Rx, k, a, b, u_e, eta0, alpha, E_prime, sigma, density, beta))))
+        F, Rx, k, a, b, u_e, eta0, alpha, E_prime, sigma, density, beta,
+        asperity_film_factor))))
     s = implicit_root(partial(_ls_iterate, film_method=film_method),
                       partial(_ls_residual, film_method=film_method), th)
     phi = jax.nn.sigmoid(s)
@@ -281,7 +292,7 @@ def load_sharing_traced(F, Rx, k, a, b, u_e, eta0, alpha, E_prime, sigma, densit
     hc = hc0 * jnp.exp(jnp.log(hc1 / hc0) * lg1)
     hm = hm0 * jnp.exp(jnp.log(hm1 / hm0) * lg1)
     lam = hc / th.sigma
-    log_f52, _, _, q2 = _gt_integrals(lam)
+    log_f52, _, _, q2 = _gt_integrals(th.c_a * lam)
     res = -jax.nn.softplus(-s) - _log_cap(th) - log_f52
     conv = jnp.isfinite(s) & (jnp.abs(res) <= _LS_TOL)
     # A_r/A = π² (η_s β σ)² F_2(λ), F_2 = F_5/2 I_2/I_5/2 (same exponentials)

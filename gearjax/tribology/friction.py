@@ -58,12 +58,18 @@ from gearjax.tribology.lubricant import (LN_ETA_CAP, LN_ETA_INF, P_ROELANDS_MPA,
 
 __all__ = ["Surface", "make_surface", "FrictionResult", "friction_point_traced",
            "friction_traced", "friction_coefficient", "REGIMES", "STEEL_E_PRIME",
-           "validate_contact_inputs"]
+           "validate_contact_inputs", "EHL_ASPERITY_FILM_FACTOR"]
 
 REGIMES = ("boundary", "mixed", "full film")
 STEEL_E_PRIME = 2.0 / (2.0 * (1.0 - 0.3 ** 2) / 206000.0)   # 226 374 MPa, steel on steel
 SIGMA_MAX_UM = 10.0          # highest accepted composite roughness, µm
 SPEED_MAX_MM_S = 5.0e5       # highest accepted entrainment / sliding speed, mm/s (500 m/s)
+
+#: asperity film factor c_a fitted to the numerical mixed-EHL reference (gearjax.tribology.ehl,
+#: 64² grid): least squares of ln φ over the 17 mixed points (0.01 ≤ φ ≤ 0.9) of the regime
+#: grid λ_s 0.3–5, p_max 0.5–2.5 GPa, Ry/Rx 1–20, u_e 2 m/s, default surface; rms error of
+#: ln φ 0.42 -> 0.18 (experiments/ehl_fast_check.py, docs/friction.md).  Not the default.
+EHL_ASPERITY_FILM_FACTOR = 0.86
 
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(48)
 _S = 0.5 * (_GL_X + 1.0)      # the former fixed 48-node rule on [0, 1] (benchmarks, tests)
@@ -80,6 +86,10 @@ class Surface:
     beta : mean asperity tip radius β, mm.
     f_c : boundary friction coefficient at asperity contacts (-).
     v_slip : regularisation speed of the boundary friction, mm/s.
+    asperity_film_factor : c_a, the asperities are loaded at the separation c_a h_c
+        (default 1: the plain load sharing of [JohnsonGreenwoodPoon1972]; an
+        optional correction towards the numerical EHL reference, see
+        :func:`gearjax.tribology.asperity.load_sharing_traced` and docs/friction.md).
     """
 
     sigma: jax.Array
@@ -87,14 +97,22 @@ class Surface:
     beta: jax.Array
     f_c: jax.Array
     v_slip: jax.Array
+    asperity_film_factor: jax.Array = 1.0
 
 
-jax.tree_util.register_dataclass(Surface, data_fields=["sigma", "density", "beta", "f_c", "v_slip"],
+jax.tree_util.register_dataclass(Surface, data_fields=["sigma", "density", "beta", "f_c", "v_slip",
+                                                       "asperity_film_factor"],
                                  meta_fields=[])
 
 
-def make_surface(sigma_um, density_per_mm2=1.0e4, beta_um=10.0, f_c=0.1, v_slip_mm_s=1.0) -> Surface:
+def make_surface(sigma_um, density_per_mm2=1.0e4, beta_um=10.0, f_c=0.1, v_slip_mm_s=1.0,
+                 asperity_film_factor=1.0) -> Surface:
     """Validated :class:`Surface` from σ (µm), η_s (1/mm²), β (µm), f_c, v_slip (mm/s).
+
+    ``asperity_film_factor`` c_a in [0.5, 1] (default 1, no correction): the
+    asperities carry the Greenwood–Tripp pressure of the separation c_a h_c;
+    ``EHL_ASPERITY_FILM_FACTOR`` is the value fitted to the numerical mixed-EHL
+    reference over the range stated in docs/friction.md.
 
     Defaults (η_s = 1e4 mm⁻² = 1e10 m⁻², β = 10 µm, f_c = 0.1) are representative of
     ground steel gear flanks (η_s β σ ≈ 0.03–0.05 for σ ≈ 0.3–0.5 µm, the range
@@ -109,13 +127,14 @@ def make_surface(sigma_um, density_per_mm2=1.0e4, beta_um=10.0, f_c=0.1, v_slip_
     check_range("asperity radius", beta_um, 0.0, 1000.0, lo_open=True, unit="um")
     check_range("f_c", f_c, 0.0, 1.0)
     check_range("v_slip", v_slip_mm_s, 0.0, 1000.0, lo_open=True, unit="mm/s")
+    check_range("asperity_film_factor", asperity_film_factor, 0.5, 1.0)
     ebs = float(density_per_mm2) * float(beta_um) * float(sigma_um) * 1e-6
     if not (0.005 <= ebs <= 0.2):
         warnings.warn(f"Greenwood-Tripp asperity model: eta_s*beta*sigma = {ebs:g} is outside "
                       "the range 0.005..0.2 typical of engineering surfaces", stacklevel=2)
     return Surface(*(float64_array(float(v)) for v in
                      (float(sigma_um) * 1e-3, density_per_mm2, float(beta_um) * 1e-3, f_c,
-                      v_slip_mm_s)))
+                      v_slip_mm_s, asperity_film_factor)))
 
 
 class FrictionResult(NamedTuple):
@@ -238,7 +257,8 @@ def friction_point_traced(F, u_e, u_s, Rx, Ry, oil: Oil, surface: Surface, E_pri
         *(jnp.asarray(v, float) for v in (F, u_e, u_s, Rx, Ry, E_prime)))
     hz = hertz_exact(F, Rx, Ry, E_prime)
     ls = load_sharing_traced(F, Rx, hz.k, hz.a, hz.b, u_e, oil.eta0, oil.alpha, E_prime,
-                             surface.sigma, surface.density, surface.beta, film_method)
+                             surface.sigma, surface.density, surface.beta, film_method,
+                             surface.asperity_film_factor)
     p_f = (1.0 - ls.phi) * hz.p_max
     X0 = oil.eta0 * PA_S_TO_MPA_S * u_s / (ls.h_c * oil.tau0)
     F_tau = 2.0 * jnp.pi * hz.a * hz.b * oil.tau0 * shear_integral(p_f, X0, oil, viscosity_model)

@@ -67,7 +67,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from gearjax.io import atomic_write, check_integer, check_keys as _check_keys, check_number
-from gearjax.io import check_string, dumps_toml, read_toml
+from gearjax.io import check_string, dumps_toml, read_toml, register_design_kind
 from gearjax.io import require_key as _req
 
 __all__ = ["HypoidDesign", "load_design", "save_design", "design_from_dict", "defaults_applied",
@@ -442,3 +442,7 @@ def load_design(source) -> HypoidDesign:
 def save_design(design: HypoidDesign, path) -> Path:
     """Write a design file (atomically); ``load_design`` reads back an equal design."""
     return atomic_write(path, dumps_toml(design.data))
+
+
+for _kind in KINDS:     # gearjax.io.load_design dispatches on [design] kind
+    register_design_kind(_kind, design_from_dict)

@@ -19,8 +19,10 @@ validated entry point only) tries the schedules of ``AUTO_SCHEDULES`` in turn �
 the direct solve from the Hertz start first, then factors < 1 (a heavier start,
 for light loads), then factors > 1 — until one converges, and as a last resort
 nested iteration: the solution on the grid with n/2 nodes (itself "auto"),
-interpolated, as start.  Above ``NESTED_ABOVE`` = 128 nodes nested iteration is
-tried first (a failed direct solve on a fine grid is expensive).  Only the final solve counts for the convergence flag.
+interpolated, as start, solved with pseudo-transient continuation.  Above
+``NESTED_ABOVE`` = 128 nodes nested iteration is tried first (a failed direct solve
+on a fine grid is expensive); it recurses, so 512² starts from 256², which starts
+from 128².  Only the final solve counts for the convergence flag.
 """
 
 from __future__ import annotations
@@ -38,7 +40,7 @@ from gearjax.fields import strong_float64
 from gearjax.tribology.ehl.grid import EHLGrid, make_grid
 from gearjax.tribology.ehl.implicit import attach_implicit_gradient
 from gearjax.tribology.ehl.model import EHLCase, fields, make_case, scales, unpack
-from gearjax.tribology.ehl.outputs import outputs
+from gearjax.tribology.ehl.outputs import EHLOutputs, outputs
 from gearjax.tribology.ehl.solver import newton_krylov, solve_state
 from gearjax.tribology.lubricant import PA_S_TO_MPA_S
 
@@ -46,31 +48,24 @@ __all__ = ["EHLResult", "solve_ehl", "ehl_traced", "ehl_gradients", "ehl_fields"
            "moes_parameters", "AUTO_SCHEDULES"]
 
 
-class EHLResult(NamedTuple):
-    """Outcome of one EHL solve.
+_RESULT_DOC = """Outcome of one EHL solve: the scalar outputs of
+:class:`gearjax.tribology.ehl.outputs.EHLOutputs` followed by the solver's state.
 
-    h_c, h_min : central film (bilinear at the contact centre) and minimum nodal film, mm.
-    mu, mu_fluid, mu_boundary : friction coefficient and its Ree–Eyring / asperity parts.
-    F_fluid, F_asperity : loads carried by the fluid and by the asperities, N.
-    residual : max|R| of the discrete equations (Fischer–Burmeister residual in
-        units of p_h; relative load error).
-    load_error : |∫∫(p + p_a) dA / F - 1|.
-    steps : Newton steps of the last stage.  converged : residual ≤ tol, finite.
-    x : the state vector [P, (P_a), H0] (dimensionless; see ehl_fields).
-    """
+h_c, h_min : central film (bilinear at the contact centre) and minimum nodal film, mm.
+mu, mu_fluid, mu_boundary : friction coefficient and its Ree–Eyring / asperity parts.
+F_fluid, F_asperity : loads carried by the fluid and by the asperities, N.
+residual : max|R| of the discrete equations (Fischer–Burmeister residual in
+    units of p_h; relative load error).
+load_error : |∫∫(p + p_a) dA / F - 1|.
+steps : Newton steps of the last stage.  converged : residual ≤ tol, finite.
+x : the state vector [P, (P_a), H0] (dimensionless; see ehl_fields).
+"""
 
-    h_c: jax.Array
-    h_min: jax.Array
-    mu: jax.Array
-    mu_fluid: jax.Array
-    mu_boundary: jax.Array
-    F_fluid: jax.Array
-    F_asperity: jax.Array
-    residual: jax.Array
-    load_error: jax.Array
-    steps: jax.Array
-    converged: jax.Array
-    x: jax.Array
+# the output fields are declared once, in EHLOutputs; the result appends the state
+EHLResult = NamedTuple("EHLResult", [(f, jax.Array) for f in EHLOutputs._fields]
+                       + [(f, jax.Array) for f in ("residual", "load_error", "steps",
+                                                   "converged", "x")])
+EHLResult.__doc__ = _RESULT_DOC
 
 
 def moes_parameters(case: EHLCase):
@@ -93,18 +88,20 @@ _outputs_jit = jax.jit(outputs, static_argnames=("grid", "mixed"))
 
 
 def ehl_traced(case: EHLCase, grid: EHLGrid, angle_deg: float = 0.0, mixed: bool = False,
-               continuation=(), tol=1e-9, max_steps: int = 60, x0=None) -> EHLResult:
+               continuation=(), tol=1e-9, max_steps: int = 60, x0=None, ptc=0.0) -> EHLResult:
     """Solve the EHL problem of ``case`` on ``grid`` (no validation; differentiable).
 
     The Newton iterations see ``stop_gradient(case)``; derivatives of the outputs
     w.r.t. ``case`` flow only through the implicit-function rule (reverse mode).
     ``continuation`` : tuple of λ multipliers (static), see the module docstring.
     ``x0`` : optional start state (default: Hertz pressure, Hamrock–Dowson H0).
+    ``ptc`` : initial pseudo-transient shift (0: plain damped Newton; see
+    :func:`gearjax.tribology.ehl.solver.newton_krylov`).
     """
     case = strong_float64(case)          # one compiled solve for every case
     cs = jax.lax.stop_gradient(case)
     st = solve_state(cs, grid, angle_deg, mixed, tol=tol, max_steps=max_steps,
-                     continuation=tuple(continuation), x0=x0)
+                     continuation=tuple(continuation), x0=x0, ptc=ptc)
     x_star = jax.lax.stop_gradient(st.x)
     out = _attached_outputs(x_star, case, grid, float(angle_deg), bool(mixed))
     return EHLResult(*out, st.residual, st.load_error, st.steps, st.converged, x_star)
@@ -124,7 +121,7 @@ def _check_grid_inputs(n, angle_deg):
 def solve_ehl(F, u_e, u_s, Rx, Ry, eta0, alpha_per_GPa, E_prime=226373.6, tau0_MPa=5.0,
               sigma_um=0.0, density_per_mm2=1.0e4, beta_um=10.0, f_c=0.1, v_slip_mm_s=1.0,
               *, n=128, angle_deg=0.0, mixed=None, continuation="auto", tol=1e-9,
-              max_steps=60, strict=True) -> tuple[EHLResult, EHLCase, EHLGrid]:
+              max_steps=60, strict=True, upwind=0.0) -> tuple[EHLResult, EHLCase, EHLGrid]:
     """Numerical EHL point contact (validated entry point).
 
     F N, u_e (mean rolling speed, along the direction ``angle_deg`` from the
@@ -132,7 +129,10 @@ def solve_ehl(F, u_e, u_s, Rx, Ry, eta0, alpha_per_GPa, E_prime=226373.6, tau0_M
     α 1/GPa, E' MPa, τ0 MPa, σ and β µm, asperity density 1/mm², boundary friction
     f_c, v_slip mm/s.  ``n`` nodes per direction (n × n grid, domain of
     :func:`gearjax.tribology.ehl.grid.default_domain`).  ``mixed`` (default: σ > 0)
-    switches on the Greenwood–Tripp asperity pressure.
+    switches on the Greenwood–Tripp asperity pressure.  ``upwind`` : weight β of the
+    second-order upwind correction of the Couette fluxes (0 first order, the default
+    and the scheme of the validation tables; 1 second-order upwind; see
+    :class:`gearjax.tribology.ehl.grid.EHLGrid`).
 
     Returns ``(result, case, grid)``.  With ``strict=True`` (default) a solve that
     did not converge raises :class:`gearjax.errors.ConvergenceError`; with
@@ -148,13 +148,16 @@ def solve_ehl(F, u_e, u_s, Rx, Ry, eta0, alpha_per_GPa, E_prime=226373.6, tau0_M
         mixed = float(sigma_um) > 0.0
     if mixed and float(sigma_um) <= 0.0:
         raise ValueError(f"mixed = True needs sigma_um > 0, got sigma_um = {sigma_um!r}")
-    grid = make_grid(int(n), float(angle_deg))
+    grid = make_grid(int(n), float(angle_deg), upwind=upwind)
     auto = isinstance(continuation, str) and continuation == "auto"
     schedules = AUTO_SCHEDULES if auto else (tuple(continuation),)
     res = None
     if auto and int(n) > NESTED_ABOVE:
         res = _nested(locals(), grid)
-    if res is None or not bool(res.converged):
+    # on a fine grid the direct schedules are not tried after a nested solve whose
+    # coarse grid converged: they failed in every case tried (256²: 18 min) and cost
+    # up to 60 Newton steps each; the nested result is returned with its residual
+    if res is None or (not bool(res.converged) and int(n) <= NESTED_ABOVE):
         for sched in schedules:
             res = ehl_traced(case, grid, float(angle_deg), bool(mixed), sched, tol,
                              int(max_steps))
@@ -171,22 +174,26 @@ def solve_ehl(F, u_e, u_s, Rx, Ry, eta0, alpha_per_GPa, E_prime=226373.6, tau0_M
 
 
 NESTED_ABOVE = 128
+NESTED_PTC = 1.0
 
 
 def _nested(a, grid):
-    """Nested iteration: auto-solve on n/2 nodes, interpolate, solve on ``grid``."""
+    """Nested iteration: auto-solve on n/2 nodes, interpolate (bilinear, P, P_a and H0),
+    solve on ``grid`` by Newton–Krylov with pseudo-transient continuation (initial
+    shift ``NESTED_PTC``): plain Newton from the interpolated state stalls on 256²
+    (the sharper exit spike of the fine grid), the damped iteration does not."""
     coarse, _, cgrid = solve_ehl(a["F"], a["u_e"], a["u_s"], a["Rx"], a["Ry"], a["eta0"],
                                  a["alpha_per_GPa"], a["E_prime"], a["tau0_MPa"],
                                  a["sigma_um"], a["density_per_mm2"], a["beta_um"], a["f_c"],
                                  a["v_slip_mm_s"], n=int(a["n"]) // 2,
                                  angle_deg=a["angle_deg"], mixed=a["mixed"],
                                  continuation="auto", tol=a["tol"], max_steps=a["max_steps"],
-                                 strict=False)
+                                 strict=False, upwind=a["upwind"])
     if not bool(coarse.converged):
         return None
     x0 = _prolong(coarse.x, cgrid, grid, bool(a["mixed"]))
     return ehl_traced(a["case"], grid, float(a["angle_deg"]), bool(a["mixed"]), (), a["tol"],
-                      int(a["max_steps"]), x0=x0)
+                      int(a["max_steps"]), x0=x0, ptc=NESTED_PTC)
 
 
 def _prolong(x, cgrid: EHLGrid, grid: EHLGrid, mixed: bool):

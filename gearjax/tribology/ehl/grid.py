@@ -39,6 +39,9 @@ class EHLGrid:
     nx, ny : nodes along X (rolling axis) and Y (transverse axis).
     x_lo, x_hi, y_lo, y_hi : domain edges in units of b (X) and a (Y); nodes sit at
         cell centres, the pressure is zero on the edges.
+    upwind : weight β of the second-order correction of the upwind Couette fluxes
+        (:func:`gearjax.tribology.ehl.model.reynolds_operator`): 0 first-order upwind
+        (default), 1 second-order upwind, in between a blend.
     """
 
     nx: int
@@ -47,6 +50,7 @@ class EHLGrid:
     x_hi: float
     y_lo: float
     y_hi: float
+    upwind: float = 0.0
 
     @property
     def dx(self) -> float:
@@ -77,8 +81,10 @@ def default_domain(angle_deg: float):
             -(by + 3.0 * max(s, 0.0)), by + 3.0 * max(-s, 0.0))
 
 
-def make_grid(n: int, angle_deg: float = 0.0, ny: int | None = None, domain=None) -> EHLGrid:
-    """Grid with ``n`` nodes along X (``ny`` along Y, default ``n``), ``default_domain``."""
+def make_grid(n: int, angle_deg: float = 0.0, ny: int | None = None, domain=None,
+              upwind: float = 0.0) -> EHLGrid:
+    """Grid with ``n`` nodes along X (``ny`` along Y, default ``n``), ``default_domain``;
+    ``upwind`` the second-order upwind weight β in [0, 1] (see :class:`EHLGrid`)."""
     for name, v in (("n", n), ("ny", n if ny is None else ny)):
         if not (isinstance(v, (int, np.integer)) and 8 <= v <= 4096):
             raise ValueError(f"grid {name} = {v!r} is outside the allowed range [8, 4096] "
@@ -87,7 +93,10 @@ def make_grid(n: int, angle_deg: float = 0.0, ny: int | None = None, domain=None
     if not (dom[0] < -1.0 and dom[1] > 1.0 and dom[2] < -1.0 and dom[3] > 1.0):
         raise ValueError(f"domain = {dom} must contain the Hertz ellipse: x_lo < -1 < 1 < x_hi "
                          "and y_lo < -1 < 1 < y_hi")
-    return EHLGrid(int(n), int(n if ny is None else ny), *dom)
+    if not (isinstance(upwind, (int, float, np.integer, np.floating)) and 0.0 <= upwind <= 1.0):
+        raise ValueError(f"upwind = {upwind!r} is outside the allowed range [0, 1] (0: first-"
+                         "order upwind, 1: second-order upwind)")
+    return EHLGrid(int(n), int(n if ny is None else ny), *dom, float(upwind))
 
 
 def _f(u, v):

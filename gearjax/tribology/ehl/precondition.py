@@ -37,11 +37,15 @@ def _shift(A, d):
     return A[..., idx]
 
 
-def _line_blocks(P, L, w, fl, dP_rho, dG, K0, K1, cw, d_a, s_a, c_a, d_c, s_c, c_c, mixed):
+def _line_blocks(P, L, w, fl, dP_rho, dG, K0, K1, cw, d_a, s_a, c_a, d_c, s_c, c_c, mixed,
+                 beta=0.0):
     """Blocks (n_lines, m, m) or (n_lines, 2m, 2m); arrays laid out (lines, along)."""
     nl, m = P.shape
     L = w * L
-    r = jnp.sqrt(P * P + L * L) + 1e-300
+    # the same regularisation as the residual (model.residual_core): with the 1e-300
+    # outside the root, P, L ~ 1e-170 (cavitated nodes after a few Newton steps)
+    # underflow P², L² and give P/r ~ 1e130, an overflowing block (seen on 256²)
+    r = jnp.sqrt(P * P + L * L + 1e-300)
     A = 1.0 - P / r
     B = (-1.0 - L / r) * w
     eps = fl.eps
@@ -66,11 +70,17 @@ def _line_blocks(P, L, w, fl, dP_rho, dG, K0, K1, cw, d_a, s_a, c_a, d_c, s_c, c
     idx = np.arange(m)
     prev = np.clip(idx - 1, 0, m - 1)
     nxt = np.clip(idx + 1, 0, m - 1)
+    prev2 = np.clip(idx - 2, 0, m - 1)
+    nxt2 = np.clip(idx + 2, 0, m - 1)
+    h = 0.5 * beta
     nb_prev = cw * rhop[:-2][..., None] * K1[None]
     nb_next = cw * rhop[2:][..., None] * K1[None]
 
     def dcou(Q):
-        along = cap * (Q - Q[:, prev, :]) + cam * (Q[:, nxt, :] - Q)
+        # in-line upwind difference with the second-order correction (weight β);
+        # the cross-line term stays first order (an approximation is enough here)
+        along = cap * ((1.0 + h) * Q - (1.0 + beta) * Q[:, prev, :] + h * Q[:, prev2, :]) \
+            + cam * ((1.0 + beta) * Q[:, nxt, :] - h * Q[:, nxt2, :] - (1.0 + h) * Q)
         cross = ccp * (Q - nb_prev) + ccm * (nb_next - Q)
         return s_a / d_a * along + s_c / d_c * cross
 
@@ -104,7 +114,8 @@ def build_preconditioner(P, L, w, fl, dP_rho, dG, kernel, sc, grid, angle_deg, m
         par = (grid.dy, 1.0 / sc.k, s, grid.dx, 1.0, c)
         tr = lambda A: A.T
     fl_t = type(fl)(*(tr(f) for f in fl))
-    blocks = _line_blocks(tr(P), tr(L), tr(w), fl_t, tr(dP_rho), tr(dG), K0, K1, sc.c_w, *par, mixed)
+    blocks = _line_blocks(tr(P), tr(L), tr(w), fl_t, tr(dP_rho), tr(dG), K0, K1, sc.c_w, *par, mixed,
+                          grid.upwind)
     lu = jax.vmap(jsl.lu_factor)(blocks)
     nl = blocks.shape[0]
     n = nx * ny

@@ -20,7 +20,10 @@ Caveat: the coefficients above were transcribed from secondary sources and could
 not be checked against the 1994 paper here; the limits are consistent (the
 rigid–isoviscous asymptote reproduces Hamrock's rigid-isoviscous point-contact
 film, 41 M⁻² against 35 M⁻² for h_min, D = 1), but treat agreement to better than
-~15 % as unverified.  Hamrock–Dowson is in :mod:`gearjax.tribology.film`.
+~15 % as unverified.  It lies 5–17 % above both the numerical solver and
+Hamrock–Dowson over M = 20–1000, L = 5–20; it is kept for reference but not used
+as validation evidence (docs/ehl.md).  Hamrock–Dowson is in
+:mod:`gearjax.tribology.film`.
 """
 
 from __future__ import annotations

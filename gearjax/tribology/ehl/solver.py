@@ -92,8 +92,19 @@ def precondition_operator(x, case, grid, angle_deg, mixed, R, sc=None):
                                    "maxiter"))
 def newton_krylov(x0, case: EHLCase, grid: EHLGrid, angle_deg: float = 0.0, mixed: bool = False,
                   tol=1e-9, max_steps: int = 60, restart: int = 40, maxiter: int = 6,
-                  lin_tol=1e-3):
-    """Damped Newton–Krylov from ``x0``; returns :class:`SolverState`."""
+                  lin_tol=1e-3, ptc=0.0):
+    """Damped Newton–Krylov from ``x0``; returns :class:`SolverState`.
+
+    ``ptc`` > 0 switches on pseudo-transient continuation (Kelley & Keyes, SIAM J.
+    Numer. Anal. 35 (1998) 508–523): each step solves ``(J + s D) δ = -R`` with D the
+    identity on the nodal rows (not on the load row) and the shift s starting at
+    ``ptc`` and following the residual, ``s ← s ‖R_new‖/‖R_old‖`` (doubled after a
+    step the line search had to shorten), so that it vanishes as the iteration
+    converges (Newton's rate is kept).  It damps the nodes where the Newton model is
+    poor; used for the fine-grid solve of the nested iteration, where the exit
+    spike of the interpolated start is far from the fine-grid one.  ``ptc = 0``
+    (default): plain damped Newton.
+    """
     sc = scales(case)
     khat = kernel_hat(grid, sc)
     f = partial(residual_core, case=case, sc=sc, khat=khat, grid=grid, angle_deg=angle_deg,
@@ -102,14 +113,16 @@ def newton_krylov(x0, case: EHLCase, grid: EHLGrid, angle_deg: float = 0.0, mixe
     def merit(R):
         return jnp.sqrt(jnp.sum(R * R))
 
+    d_rows = jnp.ones(x0.shape[0]).at[-1].set(0.0)
+
     def cond(st):
-        x, R, k, done = st
+        x, R, k, done, shift = st
         return (k < max_steps) & ~done
 
     def body(st):
-        x, R, k, _ = st
+        x, R, k, _, shift = st
         M, _ = precondition_operator(x, case, grid, angle_deg, mixed, R, sc)
-        Jv = lambda v: jax.jvp(f, (x,), (v,))[1]
+        Jv = lambda v: jax.jvp(f, (x,), (v,))[1] + shift * d_rows * v
         dx, _ = gmres(Jv, -R, M=M, tol=lin_tol, restart=restart, maxiter=maxiter)
         m0 = merit(R)
 
@@ -129,10 +142,12 @@ def newton_krylov(x0, case: EHLCase, grid: EHLGrid, angle_deg: float = 0.0, mixe
         Rn = jnp.where(ok, Rn, R)
         done = jnp.max(jnp.abs(Rn)) <= tol
         stall = ~ok | (t < 2.0 ** -11)
-        return xn, Rn, k + 1, done | stall
+        shift = shift * merit(Rn) / m0 * jnp.where(t < 1.0, 2.0, 1.0)
+        return xn, Rn, k + 1, done | stall, shift
 
     R0 = f(x0)
-    x, R, k, _ = jax.lax.while_loop(cond, body, (x0, R0, 0, jnp.max(jnp.abs(R0)) <= tol))
+    x, R, k, _, _ = jax.lax.while_loop(cond, body, (x0, R0, 0, jnp.max(jnp.abs(R0)) <= tol,
+                                                    jnp.asarray(ptc, R0.dtype)))
     res = jnp.max(jnp.abs(R))
     # a film at the floor everywhere makes ε and ρ̄H vanish, so the Reynolds residual
     # is trivially zero: such a degenerate "root" (seen on a 256² grid after a failed
@@ -145,13 +160,14 @@ def newton_krylov(x0, case: EHLCase, grid: EHLGrid, angle_deg: float = 0.0, mixe
 
 
 def solve_state(case: EHLCase, grid: EHLGrid, angle_deg: float = 0.0, mixed: bool = False,
-                tol=1e-9, max_steps: int = 60, continuation=(), x0=None):
+                tol=1e-9, max_steps: int = 60, continuation=(), x0=None, ptc=0.0):
     """Solve with optional continuation in λ (``continuation`` = multipliers m > 1, descending).
 
     Each stage solves the problem with the Reynolds coefficient multiplied by m
     (i.e. η0 u_e scaled by m at fixed α, load and geometry; m < 1 gives a heavier
     start for light loads) starting from the previous stage (the first from the
     Hertz start of its own case, or ``x0``); the last stage is the case itself.
+    ``ptc`` : initial pseudo-transient shift of every stage (see :func:`newton_krylov`).
     """
     import dataclasses
 
@@ -165,6 +181,6 @@ def solve_state(case: EHLCase, grid: EHLGrid, angle_deg: float = 0.0, mixed: boo
     for m in stages:
         cm = dataclasses.replace(case, u_e=case.u_e * m)
         st = newton_krylov(x, cm, grid, angle_deg, mixed, tol=max(tol, 1e-6),
-                           max_steps=max_steps)
+                           max_steps=max_steps, ptc=ptc)
         x = st.x
-    return newton_krylov(x, case, grid, angle_deg, mixed, tol=tol, max_steps=max_steps)
+    return newton_krylov(x, case, grid, angle_deg, mixed, tol=tol, max_steps=max_steps, ptc=ptc)

@@ -1,0 +1,1 @@
+"""Pure-rolling bevel gears with a preset parabolic transmission error ([Preset-TE-bevel])."""
