@@ -75,6 +75,8 @@ from gearjax.gears.preset_bevel.geometry import PresetBevelDesign  # noqa: E402
 from gearjax.gears.preset_bevel.design_file import PresetBevelFile  # noqa: E402
 from gearjax.gears.preset_bevel.design_file import flank_grid as preset_bevel_flank_grid  # noqa: E402
 from gearjax.gears.preset_bevel import analysis as preset_bevel_analysis  # noqa: E402
+from gearjax.gears.vh_catt.geometry import VHCattPair  # noqa: E402
+from gearjax.gears.vh_catt.design_file import VHCattDesign  # noqa: E402  (registers kind "vh_catt")
 # -- lubrication and friction --------------------------------------------------------
 from gearjax.tribology import (OILS, FrictionResult, Oil, Surface, friction_coefficient,  # noqa: E402
                                friction_traced, get_oil, make_oil, make_surface, mesh_losses,
@@ -155,6 +157,7 @@ __all__ = [
     "InvolutePair", "InvoluteTCA", "pair_geometry", "HypoidPair", "pair_flanks",
     "complementary_pinion", "prepare_hypoid", "pinion_outline", "involute_limits", "BlankInput", "blank_geometry",
     "blank_sensitivity",
+    "VHCattPair", "VHCattDesign",
     # flanks
     "FaceMillCutter", "make_cutter", "MachineSettings", "MemberBlank", "FlankSpec",
     "flank_surface", "generated_flank", "GeneratedSurface", "local_geometry",

@@ -222,7 +222,8 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
     ``path``, ``margin`` : the surface contact path and its boundary margin (mm).
     ``margin_parts(p1_body, p2_body) -> (face1, tip1, root1, face2, tip2, root2)`` :
     boundary margins (mm, >= 0 inside) of each member's face width, tip and root (form
-    circle / fillet) boundaries at body-frame points (N, 3).  ``g1, g2`` : face-end
+    circle / fillet) boundaries at body-frame points (N, 3); without ``tips`` also
+    ``(face1, rest1, face2, rest2)``, tip and root together.  ``g1, g2`` : face-end
     functions of pinion and gear (module docstring).  ``tips = (t1, t2)`` : tip-edge
     functions ``t_k(q)`` (mm, zero on the tip surface, > 0 below it) of pinion and
     gear, or ``None`` (face ends only).  ``drive`` : True on the drive side (may be traced).
@@ -315,7 +316,16 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
 
     (ph2, uv1, uv2, q1, q2, n1, n2, psi1, psi2) = jax.vmap(
         lambda zz: jax.vmap(post)(zz, path.phi1))(Z)
-    face1, tip1, root1, face2, tip2, root2 = jax.vmap(margin_parts)(q1, q2)
+    parts = jax.vmap(margin_parts)(q1, q2)
+    if len(parts) == 4:
+        # face ends only: (face1, rest1, face2, rest2), tip and root margins together
+        if tips is not None:
+            raise ValueError("margin_parts must give (face1, tip1, root1, face2, tip2, root2) "
+                             "with tips")
+        face1, tip1, face2, tip2 = parts
+        root1, root2 = tip1, tip2
+    else:
+        face1, tip1, root1, face2, tip2, root2 = parts
     pin = pin_np[:, None] > 0.5
     is_tip = tip_np[:, None] > 0.5
     # the edge point inside the other boundaries of its own flank (a face end: tip and

@@ -1,0 +1,1 @@
+"""VH-CATT cylindrical gears (variable hyperbolic circular-arc tooth trace), [VH-CATT]."""

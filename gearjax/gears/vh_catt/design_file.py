@@ -1,0 +1,164 @@
+"""VH-CATT design files (TOML, ``[design] kind = "vh_catt"``): schema, validation, grids.
+
+File units: mm, degrees, GPa.  Tables and keys (all required unless marked):
+
+* ``[design]`` kind = "vh_catt"; name, description, source (optional strings).
+* ``[pair]``
+  - ``z1``, ``z2`` (integers, 8..400): tooth numbers of pinion and gear (z2 >= z1);
+  - ``module_mm`` (0.1..50): normal module of the middle section;
+  - ``pressure_angle_deg`` (10..30): blade profile angle = middle-section pressure angle;
+  - ``face_width_mm`` (0 < b <= min(20 m, R_T)): face width, symmetric about the middle;
+  - ``cutter_radius1_mm``, ``cutter_radius2_mm`` (10..1e5, and >= 5 pi m): nominal
+    radius R_T of the head that cuts the pinion / the gear;
+  - ``blade_offset_mm`` (0..5 m): the mismatch e (blades moved apart by e each side,
+    trace radii R_T -+ (w/2 + e); 0 = the plain dual-blade head).
+* ``[material]`` ``youngs_modulus_GPa`` (50..500), ``poisson`` (0..0.5): both members
+  (E' = E/(1 - nu^2), the plane-strain modulus of two equal bodies, for the loaded
+  contact: :meth:`VHCattDesign.e_prime_MPa`; the ``gearjax efficiency`` command takes
+  its ``--E-prime`` option, default steel on steel).
+
+Every number must be a finite TOML number (tooth numbers TOML integers); unknown
+keys and missing keys raise ``ValueError`` naming the table and the key.  No
+geometry value has a default.  The tooth form is checked on loading (pointed
+teeth and an undercut reaching the active profile are refused,
+:func:`gearjax.gears.vh_catt.geometry.tooth_form`).
+
+Reference: [VH-CATT] (Table 1: the packaged example ``vh_catt_17x23``).
+"""
+
+from __future__ import annotations
+
+import copy
+from typing import NamedTuple
+
+import jax.numpy as jnp
+import numpy as np
+
+from gearjax.errors import check_range
+from gearjax.gears.vh_catt.geometry import VHCattPair, flank_grid
+from gearjax.gears.vh_catt.tca import ADAPTER
+from gearjax.io import (check_integer, check_keys, check_number, check_string,
+                        register_design_kind, require_key)
+from gearjax.tca_result import register_family
+
+__all__ = ["VHCattDesign", "design_from_dict", "FlankGrid", "KIND", "flank_sigma"]
+
+KIND = "vh_catt"
+_TOP = {"design", "pair", "material"}
+_DESIGN = {"kind", "name", "description", "source"}
+_PAIR = {"z1": "int", "z2": "int", "module_mm": "mm", "pressure_angle_deg": "deg",
+         "face_width_mm": "mm", "cutter_radius1_mm": "mm", "cutter_radius2_mm": "mm",
+         "blade_offset_mm": "mm"}
+_MATERIAL = {"youngs_modulus_GPa": (50.0, 500.0, "GPa"), "poisson": (0.0, 0.5, "")}
+
+
+def flank_sigma(member: str, flank: str) -> int:
+    """Side sign of the ``flank`` ("convex"/"concave") of ``member``: pinion convex = +1,
+    concave = -1; the gear is mirrored (convex = -1)."""
+    s = 1 if flank == "convex" else -1
+    return s if member == "pinion" else -s
+
+
+class FlankGrid(NamedTuple):
+    """A flank grid for :func:`gearjax.io.write_flank` (n_z sections x n_u points):
+    points, normals (out of the tooth), params (u, v, psi), xi (axial z, mm),
+    residual (mm/rad of the envelope), converged."""
+
+    points: np.ndarray
+    normals: np.ndarray
+    params: np.ndarray
+    xi: np.ndarray
+    residual: np.ndarray
+    converged: np.ndarray
+
+
+class VHCattDesign:
+    """A validated VH-CATT design file (``data`` in file units) and its pair
+    (:attr:`pair`, a :class:`~gearjax.gears.vh_catt.geometry.VHCattPair`)."""
+
+    def __init__(self, data: dict, pair: VHCattPair):
+        self.data = data
+        self.pair = pair
+
+    @property
+    def name(self) -> str:
+        return self.data.get("design", {}).get("name", "")
+
+    def defaults_lines(self) -> list:
+        """No defaults: every key of the schema is required."""
+        return []
+
+    def e_prime_MPa(self) -> float:
+        m = self.data["material"]
+        return float(m["youngs_modulus_GPa"]) * 1e3 / (1.0 - float(m["poisson"]) ** 2)
+
+    def teeth(self, member: str) -> int:
+        return self.pair.teeth(member)
+
+    def surface_grid(self, member: str, flank: str, n_u: int, n_v: int) -> FlankGrid:
+        """Grid of ``flank`` of tooth 0 of ``member``: ``n_u`` sections across the face
+        width (z from -b/2 to b/2) by ``n_v`` points from the form circle to the tip."""
+        if member not in ("pinion", "gear"):
+            raise ValueError(f"member = {member!r} must be 'pinion' or 'gear'")
+        if flank not in ("convex", "concave"):
+            raise ValueError(f"flank = {flank!r} must be 'convex' or 'concave'")
+        sigma = flank_sigma(member, flank)
+        g = {k: np.asarray(v) for k, v in flank_grid(self.pair, member, sigma, n_u, n_v).items()}
+        P, N = g["points"], g["normals"]
+        # orient the normals out of the tooth: flank sigma of tooth 0 faces sigma x
+        # near the +y axis, i.e. along -sigma (e_z x r)
+        t = np.stack([P[..., 1], -P[..., 0], np.zeros_like(P[..., 0])], axis=-1)
+        sgn = np.sign(np.sum(N * t, axis=-1, keepdims=True)) * sigma
+        params = np.concatenate([g["params"], np.full(P.shape[:2] + (1,), np.nan)], axis=-1)
+        return FlankGrid(P, N * sgn, params, g["xi"], g["residual"], g["converged"])
+
+
+def _table(data, key):
+    t = data.get(key)
+    if not isinstance(t, dict):
+        raise ValueError(f"missing table [{key}]")
+    return t
+
+
+def design_from_dict(data: dict) -> VHCattDesign:
+    """Validate a parsed design file and return a :class:`VHCattDesign` (module docstring)."""
+    if not isinstance(data, dict):
+        raise ValueError(f"a design must be a table (dict), got {type(data).__name__}")
+    data = copy.deepcopy(data)
+    check_keys("", data, _TOP)
+    des = _table(data, "design")
+    check_keys("design", des, _DESIGN)
+    check_string("design", "kind", require_key("design", des, "kind"), (KIND,))
+    for k in ("name", "description", "source"):
+        if k in des:
+            check_string("design", k, des[k])
+    pr = _table(data, "pair")
+    check_keys("pair", pr, set(_PAIR))
+    vals = {}
+    for k, unit in _PAIR.items():
+        v = require_key("pair", pr, k)
+        vals[k] = (check_integer("pair", k, v) if unit == "int"
+                   else check_number("pair", k, v, unit))
+    mat = _table(data, "material")
+    check_keys("material", mat, set(_MATERIAL))
+    for k, (lo, hi, unit) in _MATERIAL.items():
+        v = check_number("material", k, require_key("material", mat, k), unit)
+        try:
+            check_range(k, v, lo, hi, unit=unit)
+        except ValueError as exc:
+            raise ValueError(f"[material] {exc}") from None
+    if vals["z2"] < vals["z1"]:
+        raise ValueError(f"[pair] z2 = {vals['z2']} must be >= z1 = {vals['z1']} (the pinion "
+                         "is the member with fewer teeth)")
+    try:
+        pair = VHCattPair.create(vals["z1"], vals["z2"], vals["module_mm"],
+                                 vals["pressure_angle_deg"], vals["face_width_mm"],
+                                 vals["cutter_radius1_mm"], vals["cutter_radius2_mm"],
+                                 blade_offset=vals["blade_offset_mm"])
+    except ValueError as exc:
+        raise ValueError(f"[pair] {exc}") from None
+    return VHCattDesign(data, pair)
+
+
+register_family(VHCattDesign, ADAPTER)
+register_design_kind(KIND, design_from_dict)

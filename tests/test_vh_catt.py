@@ -1,0 +1,235 @@
+"""VH-CATT cylindrical gears ([VH-CATT]): generated flanks against closed forms, the
+point-contact TCA of the seed's pair, the seed's Hertz formula, design files.
+
+Independent references: the textbook involute (polar angle of the involute of the
+middle section, tip thickness), the circle of the cutter in the pitch plane (the
+developed trace), the involute line of action of the middle section (path of the
+aligned pair), the transverse contact ratio, Hertz's ellipse by Timoshenko's
+coefficients m_a, m_b from SciPy's complete elliptic integrals.
+"""
+
+import math
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+from scipy.special import ellipe, ellipk
+
+import gearjax as gj
+from gearjax.gears.vh_catt import geometry as G
+from gearjax.gears.vh_catt.design_file import design_from_dict, flank_sigma
+
+M, ALPHA, B, RT, E_OFF = 4.0, math.radians(20.0), 28.0, 400.0, 3.0
+
+
+def inv(a):
+    return math.tan(a) - a
+
+
+@pytest.fixture(scope="module")
+def design():
+    return gj.load_design("example:vh_catt_17x23")
+
+
+@pytest.fixture(scope="module")
+def pair(design):
+    return design.pair
+
+
+@pytest.fixture(scope="module")
+def sections(pair):
+    """Flank points of both members and flanks at blade coordinates u in sections z
+    (one compiled program)."""
+    us = jnp.linspace(-3.0, 3.5, 9)
+    zs = jnp.array([0.0, 7.0, 14.0])
+    out = {}
+    for mem in ("pinion", "gear"):
+        f = jax.jit(jax.vmap(jax.vmap(lambda s, u, z: G.section_point(pair, mem, s, u, z),
+                                      (None, 0, None)), (None, None, 0)))
+        for s in (1.0, -1.0):
+            out[mem, s] = np.asarray(f(s, us, zs))     # (3 sections, 9, 3)
+    return out
+
+
+def test_middle_section_is_the_involute(pair, sections):
+    """z = 0: every generated point lies on the involute of base radius r cos(alpha) of
+    a tooth of thickness pi m/2 (closed form, 1e-9 mm along the circle)."""
+    for (mem, s), P in sections.items():
+        z = pair.teeth(mem)
+        r = 0.5 * z * M
+        rb = r * math.cos(ALPHA)
+        Q = P[0]
+        assert np.all(np.abs(Q[:, 2]) < 1e-12)
+        R = np.hypot(Q[:, 0], Q[:, 1])
+        ok = R > rb * (1 + 1e-9)
+        phi = np.arctan2(Q[ok, 1], Q[ok, 0])
+        ref = np.array([math.pi / 2 - s * (math.pi * M / 2 / (2 * r) + inv(ALPHA)
+                                           - inv(math.acos(rb / x))) for x in R[ok]])
+        assert ok.sum() >= 6
+        assert np.max(np.abs(R[ok] * (phi - ref))) < 1e-9, (mem, s)
+
+
+def test_other_sections_are_not_involutes(pair, sections):
+    """Off the middle the sections are not involutes: after the best rotation about the
+    axis (least squares) a shape deviation from the involute is left, growing about as
+    z^2 (the numbers of docs/vh_catt.md)."""
+    devs = []
+    r, rb = 0.5 * 17 * M, 0.5 * 17 * M * math.cos(ALPHA)
+    for zi in (1, 2):
+        P = sections["pinion", -1.0][zi]
+        R = np.hypot(P[:, 0], P[:, 1])
+        ok = R > rb + 0.05
+        ref = np.array([math.pi / 2 + (math.pi * M / 2 / (2 * r) + inv(ALPHA)
+                                       - inv(math.acos(rb / x))) for x in R[ok]])
+        dphi = np.arctan2(P[ok, 1], P[ok, 0]) - ref
+        delta = np.sum(R[ok] ** 2 * dphi) / np.sum(R[ok] ** 2)
+        devs.append(np.max(np.abs(R[ok] * (dphi - delta))))
+    assert devs[0] > 1e-5 and 3.0 < devs[1] / devs[0] < 5.0
+
+
+def test_pitch_trace_is_the_cutter_circle(pair):
+    """The flank's trace on the pitch cylinder, developed, is the circle of radius
+    R_T -+ (pi m/4 + e) about the head axis (x_c, 0) of the pitch plane (1e-9 mm)."""
+    w = math.pi * M / 2
+    zs = jnp.linspace(-B / 2, B / 2, 5)
+    for mem, h in (("pinion", 1.0), ("gear", -1.0)):
+        for s in (1.0, -1.0):
+            pts, res = jax.jit(jax.vmap(lambda z: G.pitch_trace_point(pair, mem, s, z)))(zs)
+            rho0 = RT - h * s * (w / 2 + E_OFF)
+            xc = s * w / 2 - h * rho0
+            d = np.hypot(np.asarray(pts[:, 0]) - xc, np.asarray(pts[:, 1])) - rho0
+            assert np.max(np.abs(d)) < 1e-9 and np.max(np.asarray(res)) < 1e-9
+            # convex flanks bulge away from the tooth: pinion +1 and gear -1
+            assert flank_sigma(mem, "convex") == (1 if mem == "pinion" else -1)
+
+
+def test_tooth_form_checks(pair):
+    """Top land of the middle section = the involute tip thickness
+    2 r_a (s/(2r) + inv alpha - inv alpha_a); the ends are thinner (variable
+    thickness); the 17-tooth pinion is undercut (z < 2/sin^2 alpha = 17.1) up to its
+    base circle, below the start of active profile."""
+    form = G.tooth_form(pair)
+    for mem, z in (("pinion", 17), ("gear", 23)):
+        r, ra = 0.5 * z * M, 0.5 * z * M + M
+        rb = r * math.cos(ALPHA)
+        sa = 2 * ra * (math.pi * M / 2 / (2 * r) + inv(ALPHA) - inv(math.acos(rb / ra)))
+        land = form[mem]["top_land_mm"]
+        assert abs(land[1] - sa) < 1e-9
+        assert land[0] < land[1] and abs(land[0] - land[2]) < 1e-12
+    assert form["pinion"]["undercut"] and not form["gear"]["undercut"]
+    rb1 = 34.0 * math.cos(ALPHA)
+    assert abs(form["pinion"]["undercut_radius_mm"] - rb1) < 1e-6
+    assert not form["pinion"]["active_undercut"]
+
+
+@pytest.fixture(scope="module")
+def tca_runs(pair):
+    opts = dict(kinematics=False, face_ends=False)
+    return {"drive": gj.run_tca(pair, side="drive", **opts),
+            "coast": gj.run_tca(pair, side="coast", **opts),
+            "tilt": gj.run_tca(pair, gj.Misalignment.create(dSigma_deg=0.02), **opts)}
+
+
+def test_aligned_tca_is_the_middle_section_involute_mesh(pair, tca_runs):
+    """Aligned: the pair touches in the middle section along the involute line of
+    action, TE = 0, contact ratio = eps_alpha (closed form); both sides."""
+    geo = {k: float(v) for k, v in G.pair_geometry(pair).items() if np.ndim(v) == 0}
+    rb1 = 34.0 * math.cos(ALPHA)
+    p_b = math.pi * M * math.cos(ALPHA)
+    g = 80.0 * math.sin(ALPHA)
+    eps = (math.sqrt(38 ** 2 - rb1 ** 2) - (g - math.sqrt(50 ** 2 - (46 * math.cos(ALPHA)) ** 2))) / p_b
+    assert abs(geo["eps_alpha"] - eps) < 1e-12
+    for side in ("drive", "coast"):
+        r = tca_runs[side]
+        on = np.asarray(r.on_flank)
+        assert on.sum() > 20 and all(r.flags()[k] for k in ("converged", "reference_on_flank"))
+        assert np.max(np.abs(np.asarray(r.te)[on])) / gj.ARCSEC < 1e-6
+        assert np.max(np.abs(np.asarray(r.path.axial1)[on])) < 1e-9
+        # involute roll on the line of action: rho1 = rho_P +- rb1 (phi1 - phi1_P) (the
+        # drive flank rolls towards the pinion tip as phi1 grows, the coast flank back)
+        phi = np.asarray(r.phi1)
+        mid = phi.shape[0] // 2
+        rho = geo["rho_P"] + (1.0 if side == "drive" else -1.0) * rb1 * (phi - phi[mid])
+        rad = np.hypot(rb1, rho)
+        assert np.max(np.abs(np.asarray(r.path.radial1)[on] - rad[on])) < 1e-8
+        # contact ratio from the boundary crossings (linear interpolation on the grid)
+        assert abs(float(r.contact_ratio) - eps) < 2e-4
+
+
+def test_ellipse_of_the_mismatch(pair, tca_runs):
+    """The long axis of the unloaded ellipse follows the trace mismatch: at the pitch
+    point it lies along the face width, and its length is of the order of
+    sqrt(2 delta / (cos(alpha)(1/rho_convex - 1/rho_concave))) (the normal curvature
+    of the trace circles; exact value from the generated flanks)."""
+    r = tca_runs["drive"]
+    mid = r.phi1.shape[0] // 2
+    w = math.pi * M / 2
+    lam = math.cos(ALPHA) * (1 / (RT - w / 2 - E_OFF) - 1 / (RT + w / 2 + E_OFF))
+    a_est = math.sqrt(2 * 0.00632 / lam)
+    a = float(r.path.semi_major[mid])
+    assert abs(a - a_est) < 0.02 * a_est
+    assert abs(float(np.asarray(r.path.major_dir)[mid, 2])) > 0.999
+
+
+def test_misaligned_contact_moves_off_the_middle(tca_runs):
+    """A shaft-angle error moves the point contact along the face and, off the middle
+    section, the sections are not conjugate: TE appears (differences > 0)."""
+    r = tca_runs["tilt"]
+    on = np.asarray(r.on_flank)
+    assert r.flags()["converged"]
+    assert np.min(np.abs(np.asarray(r.path.axial1)[on])) > 1.0
+    assert float(r.ptp) / gj.ARCSEC > 0.05
+
+
+def _timoshenko(F, Rx, Ry, E_prime):
+    """Seed's formula a, b = k_a, k_b [3w/(2E'(A+B))]^(1/3), k_a = (2 E(e)/(pi (1 -
+    e^2)))^(1/3), k_b = k_a sqrt(1 - e^2), e from B/A = ((E/(1 - e^2)) - K)/(K - E)
+    (m = e^2; Timoshenko & Goodier)."""
+    A, Bc = 0.5 / Ry, 0.5 / Rx
+    ratio = Bc / A
+
+    def g(m):
+        K, E = ellipk(m), ellipe(m)
+        return (E / (1 - m) - K) / (K - E) - ratio
+
+    m = brentq(g, 1e-12, 1 - 1e-15, xtol=1e-16, rtol=1e-15)
+    ka = (2 * ellipe(m) / (math.pi * (1 - m))) ** (1 / 3)
+    base = (3 * F / (2 * E_prime * (A + Bc))) ** (1 / 3)
+    return ka * base, ka * math.sqrt(1 - m) * base
+
+
+def test_seed_hertz_formula_matches_exact_hertz():
+    """The seed's Hertz formula (semi-axes through k_a, k_b) and gearjax's exact Hertz
+    point contact agree (1e-8 relative) for the elongated ellipses of VH-CATT pairs."""
+    for F, Rx, Ry in ((2000.0, 6.7, 16000.0), (500.0, 2.5, 9000.0), (1000.0, 10.0, 60.0)):
+        Ep = 203e3 / (1 - 0.09)
+        hz = gj.hertz_point(F, Rx, Ry, Ep)
+        a, b = _timoshenko(F, Rx, Ry, Ep)
+        assert abs(float(hz.a) - a) / a < 1e-8 and abs(float(hz.b) - b) / b < 1e-8
+
+
+def _data(**pair_over):
+    d = {"design": {"kind": "vh_catt", "name": "t"},
+         "pair": dict(z1=17, z2=23, module_mm=4.0, pressure_angle_deg=20.0, face_width_mm=28.0,
+                      cutter_radius1_mm=400.0, cutter_radius2_mm=400.0, blade_offset_mm=3.0),
+         "material": dict(youngs_modulus_GPa=203.0, poisson=0.3)}
+    d["pair"].update(pair_over)
+    return d
+
+
+def test_design_file(design):
+    assert design.data["pair"]["cutter_radius1_mm"] == 400.0 and design.defaults_lines() == []
+    assert abs(design.e_prime_MPa() - 203e3 / 0.91) < 1e-9
+    assert gj.family_of(design).family == "vh_catt"
+    d = _data()
+    del d["pair"]["blade_offset_mm"]
+    with pytest.raises(ValueError, match="blade_offset_mm"):
+        design_from_dict(d)
+    with pytest.raises(ValueError, match=r"\[pair\] z2 = 15 must be >= z1"):
+        design_from_dict(_data(z2=15))
+    with pytest.raises(ValueError, match="cutter_radius2"):
+        design_from_dict(_data(cutter_radius2_mm=5.0))
+    with pytest.raises(ValueError, match="unknown|not allowed|helix"):
+        design_from_dict(_data(helix_deg=10.0))
