@@ -216,9 +216,15 @@ def test_contact_point_velocity_matches_central_differences(localised):
         a = np.asarray(a)
         return (a[:-4] - 8 * a[1:-3] + 8 * a[3:-1] - a[4:]) / (12 * h)
 
-    vc = np.asarray(k.v_contact)[2:-2]
-    assert np.max(np.abs(d4(out.path.point) - vc)) < 1e-5 * np.max(np.abs(vc))
-    ratio = np.asarray(k.gear_ratio)[2:-2]
-    assert np.max(np.abs(d4(out.path.phi2) - ratio)) < 1e-9
+    # the kinematics are those of the surface contact: stencils of five surface points
+    # only (where the path runs onto a tip edge, the contact made there is the edge's,
+    # gearjax.edge_contact, and the difference quotient straddles the switch)
+    surf = np.asarray(out.path.edge_kind) < 0
+    inner = np.convolve(surf.astype(int), np.ones(5, int), "valid") == 5
+    assert inner.sum() >= len(surf) // 2
+    vc = np.asarray(k.v_contact)[2:-2][inner]
+    assert np.max(np.abs(d4(out.path.point)[inner] - vc)) < 1e-5 * np.max(np.abs(vc))
+    ratio = np.asarray(k.gear_ratio)[2:-2][inner]
+    assert np.max(np.abs(d4(out.path.phi2)[inner] - ratio)) < 1e-9
     # not conjugate: the pair's rolling velocity differs from the conjugate model's
     assert np.max(np.abs(np.asarray(k.u_e) - np.asarray(k.model.u_e))) > 1e-3

@@ -1,6 +1,6 @@
 """Gradients through the whole chain -- design field -> flanks -> TCA -> kinematics at
 the contact points -> objective -- by autodiff against fourth-order central
-differences, on the involute, spiral-bevel and hypoid examples, through the public
+differences, on the involute and hypoid examples, through the public
 API only (``gj.tca_function``, ``gj.with_fields``).
 
 Objectives: TE peak-to-peak (arcsec), mean and max |SRR| and min R_x over the
@@ -77,8 +77,13 @@ def test_involute_chain():
     assert abs(float(jac["lead_crown"][4])) > 1e-3 and abs(float(jac["profile_crown"][0])) > 1.0
 
 
-@pytest.mark.parametrize("example", ["spiral_bevel_10x30_synthesised",
-                                     "hypoid_iso_10x41_synthesised"])
+# the hypoid example only: a spiral-bevel design runs the same program with offset 0
+# (the offset enters as a traced field; only the static tooth numbers differ), and
+# the spiral-bevel example's TCA derivatives are checked against central differences
+# in test_tca_hypoid.py (test_gradients_match_central_differences) and for finiteness
+# in test_fuzz_designs.py -- a second compile of this chain (~2 min CPU) bought no
+# extra check
+@pytest.mark.parametrize("example", ["hypoid_iso_10x41_synthesised"])
 def test_bevel_and_hypoid_chain(example):
     d = gj.load_design(f"example:{example}")
     f = gj.tca_function(d, side="drive", steps_per_pitch=6, half_pitches=1.5, n_pairs=3)
