@@ -81,7 +81,7 @@ SLOWEST_FIRST = (
     "test_tca_hypoid.py", "test_synthesis.py", "test_synthesis_hypoid.py",
     "test_edge_contact.py", "test_cutter_radius_study.py", "test_cli_tca.py",
     "test_formate_pair.py", "test_tca.py", "test_cutter_radius_optimize.py",
-    "test_involute.py", "test_ehl.py", "test_kinematics.py", "test_notebooks.py",
+    "test_involute.py", "test_ehl.py", "test_preset_bevel_tca.py", "test_kinematics.py", "test_notebooks.py",
     "test_hypoid_surface.py", "test_tca_result.py",
     "test_vh_catt.py",
 )
