@@ -187,7 +187,7 @@ def _figure(path, axial, curves):
 
 def main():
     t0 = time.perf_counter()
-    out = {"seed": "000_be2d122acb15edb3.txt", "flank": "gear convex (drive)",
+    out = {"reference": "Eigenfunctions", "flank": "gear convex (drive)",
            "units": {"u_e, u_s": "mm per rad of pinion roll", "r_eff": "mm"}, "cutters": {}}
     axial_75 = curves = None
     for label, r0 in hk.STUDY_CUTTERS.items():

@@ -95,7 +95,7 @@ def main(argv=None):
         sys.stderr.write(f"[{time.time() - t0:6.1f} s] {msg}\n")
 
     OUT.mkdir(parents=True, exist_ok=True)
-    res = {"seed": "000_be2d122acb15edb3.txt", "blank_input": hk.STUDY_BLANK,
+    res = {"reference": "Eigenfunctions", "blank_input": hk.STUDY_BLANK,
            "grid": list(shape), "units": {"u_e, u_s": "mm per rad of pinion roll",
                                           "r_eff": "mm", "k_II": "1/mm", "srr": "-",
                                           "phi": "eigenfunction units (mm/rad^2 scale)"}}
