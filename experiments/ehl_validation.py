@@ -8,7 +8,9 @@ Parts (run all, or name some on the command line: moes grid fig rot fast):
   (1994) central-film formula, load error, residual.  Fixed: E' = 226.4 GPa,
   Rx = 10 mm, η0 = 0.088 Pa·s, α = 22 GPa⁻¹; u_e and F are chosen to give (M, L).
 * ``grid``: grid convergence of one case (F = 100 N, u_e = 1 m/s, M = 168,
-  L = 14.8) on 64², 128², 256² nodes (Richardson estimate of the order).
+  L = 14.8) on 64², 128², 256² nodes (512² with EHL_VAL_512=1; fine-grid tolerance
+  EHL_VAL_TOL_FINE; scheme from EHL_VAL_UPWIND and EHL_VAL_LIMITER), each solution
+  with a one-Newton-step estimate of its distance to the discrete root.
 * ``fig``: pressure spike and horseshoe film (M = 200, L = 10, 128²) ->
   results/ehl_fields.png.
 * ``rot``: circular contact, entrainment at 0° and 90° (must agree) and 30°.
@@ -89,10 +91,47 @@ def part_moes(results):
     results["moes"] = rows
 
 
+def newton_error_estimate(x, case, grid, angle=0.0, mixed=False):
+    """Distance of the outputs of a state x to the discrete root, estimated by one
+    Newton step: solve J δ = -R(x) by GMRES(100) (10 cycles, to 1e-6 relative, the
+    solver's own preconditioner) and return the first-order changes of h_c, h_min
+    (µm) and μ along δ, with the linear residual reached.  Used for the fine grids,
+    whose Newton iteration stops at max|R| ≈ 3e-7 p_h (docs/ehl.md)."""
+    from functools import partial
+
+    import jax.numpy as jnp
+
+    from gearjax.tribology.ehl.krylov import gmres
+    from gearjax.tribology.ehl.model import kernel_hat, residual_core
+    from gearjax.tribology.ehl.outputs import outputs
+    from gearjax.tribology.ehl.solver import precondition_operator
+
+    sc = scales(case)
+    f = partial(residual_core, case=case, sc=sc, khat=kernel_hat(grid, sc), grid=grid,
+                angle_deg=angle, mixed=mixed)
+
+    @jax.jit
+    def step(x):
+        R = f(x)
+        M, _ = precondition_operator(x, case, grid, angle, mixed, R, sc)
+        Jv = lambda v: jax.jvp(f, (x,), (v,))[1]
+        dx, rel = gmres(Jv, -R, M=M, tol=1e-6, restart=100, maxiter=10)
+        out = lambda y: outputs(y, case, grid, mixed)[0]
+        d = jax.jvp(lambda y: jnp.stack([out(y).h_c, out(y).h_min, out(y).mu]), (x,), (dx,))[1]
+        return d, rel
+
+    d, rel = step(jnp.asarray(x))
+    return dict(newton_dh_c=float(d[0]) * 1e3, newton_dh_min=float(d[1]) * 1e3,
+                newton_dmu=float(d[2]), newton_lin_res=float(rel))
+
+
 def part_grid(results):
-    """64², 128², 256² (and 512² with EHL_VAL_512=1); ``upwind`` from EHL_VAL_UPWIND."""
+    """64², 128², 256² (and 512² with EHL_VAL_512=1); ``upwind`` from EHL_VAL_UPWIND,
+    ``limiter`` from EHL_VAL_LIMITER; each row with a one-Newton-step error estimate."""
     beta = float(os.environ.get("EHL_VAL_UPWIND", "0"))
+    limiter = os.environ.get("EHL_VAL_LIMITER", "none")
     key = "grid" if beta == 0.0 else f"grid_upwind{beta:g}"
+    key += "" if limiter == "none" else f"_{limiter}"
     sizes = (64, 128, 256) + ((512,) if os.environ.get("EHL_VAL_512") else ())
     old = {r["n"]: r for r in results.get(key, []) if r.get("converged")}
     rows = []
@@ -101,9 +140,13 @@ def part_grid(results):
             rows.append(old[n])
             continue
         tol = float(os.environ.get("EHL_VAL_TOL_FINE", "1e-9")) if n > 128 else 1e-9
-        r, _ = run_case(100.0, 1000.0, RX, n, upwind=beta, tol=tol)
+        r, (res, case, grid) = run_case(100.0, 1000.0, RX, n, upwind=beta, tol=tol,
+                                        limiter=limiter)
         r["upwind"] = beta
+        r["limiter"] = limiter
         r["tol"] = tol
+        if r["converged"]:
+            r.update(newton_error_estimate(res.x, case, grid))
         rows.append(r)
         print(json.dumps(r), flush=True)
         results[key] = rows + [old[m] for m in sizes if m > n and m in old]
@@ -248,11 +291,15 @@ def write_md(results):
         lines.append("")
     for key in sorted(k for k in results if k.startswith("grid")):
         lines += [f"## Grid convergence (F = 100 N, u_e = 1 m/s, M = 168, L = 14.8; {key})", "",
-                  "| grid | h_c µm | h_min µm | μ | p_max MPa | load err | residual | steps | time s | converged |",
-                  "|---|---|---|---|---|---|---|---|---|---|"]
+                  "Newton-step estimate: first-order change of h_c, h_min, μ along one Newton "
+                  "step from the returned state (distance to the discrete root).", "",
+                  "| grid | h_c µm | h_min µm | μ | p_max MPa | load err | residual | steps | time s | converged | Newton-step Δh_c µm | Δh_min µm | Δμ |",
+                  "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
         for r in results[key]:
-            pm = f"{r['p_max']:.0f}" if "p_max" in r else "—"
-            lines.append(f"| {r['n']}² | {r['h_c']:.5f} | {r['h_min']:.5f} | {r['mu']:.5f} | {pm} | {r['load_error']:.1e} | {r['residual']:.1e} | {r['steps']} | {r['time_s']:.1f} | {r['converged']} |")
+            pm = f"{r['p_max']:.1f}" if "p_max" in r else "—"
+            est = (f"{r['newton_dh_c']:+.1e} | {r['newton_dh_min']:+.1e} | {r['newton_dmu']:+.1e}"
+                   if "newton_dh_c" in r else "— | — | —")
+            lines.append(f"| {r['n']}² | {r['h_c']:.5f} | {r['h_min']:.5f} | {r['mu']:.5f} | {pm} | {r['load_error']:.1e} | {r['residual']:.1e} | {r['steps']} | {r['time_s']:.1f} | {r['converged']} | {est} |")
         lines.append("")
     if "sou" in results:
         lines += ["## First- (β = 0) vs second-order (β = 1) upwind Couette fluxes", "",

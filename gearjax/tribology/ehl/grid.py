@@ -42,6 +42,9 @@ class EHLGrid:
     upwind : weight β of the second-order correction of the upwind Couette fluxes
         (:func:`gearjax.tribology.ehl.model.reynolds_operator`): 0 first-order upwind
         (default), 1 second-order upwind, in between a blend.
+    limiter : ``"none"`` (the correction as it stands) or ``"van_albada"`` (the
+        correction slope limited by van Albada's smooth limiter; see
+        :func:`gearjax.tribology.ehl.model.van_albada`).
     """
 
     nx: int
@@ -51,6 +54,7 @@ class EHLGrid:
     y_lo: float
     y_hi: float
     upwind: float = 0.0
+    limiter: str = "none"
 
     @property
     def dx(self) -> float:
@@ -82,9 +86,10 @@ def default_domain(angle_deg: float):
 
 
 def make_grid(n: int, angle_deg: float = 0.0, ny: int | None = None, domain=None,
-              upwind: float = 0.0) -> EHLGrid:
+              upwind: float = 0.0, limiter: str = "none") -> EHLGrid:
     """Grid with ``n`` nodes along X (``ny`` along Y, default ``n``), ``default_domain``;
-    ``upwind`` the second-order upwind weight β in [0, 1] (see :class:`EHLGrid`)."""
+    ``upwind`` the second-order upwind weight β in [0, 1] and ``limiter`` ("none" or
+    "van_albada") of its correction (see :class:`EHLGrid`)."""
     for name, v in (("n", n), ("ny", n if ny is None else ny)):
         if not (isinstance(v, (int, np.integer)) and 8 <= v <= 4096):
             raise ValueError(f"grid {name} = {v!r} is outside the allowed range [8, 4096] "
@@ -96,7 +101,12 @@ def make_grid(n: int, angle_deg: float = 0.0, ny: int | None = None, domain=None
     if not (isinstance(upwind, (int, float, np.integer, np.floating)) and 0.0 <= upwind <= 1.0):
         raise ValueError(f"upwind = {upwind!r} is outside the allowed range [0, 1] (0: first-"
                          "order upwind, 1: second-order upwind)")
-    return EHLGrid(int(n), int(n if ny is None else ny), *dom, float(upwind))
+    if limiter not in LIMITERS:
+        raise ValueError(f"limiter = {limiter!r} must be one of {LIMITERS}")
+    return EHLGrid(int(n), int(n if ny is None else ny), *dom, float(upwind), limiter)
+
+
+LIMITERS = ("none", "van_albada")
 
 
 def _f(u, v):
