@@ -70,8 +70,9 @@ from gearjax.surfaces import GeneratedSurface, meshing_function
 __all__ = ["VHCattPair", "ToolData", "tool_data", "tool_point", "tool_family", "tool_psi0",
            "generated_flank", "pair_geometry", "HANDS", "MEMBERS", "SIDE_NAMES",
            "section_point", "pitch_trace_point", "involute_polar_angle", "tooth_form",
-           "flank_grid", "envelope_point_np", "MODULE_RANGE_MM", "CUTTER_RADIUS_RANGE_MM", "MAX_TEETH",
-           "ADDENDUM", "DEDENDUM", "BLADE_DEPTH", "envelope_point", "radius_point"]
+           "flank_grid", "MODULE_RANGE_MM", "CUTTER_RADIUS_RANGE_MM", "MAX_TEETH",
+           "ADDENDUM", "DEDENDUM", "BLADE_DEPTH", "envelope_point", "radius_point",
+           "envelope_point_np"]
 
 #: members and their hands (h = +1 pinion, -1 gear: head centres mirrored)
 MEMBERS = ("pinion", "gear")
