@@ -26,6 +26,17 @@ Usage (2-core CPU: the default set takes about 10 minutes)::
     python benchmarks/bench_startup.py --jobs all           # + tca-grad, synthesis
     python benchmarks/bench_startup.py --list
 
+``--wall`` times whole processes instead: each command of ``WALL`` (the console
+command ``gearjax ...`` as a user types it, and ``python -c "import gearjax"``) is run
+as a fresh Python process with ``GEARJAX_CACHE_DIR=off`` (no persistent compilation
+cache: every process compiles from scratch), ``--repeat`` times (default 2), and the
+minimum wall time is reported (process start to exit, output discarded)::
+
+    python benchmarks/bench_startup.py --wall
+    python benchmarks/bench_startup.py --wall --repeat 3 --json wall.json
+
+Results of past runs: ``benchmarks/results/startup_wall.md``.
+
 Benchmarks are never tests.  Not for CI.
 """
 
@@ -70,6 +81,14 @@ JOBS = {
 }
 DEFAULT = ["surface", "tca-hypoid", "tca-involute", "kinematics", "blank", "friction", "efficiency",
            "tca"]
+
+# name -> gearjax argv for the whole-process (--wall) timings; None = only "import gearjax"
+WALL = {
+    "import": None,
+    "example-list": ["example", "list"],
+    "example-show-vh": ["example", "show", "vh_catt_17x23"],
+    "tca-vh-11": ["tca", "example:vh_catt_17x23", "--positions", "11"],
+}
 
 EVENTS = {"/jax/core/compile/jaxpr_trace_duration": "trace",
           "/jax/core/compile/jaxpr_to_mlir_module_duration": "lower",
@@ -197,6 +216,36 @@ def child(job, cache_dir, tmp, count_binds):
 
 # ------------------------------------------------------------------------ parent side
 
+def wall(names, repeat):
+    """Minimum over ``repeat`` fresh processes of the wall time of each ``WALL`` job
+    (``GEARJAX_CACHE_DIR=off``); returns ``{name: [seconds of each run]}``."""
+    env = dict(os.environ, GEARJAX_CACHE_DIR="off")
+    # run outside any checkout: ``python -c`` puts the working directory first on
+    # sys.path, so the package imported is the one the environment (PYTHONPATH) names
+    cwd = tempfile.mkdtemp(prefix="gearjax-bench-wall-")
+    out = {}
+    for name in names:
+        argv = WALL[name]
+        code = ("import gearjax" if argv is None else
+                "import sys; from gearjax.cli import main; sys.argv[0] = 'gearjax'; "
+                "raise SystemExit(main())")
+        times = []
+        for _ in range(repeat):
+            t = time.perf_counter()
+            p = subprocess.run([sys.executable, "-c", code] + (argv or []), env=env, cwd=cwd,
+                               stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+            times.append(time.perf_counter() - t)
+            if p.returncode:
+                raise RuntimeError(f"{name}: exit {p.returncode}: {p.stderr[-2000:]}")
+        out[name] = times
+        shown = " ".join(f"{x:.2f}" for x in times)
+        print(f"{name:16s} {min(times):7.2f}   (runs: {shown})", flush=True)
+    shutil.rmtree(cwd, ignore_errors=True)
+    import gearjax
+    print(f"package: {os.path.dirname(gearjax.__file__)}")
+    return out
+
+
 def _spawn(job, cache_dir, tmp, binds=False):
     cmd = [sys.executable, os.path.abspath(__file__), "--child", job, "--cache", cache_dir,
            "--tmp", tmp] + (["--binds"] if binds else [])
@@ -215,6 +264,9 @@ def main(argv=None):
     ap.add_argument("--no-warm", action="store_true", help="skip the warm-cache process")
     ap.add_argument("--json", default=None, help="write the raw numbers to this file")
     ap.add_argument("--list", action="store_true")
+    ap.add_argument("--wall", action="store_true",
+                    help="whole-process wall times of the WALL commands, no compilation cache")
+    ap.add_argument("--repeat", type=int, default=2, help="runs per --wall command (min shown)")
     ap.add_argument("--child", default=None, help=argparse.SUPPRESS)
     ap.add_argument("--cache", default=None, help=argparse.SUPPRESS)
     ap.add_argument("--tmp", default=None, help=argparse.SUPPRESS)
@@ -224,6 +276,21 @@ def main(argv=None):
     if args.list:
         for k, (d, _, _) in JOBS.items():
             print(f"{k:14s} {d}{'  (default)' if k in DEFAULT else ''}")
+        for k, a in WALL.items():
+            cmd = 'python -c "import gearjax"' if a is None else "gearjax " + " ".join(a)
+            print(f"{k:14s} --wall: {cmd}")
+        return 0
+    if args.wall:
+        names = list(WALL) if args.jobs == ",".join(DEFAULT) else [
+            j.strip() for j in args.jobs.split(",")]
+        unknown = [j for j in names if j not in WALL]
+        if unknown:
+            ap.error(f"unknown --wall job(s) {unknown}; --list shows them")
+        print(f"seconds, min of {args.repeat} fresh processes, GEARJAX_CACHE_DIR=off")
+        res = wall(names, args.repeat)
+        if args.json:
+            with open(args.json, "w") as fh:
+                json.dump(res, fh, indent=1)
         return 0
     jobs = list(JOBS) if args.jobs == "all" else [j.strip() for j in args.jobs.split(",")]
     unknown = [j for j in jobs if j not in JOBS]

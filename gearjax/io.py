@@ -21,6 +21,7 @@ import os
 import tempfile
 from importlib import resources
 from pathlib import Path
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -35,7 +36,8 @@ __all__ = ["read_toml", "check_keys", "require_key", "check_number", "check_inte
            "check_output_path", "WriteError", "finite_json", "dumps_json",
            "write_csv", "write_xyz", "write_stl_flank",
            "write_stl_tooth", "tooth_mesh", "flank_triangles", "write_flank",
-           "register_design_kind", "design_kinds", "design_from_dict", "load_design"]
+           "register_design_kind", "design_kinds", "design_from_dict", "load_design",
+           "FlankGrid"]
 
 #: packaged examples renamed since (old name -> current name); still accepted
 EXAMPLE_ALIASES = {"seed000_6x39_7p5in": "hypoid_6x39_7p5in"}
@@ -472,6 +474,30 @@ def load_design(source, kinds=None):
 
 # --------------------------------------------------------------------------------------
 # exports
+
+
+class FlankGrid(NamedTuple):
+    """The flank grid of the surface-export protocol, one type for every family
+    (returned by the designs' ``surface_grid`` and by the families' grid functions;
+    written by :func:`write_flank`).  Shapes (n_xi, n_s) per field, index j from the
+    root to the tip (mm, rad):
+
+    points (n_xi, n_s, 3) and normals (n_xi, n_s, 3, out of the tooth) in the
+    member's frame; params (n_xi, n_s, k) the family's surface parameters (hypoid:
+    s, theta, psi; preset-TE bevel: height above the pitch cone, curve parameter t,
+    profile parameter u; VH-CATT: blade coordinate u, trace parameter v, NaN);
+    xi (n_xi,) the face-width positions (hypoid: xi; preset-TE bevel: (L - A_i)/b;
+    VH-CATT: axial z, mm); residual (n_xi, n_s) of the point solves; converged
+    (n_xi, n_s) bool.  The families' grid functions document their parameters.  A
+    NamedTuple, so a pytree: JAX or NumPy arrays.
+    """
+
+    points: Any
+    normals: Any
+    params: Any
+    xi: Any
+    residual: Any
+    converged: Any
 
 
 def _np(a):

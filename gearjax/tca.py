@@ -89,7 +89,7 @@ __all__ = ["pair_arrays", "Misalignment", "Assembly", "contact_equations", "cont
            "ContactPath", "contact_path", "te_arcsec", "require_path",
            "ARCSEC", "ellipse_from_weingarten", "rotation_about", "relative_curvature",
            "MultiPair", "multi_pair", "DEFAULT_APPROACH", "NoContactError",
-           "check_on_flank_converged", "check_tca_options"]
+           "check_on_flank_converged", "check_tca_options", "pinion_angle_grid"]
 
 class NoContactError(ConvergenceError):
     """The flanks do not touch inside their boundaries (a :class:`ConvergenceError`)."""
@@ -662,3 +662,13 @@ def check_tca_options(steps_per_pitch, half_pitches, n_pairs, approach) -> None:
         raise ValueError(f"n_pairs = {n_pairs} must be odd (pairs -k..k)")
     check_range("half_pitches", half_pitches, 0.5, 4.0)
     check_range("approach", approach, 0.0, 1.0, lo_open=True, unit="mm")
+
+
+def pinion_angle_grid(phi1_ref, z1: int, steps_per_pitch: int, half_pitches: float):
+    """The TCA grid of pinion angles (rad) of every adapter: ``phi1_ref + h k`` with
+    ``h = 2 pi/(z1 steps_per_pitch)`` and ``|k| <= round(half_pitches steps_per_pitch)``
+    (``2 round(half_pitches steps_per_pitch) + 1`` angles, the middle one ``phi1_ref``).
+    ``phi1_ref`` may be traced; the rest are static."""
+    h = 2.0 * np.pi / (z1 * steps_per_pitch)
+    k = int(round(half_pitches * steps_per_pitch))
+    return phi1_ref + h * jnp.arange(-k, k + 1, dtype=float)

@@ -50,3 +50,41 @@ def test_surface_tooth_stl_and_refusals(tmp_path, capsys):
     with pytest.raises(SystemExit):
         main(["surface", "example:vh_catt_17x23", "--member", "gear", "--flank", "side",
               "--out", str(tmp_path / "x.csv")])
+
+
+def test_example_list_reads_design_tables_without_loading(capsys, monkeypatch):
+    """``gearjax example list`` prints each example's ``[design] description`` from the
+    TOML alone: it builds no design (a load would run the tooth-form check and, for
+    other families, their geometry), and reports a file whose kind is unknown."""
+    import gearjax.io as io
+
+    def no_load(*a, **k):
+        raise AssertionError("example list must not load the designs")
+
+    monkeypatch.setattr(io, "load_design", no_load)
+    monkeypatch.setattr(io, "design_from_dict", no_load)
+    assert main(["example", "list"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    desc = io.read_toml("example:vh_catt_17x23")["design"]["description"]
+    assert any(ln.startswith("vh_catt_17x23") and ln.endswith(desc) for ln in lines)
+    assert len(lines) == len(io.list_examples()) and "(invalid" not in "".join(lines)
+    real = io.read_toml
+    monkeypatch.setattr(io, "read_toml", lambda src: {"design": {"kind": "helical"}}
+                        if src == "example:vh_catt_17x23" else real(src))
+    assert main(["example", "list"]) == 0
+    line = [ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("vh_catt")]
+    assert "(invalid: [design] kind = 'helical'" in line[0]
+
+
+def test_example_show_prints_the_file_that_loads(capsys):
+    """``gearjax example show`` prints the file text (still TOML that loads to the same
+    pair) and no defaults (every VH-CATT key is required)."""
+    import tomllib
+
+    import gearjax as gj
+    assert main(["example", "show", "vh_catt_17x23"]) == 0
+    out = capsys.readouterr().out
+    assert "defaults applied (keys not in this file; gearjax uses these values): none" in out
+    data = tomllib.loads(out)
+    assert data["pair"]["z1"] == 17 and data["pair"]["blade_offset_mm"] == 3.0
+    assert gj.design_from_dict(data).pair.z2 == 23

@@ -608,3 +608,18 @@ def test_plot_written_atomically(tmp_path, pair, crowned):
     np.testing.assert_allclose([o[:, 0].min(), o[:, 0].max()],
                                [-float(path.semi_major[MID]), float(path.semi_major[MID])],
                                rtol=1e-3)
+
+
+def test_pinion_angle_grid_of_the_adapters():
+    """The adapters' shared grid: 2 round(half_pitches steps_per_pitch) + 1 angles,
+    step 2 pi/(z1 steps_per_pitch), centred on phi1_ref (exactly: the middle angle
+    is phi1_ref + 0); phi1_ref may be traced (one program for any reference)."""
+    from gearjax.tca import pinion_angle_grid
+    g = np.asarray(pinion_angle_grid(0.3, 17, 8, 1.25))
+    assert g.shape == (21,) and g[10] == 0.3
+    np.testing.assert_allclose(np.diff(g), 2 * np.pi / (17 * 8), rtol=1e-12)
+    assert np.isclose(g[-1] - g[0], 2 * 1.25 * 2 * np.pi / 17, rtol=1e-12)
+    assert pinion_angle_grid(0.0, 43, 6, 1.5).shape == (19,)        # round(9.0) = 9
+    gj = jax.jit(pinion_angle_grid, static_argnums=(1, 2, 3))(jnp.float64(-0.1), 17, 8, 1.25)
+    assert np.asarray(gj)[10] == -0.1
+    np.testing.assert_allclose(np.asarray(gj), g - 0.4, rtol=0, atol=1e-14)

@@ -124,6 +124,52 @@ def test_tooth_form_checks(pair):
     assert not form["pinion"]["active_undercut"]
 
 
+def test_closed_form_envelope_is_the_generated_flank(pair, sections):
+    """The closed-form envelope of the tooth-form check (NumPy, Willis' condition on
+    the rack) gives the points of the autodiff envelope (``GeneratedSurface`` Newton
+    solve of ``n . dr_w/dpsi = 0``) and of the plain-Newton ``envelope_point``,
+    1e-9 mm, for both members and flanks, in and off the middle section (undercut
+    pinion rows included); its meshing residual is at the rounding level."""
+    us, zs = np.linspace(-3.0, 3.5, 9), np.array([0.0, 7.0, 14.0])
+    pn = jax.tree_util.tree_map(np.asarray, pair)
+    env = jax.jit(jax.vmap(G.envelope_point, (None, 0, 0)))
+    for (mem, s), P in sections.items():
+        k = G.tool_data(pn.module, pn.pressure_angle, pn.cutter_radius(mem), pn.teeth(mem),
+                        G.HANDS[mem], s, pn.blade_offset, xp=np)
+        q, res = G.envelope_point_np(k, us[None, :], zs[:, None])
+        assert q.shape == (3, 9, 3) and np.max(res) < 1e-11
+        assert np.max(np.abs(q - P)) < 1e-9, (mem, s)
+        kj = G.tool_data(pair.module, pair.pressure_angle, pair.cutter_radius(mem),
+                         pair.teeth(mem), G.HANDS[mem], s, pair.blade_offset)
+        qj, rj = env(kj, jnp.asarray(us[::4]), jnp.full(3, 7.0))
+        assert np.max(np.abs(np.asarray(qj) - P[1, ::4])) < 1e-9 and np.max(rj) < 1e-9
+
+
+def test_tooth_form_refusals_name_the_member():
+    """The form check runs in ``create`` (and so on every design-file load): teeth
+    pointed at the face ends are refused with a ValueError naming z2 (here a small
+    cutter narrows the end sections: the middle section's top land is still the
+    positive involute tip thickness), ``check_form=False`` skips it."""
+    args = (13, 14, 2.0, 14.5, 30.0, 60.0, 45.0)
+    p = G.VHCattPair.create(*args, blade_offset=10.0, check_form=False)
+    form = G.tooth_form(p)
+    r, ra, al = 14.0, 16.0, math.radians(14.5)
+    rb = r * math.cos(al)
+    sa = 2 * ra * (math.pi * 2.0 / 2 / (2 * r) + inv(al) - inv(math.acos(rb / ra)))
+    assert abs(form["gear"]["top_land_mm"][1] - sa) < 1e-9 and sa > 1.0
+    assert form["gear"]["min_top_land_mm"] < 0.0 < form["pinion"]["min_top_land_mm"]
+    with pytest.raises(ValueError, match="z2: pointed gear teeth"):
+        G.VHCattPair.create(*args, blade_offset=10.0)
+    with pytest.raises(ValueError, match=r"\[pair\] z2: pointed gear teeth"):
+        design_from_dict(_data(z1=13, z2=14, module_mm=2.0, pressure_angle_deg=14.5,
+                               face_width_mm=30.0, cutter_radius1_mm=60.0,
+                               cutter_radius2_mm=45.0, blade_offset_mm=10.0))
+    # undercut flag at the textbook limit of rack generation z < 2/sin^2(alpha) = 17.1
+    und = {z: G.tooth_form(G.VHCattPair.create(z, 40, M, 20.0, B, RT, check_form=False))
+           ["pinion"]["undercut"] for z in (17, 18)}
+    assert und == {17: True, 18: False}
+
+
 @pytest.fixture(scope="module")
 def tca_runs(pair):
     opts = dict(kinematics=False, face_ends=False)

@@ -17,11 +17,25 @@ def register(sub):
 
 
 def run_list(args) -> int:
-    from gearjax import list_examples, load_design
+    """One line per packaged example: its name and the ``[design] description``.
+
+    Listing reads the files' ``[design]`` tables only (TOML parse and ``kind``), it
+    does not build the designs: no geometry, no compiled program (the full validation
+    of every packaged example runs in ``gearjax example show`` and every command that
+    loads it, and in tests/test_io.py).  A file that does not parse or names an
+    unknown kind is reported on its line, not hidden."""
+    import gearjax  # noqa: F401  (registers the families' design kinds)
+    from gearjax.io import design_kinds, list_examples, read_toml
+    kinds = design_kinds()
     for name in list_examples():
         try:
-            desc = load_design(f"example:{name}").data.get("design", {}).get("description", "")
-        except ValueError as exc:   # an example that no longer validates is reported, not hidden
+            des = read_toml(f"example:{name}").get("design", {})
+            kind = des.get("kind") if isinstance(des, dict) else None
+            if kind not in kinds:
+                raise ValueError(f"[design] kind = {kind!r} must be one of "
+                                 + ", ".join(repr(k) for k in kinds))
+            desc = des.get("description", "")
+        except ValueError as exc:
             desc = f"(invalid: {exc})"
         sys.stdout.write(f"{name:20s} {desc}\n")
     return 0

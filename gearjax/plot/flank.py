@@ -28,7 +28,7 @@ def axial_projection(points):
 
 
 def plot_flank_axial(grid, blank=None, ax=None, label: str = "flank", color="C0"):
-    """Draw ``grid`` (a :class:`~gearjax.gears.hypoid.flank.FlankGrid`) in the axial plane.
+    """Draw ``grid`` (a :class:`~gearjax.io.FlankGrid`) in the axial plane.
 
     ``blank`` (optional :class:`~gearjax.gears.hypoid.flank.MemberBlank`) adds the face and
     root cones and the toe/heel lines (normal to the pitch generatrix at

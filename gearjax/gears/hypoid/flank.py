@@ -50,7 +50,6 @@ from __future__ import annotations
 
 import functools
 from dataclasses import dataclass
-from typing import NamedTuple
 
 import jax
 import jax.numpy as jnp
@@ -62,6 +61,7 @@ from gearjax.gears.hypoid.cutter import (FaceMillCutter, blade_data, cone_normal
 from gearjax.errors import check_int, check_positive, check_range, require_converged
 from gearjax.gears.hypoid.machine import (MachineSettings, cutter_to_cradle, cutter_to_work,
                                           work_to_machine)
+from gearjax.io import FlankGrid  # noqa: F401  (the shared export grid; exported here)
 from gearjax.newton import newton_solve
 
 __all__ = ["MemberBlank", "FlankSpec", "FlankGrid", "make_member_blank", "mean_cone_distance",
@@ -361,23 +361,6 @@ def solve_point(fl: FlankSpec, s, xi0, x0):
                                        jnp.asarray(xi0, float)), tol=TOL)
 
 
-class FlankGrid(NamedTuple):
-    """A flank grid, shape (n_xi, n_s) per field; index j runs root (fillet start) -> tip.
-
-    points (n_xi, n_s, 3) mm and normals (n_xi, n_s, 3) in the work frame;
-    params (n_xi, n_s, 3) = (s, theta, psi) surface parameters (mm, rad, rad);
-    xi (n_xi,) face-width positions; residual (n_xi, n_s) max |F| of the solve (mm);
-    converged (n_xi, n_s) bool (point solve and its row's tip solve both converged).
-    """
-
-    points: jax.Array
-    normals: jax.Array
-    params: jax.Array
-    xi: jax.Array
-    residual: jax.Array
-    converged: jax.Array
-
-
 def _tip_scan(fl, xs, x_start):
     def step(carry, xi0):
         res = solve_tip(fl, xi0, carry)
@@ -394,6 +377,13 @@ def flank_points(fl: FlankSpec, n_xi: int = 21, n_s: int = 11) -> FlankGrid:
     positions from the fillet start ``s_min`` to the tip ``s_max(xi)``, uniformly
     spaced in ``s``.  Use :func:`flank_surface` for a validated, convergence-checked
     result.  Differentiable w.r.t. ``fl`` (jacfwd/jacrev) through the implicit solves.
+
+    Returns a :class:`gearjax.io.FlankGrid`, shape (n_xi, n_s) per field, index j
+    from root (fillet start) to tip: points (n_xi, n_s, 3) mm and normals (n_xi,
+    n_s, 3) in the work frame; params (n_xi, n_s, 3) = (s, theta, psi) surface
+    parameters (mm, rad, rad); xi (n_xi,) face-width positions; residual (n_xi, n_s)
+    max |F| of the solve (mm); converged (n_xi, n_s) bool (point solve and its row's
+    tip solve both converged).
     """
     xis = np.linspace(-1.0, 1.0, int(n_xi))
     ts = np.linspace(1.0, 0.0, int(n_s))          # tip -> root

@@ -42,7 +42,7 @@ from gearjax.tca_result import (TCAResult, check_side, contact_kinematics, regis
                                 strong_float64)
 from gearjax.tca import (DEFAULT_APPROACH, ContactPath, Misalignment, MultiPair,
                          NoContactError, check_on_flank_converged, check_tca_options,
-                         contact_path, contact_system, multi_pair)
+                         contact_path, contact_system, multi_pair, pinion_angle_grid)
 
 __all__ = ["mean_dedendum", "HypoidPair", "pair_flanks", "complementary_pinion",
            "hypoid_assembly", "flank_function", "reference_guess", "hypoid_margin",
@@ -257,9 +257,7 @@ def hypoid_tca_traced(pair: HypoidPair, mis: Misalignment, x_ref, phi1_ref, *,
         x_ref = jnp.where(s1.converged, jax.lax.stop_gradient(x1), x_guess)
         phi1_ref = jnp.where(s1.converged, s1.x[0],
                              jax.lax.stop_gradient(jnp.asarray(phi1_ref, float)))
-    h = 2.0 * np.pi / (pair.z1 * steps_per_pitch)
-    k = int(round(half_pitches * steps_per_pitch))
-    grid = phi1_ref + h * jnp.arange(-k, k + 1, dtype=float)
+    grid = pinion_angle_grid(phi1_ref, pair.z1, steps_per_pitch, half_pitches)
     asm = hypoid_assembly(pair)
     path = contact_path(r1, r2, asm, mis, grid, x_ref,
                         line_contact=line_contact, approach=approach)

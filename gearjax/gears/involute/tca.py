@@ -56,7 +56,8 @@ from gearjax.loaded_contact import TeethOf
 from gearjax.tca_result import (TCAResult, check_side, contact_kinematics, register_family,
                                 strong_float64)
 from gearjax.tca import (DEFAULT_APPROACH, Assembly, ContactPath, Misalignment, MultiPair,
-                  contact_path, multi_pair, check_on_flank_converged, check_tca_options)
+                  contact_path, multi_pair, check_on_flank_converged, check_tca_options,
+                  pinion_angle_grid)
 
 __all__ = ["InvoluteTCA", "crowned_pinion_flank", "involute_assembly", "involute_tca_traced",
            "involute_tca", "involute_margin", "tca_summary", "SUMMARY_KEYS", "reference_guess",
@@ -248,9 +249,7 @@ def involute_tca_traced(des: InvoluteTCA, mis: Misalignment, *, side: int = -1,
     """
     p = des.pair
     x_ref, phi1_ref, ok = reference_guess(des, side)
-    h = 2.0 * np.pi / (p.z1 * steps_per_pitch)
-    k = int(round(half_pitches * steps_per_pitch))
-    grid = phi1_ref + h * jnp.arange(-k, k + 1, dtype=float)
+    grid = pinion_angle_grid(phi1_ref, p.z1, steps_per_pitch, half_pitches)
     r1 = crowned_pinion_flank(des, side)
     r2 = generated_flank(p.module, p.pressure_angle, -p.helix, p.x2, p.z2, side)
     asm = involute_assembly(p)

@@ -26,7 +26,6 @@ import copy
 import functools
 import math
 from dataclasses import dataclass, field
-from typing import NamedTuple
 
 import jax
 import jax.numpy as jnp
@@ -38,7 +37,8 @@ from gearjax.gears.preset_bevel.geometry import (PresetBevelDesign, cone_distanc
                                                  curve_parameter, flank_phase, gear_curve,
                                                  gear_flank_point, pinion_flank_point,
                                                  pitch_angles, preset_kappa)
-from gearjax.io import check_integer, check_keys, check_number, register_design_kind, require_key
+from gearjax.io import (FlankGrid, check_integer, check_keys, check_number,  # noqa: F401
+                        register_design_kind, require_key)
 from gearjax.newton import newton_solve
 from gearjax.tca import ARCSEC
 from gearjax.tca_result import register_family
@@ -100,20 +100,6 @@ def validate_fields(v: dict) -> PresetBevelDesign:
                              f(k), des.rho1, des.rho2, des.addendum, des.dedendum, z1, z2)
 
 
-class FlankGrid(NamedTuple):
-    """A flank grid for export (:func:`gearjax.io.write_flank`): ``points``, ``normals``
-    (n_u, n_v, 3; outward normals, mm), ``params`` (n_u, n_v, 3) = (height above the pitch
-    cone mm, curve parameter t rad, profile parameter u rad), ``xi`` (n_u,) face
-    position (L - A_i)/b, ``residual`` (mm) and ``converged`` of the point solves."""
-
-    points: np.ndarray
-    normals: np.ndarray
-    params: np.ndarray
-    xi: np.ndarray
-    residual: np.ndarray
-    converged: np.ndarray
-
-
 def _grid_point(fn, data, outward_sign, delta, L, H, t0):
     """Solve ``|S(u, t)| = L``, ``h(S) = H`` for (u, t) (mm)."""
     def F(x, th):
@@ -132,7 +118,11 @@ def _grid_point(fn, data, outward_sign, delta, L, H, t0):
 def flank_grid(des: PresetBevelDesign, member: str, flank: str, n_u: int, n_v: int) -> FlankGrid:
     """Flank grid of ``member`` ("pinion"/"gear"), ``flank`` ("concave"/"convex"): n_u
     cone distances from toe to heel x n_v heights from -dedendum to +addendum (concrete;
-    every point a converged solve)."""
+    every point a converged solve).  A :class:`gearjax.io.FlankGrid`: ``points``,
+    ``normals`` (n_u, n_v, 3; outward normals, mm), ``params`` (n_u, n_v, 3) = (height
+    above the pitch cone mm, curve parameter t rad, profile parameter u rad), ``xi``
+    (n_u,) face position (L - A_i)/b, ``residual`` (mm) and ``converged`` of the point
+    solves."""
     if member not in ("pinion", "gear"):
         raise ValueError(f"member = {member!r} must be 'pinion' or 'gear'")
     if flank not in ("concave", "convex"):

@@ -39,7 +39,7 @@ from gearjax.gears.preset_bevel.pair import (drives_forward, preset_assembly, pr
                                              side_flanks)
 from gearjax.loaded_contact import TeethOf
 from gearjax.tca import (DEFAULT_APPROACH, Misalignment, check_on_flank_converged,
-                         check_tca_options, contact_path, multi_pair)
+                         check_tca_options, contact_path, multi_pair, pinion_angle_grid)
 from gearjax.tca_result import (TCAResult, check_side, contact_kinematics, register_family,
                                 strong_float64)
 
@@ -74,9 +74,7 @@ def _result_parts(des, mis, x_ref, phi1_ref, code, *, steps_per_pitch, half_pitc
     contacts (toe, heel and tip edge of both members) are solved and the contact made
     at each grid point is the surface or an edge contact
     (:func:`gearjax.edge_contact.face_end_contact`)."""
-    h = 2.0 * np.pi / (des.z1 * steps_per_pitch)
-    k = int(round(half_pitches * steps_per_pitch))
-    grid = phi1_ref + h * jnp.arange(-k, k + 1, dtype=float)
+    grid = pinion_angle_grid(phi1_ref, des.z1, steps_per_pitch, half_pitches)
     r1, r2 = side_flanks(des, code)
     asm = preset_assembly(des)
     path = contact_path(r1, r2, asm, mis, grid, x_ref, line_contact=False, approach=approach)

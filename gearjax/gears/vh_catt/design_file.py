@@ -29,15 +29,13 @@ Reference: [VH-CATT] (Table 1: the packaged example ``vh_catt_17x23``).
 from __future__ import annotations
 
 import copy
-from typing import NamedTuple
 
-import jax.numpy as jnp
 import numpy as np
 
 from gearjax.errors import check_range
 from gearjax.gears.vh_catt.geometry import VHCattPair, flank_grid
 from gearjax.gears.vh_catt.tca import ADAPTER
-from gearjax.io import (check_integer, check_keys, check_number, check_string,
+from gearjax.io import (FlankGrid, check_integer, check_keys, check_number, check_string,
                         register_design_kind, require_key)
 from gearjax.tca_result import register_family
 
@@ -57,19 +55,6 @@ def flank_sigma(member: str, flank: str) -> int:
     concave = -1; the gear is mirrored (convex = -1)."""
     s = 1 if flank == "convex" else -1
     return s if member == "pinion" else -s
-
-
-class FlankGrid(NamedTuple):
-    """A flank grid for :func:`gearjax.io.write_flank` (n_z sections x n_u points):
-    points, normals (out of the tooth), params (u, v, psi), xi (axial z, mm),
-    residual (mm/rad of the envelope), converged."""
-
-    points: np.ndarray
-    normals: np.ndarray
-    params: np.ndarray
-    xi: np.ndarray
-    residual: np.ndarray
-    converged: np.ndarray
 
 
 class VHCattDesign:
@@ -97,7 +82,10 @@ class VHCattDesign:
 
     def surface_grid(self, member: str, flank: str, n_u: int, n_v: int) -> FlankGrid:
         """Grid of ``flank`` of tooth 0 of ``member``: ``n_u`` sections across the face
-        width (z from -b/2 to b/2) by ``n_v`` points from the form circle to the tip."""
+        width (z from -b/2 to b/2) by ``n_v`` points from the form circle to the tip.
+        A :class:`gearjax.io.FlankGrid`: points, normals (out of the tooth), params
+        (u, v, NaN: blade and trace coordinates, mm), xi (axial z, mm), residual
+        (mm/rad of the envelope), converged."""
         if member not in ("pinion", "gear"):
             raise ValueError(f"member = {member!r} must be 'pinion' or 'gear'")
         if flank not in ("convex", "concave"):

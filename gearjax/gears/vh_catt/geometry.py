@@ -71,7 +71,8 @@ __all__ = ["VHCattPair", "ToolData", "tool_data", "tool_point", "tool_family", "
            "generated_flank", "pair_geometry", "HANDS", "MEMBERS", "SIDE_NAMES",
            "section_point", "pitch_trace_point", "involute_polar_angle", "tooth_form",
            "flank_grid", "MODULE_RANGE_MM", "CUTTER_RADIUS_RANGE_MM", "MAX_TEETH",
-           "ADDENDUM", "DEDENDUM", "BLADE_DEPTH", "envelope_point", "radius_point"]
+           "ADDENDUM", "DEDENDUM", "BLADE_DEPTH", "envelope_point", "radius_point",
+           "envelope_point_np"]
 
 #: members and their hands (h = +1 pinion, -1 gear: head centres mirrored)
 MEMBERS = ("pinion", "gear")
@@ -185,18 +186,20 @@ class ToolData(NamedTuple):
     cos_a: jax.Array
 
 
-def tool_data(module, alpha, cutter_radius, z, hand, sigma, blade_offset=0.0) -> ToolData:
+def tool_data(module, alpha, cutter_radius, z, hand, sigma, blade_offset=0.0,
+              xp=jnp) -> ToolData:
     """:class:`ToolData` of flank ``sigma`` (+-1) of a member of hand ``hand`` (+-1):
     trace radius ``rho0 = R_T - h sigma (w/2 + e)``, head axis ``x_c = sigma s/2 - h rho0``
-    (``s = w = pi m/2``: the flank passes through ``x = sigma s/2`` in the middle section)."""
-    p = jnp.pi * module
+    (``s = w = pi m/2``: the flank passes through ``x = sigma s/2`` in the middle section).
+    ``xp``: the array module (``numpy`` for the concrete checks of :func:`tooth_form`)."""
+    p = xp.pi * module
     w = 0.5 * p
     r = 0.5 * z * module
-    h = jnp.asarray(hand, float)
-    s = jnp.asarray(sigma, float)
+    h = xp.asarray(hand, float)
+    s = xp.asarray(sigma, float)
     rho0 = cutter_radius - h * s * (0.5 * w + blade_offset)
     xc = s * 0.5 * (p - w) - h * rho0
-    return ToolData(r, xc, rho0, h * s, h, s, jnp.sin(alpha), jnp.cos(alpha))
+    return ToolData(r, xc, rho0, h * s, h, s, xp.sin(alpha), xp.cos(alpha))
 
 
 def tool_point(k: ToolData, uv):
@@ -237,7 +240,7 @@ def _inv(a):
     return jnp.tan(a) - a
 
 
-def pair_geometry(pair: VHCattPair) -> dict:
+def pair_geometry(pair: VHCattPair, xp=jnp) -> dict:
     """Closed-form geometry of the pair (traceable; mm, rad).
 
     Middle section (an involute pair, standard centre distance ``a = r1 + r2``): r1,
@@ -249,33 +252,34 @@ def pair_geometry(pair: VHCattPair) -> dict:
     tangential extent of the pitch-plane trace over the half face,
     ``dx = R - sqrt(R^2 - (b/2)^2)`` for the mean cutter radius (the middle of the
     tooth), overlap ratio ``eps_beta = dx / p`` and total ``eps_gamma = eps_alpha +
-    eps_beta``.  ``start_radius1/2``: radii of the start of active profile.
+    eps_beta``.  ``start_radius1/2``: radii of the start of active profile.  ``xp``: the
+    array module (``numpy`` with a pair of NumPy leaves: concrete, no JAX dispatch).
     """
     m, al = pair.module, pair.pressure_angle
     r1, r2 = 0.5 * pair.z1 * m, 0.5 * pair.z2 * m
-    rb1, rb2 = r1 * jnp.cos(al), r2 * jnp.cos(al)
+    rb1, rb2 = r1 * xp.cos(al), r2 * xp.cos(al)
     ra1, ra2 = r1 + ADDENDUM * m, r2 + ADDENDUM * m
     a = r1 + r2
-    g = a * jnp.sin(al)
-    rho_A = g - jnp.sqrt(ra2 ** 2 - rb2 ** 2)
-    rho_E = jnp.sqrt(ra1 ** 2 - rb1 ** 2)
-    p = jnp.pi * m
-    p_b = p * jnp.cos(al)
+    g = a * xp.sin(al)
+    rho_A = g - xp.sqrt(ra2 ** 2 - rb2 ** 2)
+    rho_E = xp.sqrt(ra1 ** 2 - rb1 ** 2)
+    p = xp.pi * m
+    p_b = p * xp.cos(al)
 
     def form(r, rb):
-        rho_f = jnp.maximum(r * jnp.sin(al) - BLADE_DEPTH * m / jnp.sin(al), 0.0)
-        return jnp.sqrt(rb ** 2 + rho_f ** 2)
+        rho_f = xp.maximum(r * xp.sin(al) - BLADE_DEPTH * m / xp.sin(al), 0.0)
+        return xp.sqrt(rb ** 2 + rho_f ** 2)
 
     R = 0.5 * (pair.cutter_radius1 + pair.cutter_radius2)
     hb = 0.5 * pair.face_width
-    dx = R - jnp.sqrt(R ** 2 - hb ** 2)
+    dx = R - xp.sqrt(R ** 2 - hb ** 2)
     eps_a = (rho_E - rho_A) / p_b
     eps_b = dx / p
-    sap1 = jnp.sqrt(rb1 ** 2 + rho_A ** 2)
-    sap2 = jnp.sqrt(rb2 ** 2 + (g - rho_E) ** 2)
+    sap1 = xp.sqrt(rb1 ** 2 + rho_A ** 2)
+    sap2 = xp.sqrt(rb2 ** 2 + (g - rho_E) ** 2)
     return dict(r1=r1, r2=r2, rb1=rb1, rb2=rb2, ra1=ra1, ra2=ra2, rf1=form(r1, rb1),
                 rf2=form(r2, rb2), root1=r1 - DEDENDUM * m, root2=r2 - DEDENDUM * m,
-                a=a, rho_A=rho_A, rho_E=rho_E, rho_P=rb1 * jnp.tan(al), p=p, p_b=p_b,
+                a=a, rho_A=rho_A, rho_E=rho_E, rho_P=rb1 * xp.tan(al), p=p, p_b=p_b,
                 eps_alpha=eps_a, trace_extent=dx, eps_beta=eps_b, eps_gamma=eps_a + eps_b,
                 start_radius1=sap1, start_radius2=sap2)
 
@@ -304,14 +308,14 @@ def section_point(pair: VHCattPair, member: str, sigma, u, z):
     return fl(jnp.stack([u, _v_of(k, u, z)]))
 
 
-def _u_guess(pair, member, R):
+def _u_guess(pair, member, R, xp=jnp):
     """Blade coordinate of the middle-section involute point at radius ``R`` (rack
     geometry: the height of the rack point that meets the line of action there)."""
     al = pair.pressure_angle
     r = 0.5 * pair.teeth(member) * pair.module
-    rb = r * jnp.cos(al)
-    rho = jnp.sqrt(jnp.maximum(R ** 2 - rb ** 2, 0.0))
-    return (rho - r * jnp.sin(al)) * jnp.sin(al) / jnp.cos(al)
+    rb = r * xp.cos(al)
+    rho = xp.sqrt(xp.maximum(R ** 2 - rb ** 2, 0.0))
+    return (rho - r * xp.sin(al)) * xp.sin(al) / xp.cos(al)
 
 
 def _secant(f, x0, x1, steps: int = 12):
@@ -352,16 +356,18 @@ def pitch_trace_point(pair: VHCattPair, member: str, sigma, z):
 
 #: blade-coordinate step (mm) of the finite-difference slope of the undercut check
 _DU = 1e-4
-#: Newton steps of the plain envelope solve of the checks (quadratic convergence from
-#: the rack's line-of-action start value: machine precision in 4-5 steps)
+#: Newton steps of the plain envelope solve of :func:`envelope_point` (the meshing
+#: equation is linear in psi for a rack-generated member: one step reaches the root,
+#: the others keep it)
 _ENV_STEPS = 8
 
 
 def envelope_point(k: ToolData, u, z):
     """``(point, meshing residual)`` of the generated flank at blade coordinate ``u`` in
     section ``z`` by a plain Newton iteration on the meshing equation (fixed steps, no
-    implicit derivative rule): cheap to compile, for the concrete checks of
-    :func:`tooth_form`.  Same point as :func:`section_point` (tested)."""
+    implicit derivative rule; traceable, cheap to compile).  Same point as
+    :func:`section_point` and as the closed form :func:`envelope_point_np` that
+    :func:`tooth_form` uses (tested)."""
     fam = jax.tree_util.Partial(tool_family, k)
     uv = jnp.stack([u, _v_of(k, u, z)])
 
@@ -376,52 +382,93 @@ def envelope_point(k: ToolData, u, z):
     return tool_family(k, uv, psi), jnp.abs(f(psi))
 
 
-@jax.jit
-def _form_arrays(pair: VHCattPair):
-    geo = pair_geometry(pair)
-    hb = 0.5 * pair.face_width
-    zs = jnp.stack([-hb, 0.0 * hb, hb])
-    m, al = pair.module, pair.pressure_angle
-    u_lo = -BLADE_DEPTH * m / jnp.cos(al)
+def envelope_point_np(k: ToolData, u, z):
+    """``(point, meshing residual)`` of the generated flank at blade coordinates ``u``
+    in sections ``z`` in closed form (NumPy, concrete, broadcasting over ``u`` and
+    ``z``; ``k`` with NumPy leaves): the check route of :func:`tooth_form`, no JAX
+    program.
+
+    The member rolls on its rack (translation ``r psi`` with rotation ``psi`` about
+    the gear axis), so the meshing equation ``n . dr_w/dpsi = 0`` is linear in psi:
+    in the rack frame it reads ``n_x (c_y - r) - n_y (c_x - r psi) = 0`` (Willis: the
+    normal at the contact point meets the instantaneous axis x = r psi, y = r).  The
+    cone normal is ``n ~ (cos(alpha) cos(theta), sigma sin(alpha), h cos(alpha)
+    sin(theta))`` (``c_u x c_v``, module docstring), so
+    ``psi = (c_x - n_x/n_y (c_y - r)) / r`` and the generated point is
+    ``Rz(-psi) [c - (r psi, 0, 0)]``.  Same point as :func:`envelope_point` and
+    :func:`section_point` (the autodiff envelopes; tested).  The residual is the
+    meshing function ``n . dr_w/dpsi`` (unit normal, mm/rad) at that psi, rounding
+    level.  Units: mm, rad.
+    """
+    u, z = np.asarray(u, float), np.asarray(z, float)
+    rho = k.rho0 - k.hs * u * k.sin_a
+    th = np.arcsin(z / rho)                        # theta = v/rho0 with v = rho0 asin(z/rho)
+    cx = k.xc + k.h * rho * np.cos(th)
+    cy = k.r + u * k.cos_a
+    nx, ny, nz = k.cos_a * np.cos(th), k.sigma * k.sin_a, k.h * k.cos_a * np.sin(th)
+    psi = (cx - nx / ny * (cy - k.r)) / k.r
+    X = cx - k.r * psi
+    c, s_ = np.cos(psi), np.sin(psi)
+    q = np.stack([c * X + s_ * cy, -s_ * X + c * cy, np.broadcast_to(z, X.shape)], axis=-1)
+    res = (nx * (cy - k.r) - ny * X) / np.sqrt(nx ** 2 + ny ** 2 + nz ** 2)
+    return q, np.abs(res)
+
+
+def _secant_np(f, x0, x1, steps: int = 12):
+    """:func:`_secant` in NumPy (elementwise over arrays of starts; fixed steps)."""
+    a, b = x0, x1
+    fa, fb = f(a), f(b)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for _ in range(steps):
+            d = fb - fa
+            ok = np.abs(d) > 1e-300
+            x = np.where(ok, b - fb * (b - a) / np.where(ok, d, 1.0), b)
+            a, b, fa, fb = b, x, fb, f(x)
+    return b, np.abs(fb)
+
+
+def _form_arrays(pair: VHCattPair) -> dict:
+    """The arrays of :func:`tooth_form` (NumPy, closed-form envelope): for each member,
+    the 3 sections z = -b/2, 0, b/2 x the 2 flanks in one vectorised pass."""
+    pn = jax.tree_util.tree_map(lambda x: np.asarray(x, float), pair)
+    geo = pair_geometry(pn, xp=np)
+    hb = 0.5 * float(pn.face_width)
+    zs = np.array([-hb, 0.0, hb] * 2)
+    sig = np.repeat([1.0, -1.0], 3)
+    m, al = pn.module, pn.pressure_angle
+    u_lo = -BLADE_DEPTH * m / np.cos(al)
     out = {}
     for mem, ra, sap in (("pinion", geo["ra1"], geo["start_radius1"]),
                          ("gear", geo["ra2"], geo["start_radius2"])):
-        def one(z, sigma):
-            k = tool_data(pair.module, pair.pressure_angle, pair.cutter_radius(mem),
-                          pair.teeth(mem), HANDS[mem], sigma, pair.blade_offset)
+        k = tool_data(m, al, pn.cutter_radius(mem), pn.teeth(mem), HANDS[mem], sig,
+                      pn.blade_offset, xp=np)
 
-            def rad(u):
-                q, _ = envelope_point(k, u, z)
-                return jnp.sqrt(q[0] ** 2 + q[1] ** 2)
+        def rad(u):
+            q, _ = envelope_point_np(k, u, zs)
+            return np.hypot(q[..., 0], q[..., 1])
 
-            u0 = _u_guess(pair, mem, ra)
-            u_tip, res_r = _secant(lambda u: rad(u) - ra, u0, u0 + 1e-3)
-            p, res_m = envelope_point(k, u_tip, z)
-            res = jnp.maximum(res_r, res_m)
+        u0 = _u_guess(pn, mem, ra, xp=np) + np.zeros_like(zs)
+        u_tip, res_r = _secant_np(lambda u: rad(u) - ra, u0, u0 + 1e-3)
+        p, res_m = envelope_point_np(k, u_tip, zs)
+        res = np.maximum(res_r, res_m)
 
-            def slope(u):
-                return rad(u + _DU) - rad(u)
+        def slope(u):
+            return rad(u + _DU) - rad(u)
 
-            # the straight blade's end folds the envelope back (undercut) when the
-            # generated radius decreases there; the fold ends at the singular point
-            und = slope(u_lo) <= 0.0
-
-            def bis(_, c):
-                lo, hi = c
-                mid = 0.5 * (lo + hi)
-                bad = slope(mid) <= 0.0
-                return jnp.where(bad, mid, lo), jnp.where(bad, hi, mid)
-
-            lo, hi = jax.lax.fori_loop(0, 40, bis, (u_lo, jnp.zeros_like(u_lo)))
-            return jnp.arctan2(p[1], p[0]), res, und, jnp.where(und, rad(hi), jnp.nan)
-
-        # one vmap over the 3 sections x 2 flanks (the side is a traced number)
-        ang, res, und, r_u = jax.vmap(one)(jnp.concatenate([zs, zs]),
-                                           jnp.repeat(jnp.array([1.0, -1.0]), 3))
-        a_p, a_m = ang[:3], ang[3:]
-        res_p, res_m, und_p, und_m, r_p, r_m = res[:3], res[3:], und[:3], und[3:], r_u[:3], r_u[3:]
-        out[mem] = dict(top_land=ra * (a_m - a_p), residual=jnp.maximum(res_p, res_m),
-                        undercut=und_p | und_m, undercut_radius=jnp.fmax(r_p, r_m), sap=sap)
+        # the straight blade's end folds the envelope back (undercut) when the
+        # generated radius decreases there; the fold ends at the singular point
+        und = slope(u_lo + np.zeros_like(zs)) <= 0.0
+        lo, hi = u_lo + np.zeros_like(zs), np.zeros_like(zs)
+        for _ in range(40):
+            mid = 0.5 * (lo + hi)
+            bad = slope(mid) <= 0.0
+            lo, hi = np.where(bad, mid, lo), np.where(bad, hi, mid)
+        r_u = np.where(und, rad(hi), np.nan)
+        ang = np.arctan2(p[:, 1], p[:, 0])
+        with np.errstate(invalid="ignore"):
+            r_und = np.fmax(r_u[:3], r_u[3:])
+        out[mem] = dict(top_land=ra * (ang[3:] - ang[:3]), residual=np.maximum(res[:3], res[3:]),
+                        undercut=und[:3] | und[3:], undercut_radius=r_und, sap=np.asarray(sap))
     return out
 
 
@@ -435,10 +482,15 @@ def tooth_form(pair: VHCattPair) -> dict:
     ``undercut_radius_mm`` -- the highest radius reached by the folded part (the
     regular flank starts above it); ``active_undercut`` -- that radius lies above the
     start of active profile (the mating tip would reach the undercut).
+
+    Plain NumPy on the closed-form envelope (:func:`envelope_point_np`), no JAX
+    program: it runs on every :meth:`VHCattPair.create` (every design file load) in
+    about a millisecond.  The tip point is found by a secant iteration on the blade
+    coordinate (``residual_mm``: radius and meshing residual), the end of the fold by
+    bisection of the sign of the finite-difference slope (step 1e-4 mm, 40 halvings).
     """
-    arr = jax.tree_util.tree_map(np.asarray, _form_arrays(pair))
     out = {}
-    for mem, d in arr.items():
+    for mem, d in _form_arrays(pair).items():
         und = bool(d["undercut"].any())
         r_und = float(np.nanmax(d["undercut_radius"])) if und else float("nan")
         out[mem] = dict(top_land_mm=d["top_land"], min_top_land_mm=float(d["top_land"].min()),

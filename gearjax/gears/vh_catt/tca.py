@@ -38,7 +38,8 @@ from gearjax.edge_contact import face_end_contact
 from gearjax.gears.vh_catt.geometry import VHCattPair, generated_flank, pair_geometry
 from gearjax.loaded_contact import TeethOf
 from gearjax.tca import (DEFAULT_APPROACH, Assembly, ContactPath, Misalignment,
-                         check_on_flank_converged, check_tca_options, contact_path, multi_pair)
+                         check_on_flank_converged, check_tca_options, contact_path, multi_pair,
+                         pinion_angle_grid)
 from gearjax.tca_result import (TCAResult, check_side, contact_kinematics, register_family,
                                 strong_float64)
 
@@ -118,9 +119,7 @@ def vh_tca_traced(pair: VHCattPair, mis: Misalignment, code, *, steps_per_pitch:
     round(half_pitches steps_per_pitch)``; with ``face_ends`` the edge contacts at the
     face ends are solved too (:func:`gearjax.edge_contact.face_end_contact`)."""
     x_ref, phi1_ref = reference_guess(pair, code)
-    h = 2.0 * np.pi / (pair.z1 * steps_per_pitch)
-    k = int(round(half_pitches * steps_per_pitch))
-    grid = phi1_ref + h * jnp.arange(-k, k + 1, dtype=float)
+    grid = pinion_angle_grid(phi1_ref, pair.z1, steps_per_pitch, half_pitches)
     r1, r2 = vh_flanks(pair, code)
     asm = vh_assembly(pair)
     path = contact_path(r1, r2, asm, mis, grid, x_ref, line_contact=False, approach=approach)
