@@ -201,8 +201,9 @@ VA_DELTA = 1e-12
 
 def van_albada(a, b, delta=VA_DELTA):
     """Van Albada's limited slope ``[a(b² + δ) + b(a² + δ)]/(a² + b² + 2δ)`` of the
-    backward and forward differences a, b (van Albada, van Leer & Roberts, Astron.
-    Astrophys. 108 (1982) 76–84).  ≈ (a + b)/2 where a ≈ b (second order), → 0 at an
+    backward and forward differences a, b ([VanAlbada1982]: van Albada, van Leer &
+    Roberts, Astron. Astrophys. 108 (1982) 76–84).  ≈ (a + b)/2 where a ≈ b (second
+    order), → 0 at an
     extremum (ab < 0), and — unlike minmod or van Leer's limiter — differentiable
     everywhere (δ > 0), so the Newton Jacobian and the implicit gradients exist."""
     return (a * (b * b + delta) + b * (a * a + delta)) / (a * a + b * b + 2.0 * delta)
