@@ -8,7 +8,9 @@ but the executable), Newton steps, and the time of the implicit gradient of
 (h_c, h_min, μ) w.r.t. all case fields (one adjoint GMRES solve per output).
 Prints a table; not a test.
 
-    python benchmarks/bench_ehl.py [--grids 64 128]   (256²: nested start, reaches max|R| ~ 3e-7 only, so the default tol 1e-9 fails there: docs/ehl.md)
+    python benchmarks/bench_ehl.py [--grids 64 128]   (256²: nested start from 128², solved
+    to the fine-grid default tol 1e-6; 512² stops at max|R| ~ 3e-6 and fails that
+    tolerance: docs/ehl.md)
 """
 
 from __future__ import annotations

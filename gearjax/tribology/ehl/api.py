@@ -187,12 +187,15 @@ FINE_GRID_TOL = 1e-6
 
 def default_tol(n: int) -> float:
     """Default convergence tolerance of :func:`solve_ehl` on an n × n grid: 1e-9 up to
-    ``NESTED_ABOVE`` nodes per side, ``FINE_GRID_TOL`` = 1e-6 above.  On 256² and 512²
-    the Newton iteration stops decreasing max|R| at about 3e-7 (p_h units; the
-    cavitation boundary and side-lobe nodes change their active set from step to
-    step, docs/ehl.md); one further Newton step changes h_c, h_min and μ there by
-    ≤ 3e-4 relative (measured), far below the discretisation error of those grids."""
+    ``NESTED_ABOVE`` nodes per side, ``FINE_GRID_TOL`` = 1e-6 above.  On 256² the
+    Newton iteration stops decreasing max|R| at about 3e-7 (p_h units), on 512² at about
+    3e-6 (flagged at this default): the cavitation-boundary nodes change their active
+    set from step to step (docs/ehl.md, "Grid convergence").  At 256² one further
+    Newton step changes h_c by 2e-4 relative (measured), ~100× below the grid-to-grid
+    change there."""
     return 1e-9 if n <= NESTED_ABOVE else FINE_GRID_TOL
+
+
 NESTED_PTC = 1.0
 
 
@@ -242,7 +245,9 @@ def ehl_gradients(result: EHLResult, case: EHLCase, grid: EHLGrid, angle_deg: fl
 
     Returns ``{"h_c": EHLCase, "h_min": EHLCase, "mu": EHLCase}`` of partial
     derivatives (units: output unit per case-field unit, e.g. dh_c/dF in mm/N,
-    d/dalpha per (1/MPa)).  ValueError if ``result`` is not converged.
+    d/dalpha per (1/MPa)).  ValueError if ``result`` is not converged; NaN entries if
+    the adjoint solve did not reach 1e-8 relative
+    (:data:`gearjax.tribology.ehl.implicit.ADJOINT_ACCEPT`).
     """
     if not bool(result.converged):
         raise ValueError("result.converged = False: gradients exist only at a converged "
