@@ -170,6 +170,31 @@ def test_tooth_form_refusals_name_the_member():
     assert und == {17: True, 18: False}
 
 
+def test_tip_interference_is_refused_at_the_textbook_limit():
+    """Involute interference: the mating tip must not pass the interference point T1
+    (tangency of the line of action with the pinion base circle), i.e. the path of
+    contact must start at rho_A = a sin(alpha) - sqrt(ra2^2 - rb2^2) >= 0 (computed here
+    from the textbook formula).  For z2 = 40, m 4, 20 deg: rho_A = -0.54 mm at z1 = 14,
+    +0.14 mm at z1 = 15.  The start-of-active-profile radius sqrt(rb^2 + rho_A^2) is
+    symmetric in rho_A, so a check on that radius alone accepts z1 = 8 (rho_A = -4.6)."""
+    al = math.radians(20.0)
+    for z1 in (8, 13, 14, 15, 16):
+        rb2, ra2 = 80.0 * math.cos(al), 84.0
+        rho_A = (2.0 * z1 + 80.0) * math.sin(al) - math.sqrt(ra2 ** 2 - rb2 ** 2)
+        p = G.VHCattPair.create(z1, 40, 4.0, 20.0, B, RT, check_form=False)
+        form = G.tooth_form(p)["pinion"]
+        assert abs(form["start_active_roll_mm"] - rho_A) < 1e-9
+        assert form["tip_interference"] == (rho_A < 0.0)
+        if rho_A < 0.0:
+            with pytest.raises(ValueError, match=rf"z1 = {z1}: the gear tip passes"):
+                G.VHCattPair.create(z1, 40, 4.0, 20.0, B, RT)
+        else:
+            G.VHCattPair.create(z1, 40, 4.0, 20.0, B, RT)
+    # the gear side: a large pinion tip against a small gear (z2 = 14, z1 = 40)
+    with pytest.raises(ValueError, match=r"z2 = 14: the pinion tip passes the gear's"):
+        G.VHCattPair.create(40, 14, 4.0, 20.0, B, RT)
+
+
 @pytest.fixture(scope="module")
 def tca_runs(pair):
     opts = dict(kinematics=False, face_ends=False)

@@ -20,7 +20,7 @@ File units: mm, degrees, GPa.  Tables and keys (all required unless marked):
 Every number must be a finite TOML number (tooth numbers TOML integers); unknown
 keys and missing keys raise ``ValueError`` naming the table and the key.  No
 geometry value has a default.  The tooth form is checked on loading (pointed
-teeth and an undercut reaching the active profile are refused,
+teeth, an undercut reaching the active profile and involute tip interference are refused,
 :func:`gearjax.gears.vh_catt.geometry.tooth_form`).
 
 Reference: [VH-CATT] (Table 1: the packaged example ``vh_catt_17x23``).

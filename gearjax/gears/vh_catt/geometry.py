@@ -125,8 +125,8 @@ class VHCattPair:
         face width (0, min(20 m, R_T))  mm, cutter radii 10..1e5 mm and above 10 blade
         spacings ``10 w = 5 pi m``, blade offset [0, 5 m] mm.  ``cutter_radius2`` defaults to ``cutter_radius1``
         (one head cuts both members, as in [VH-CATT] Table 1).  With ``check_form``
-        the tooth form is checked (:func:`tooth_form`): pointed teeth, and undercut
-        reaching the active profile, are refused.
+        the tooth form is checked (:func:`tooth_form`): pointed teeth, undercut
+        reaching the active profile, and involute (tip) interference are refused.
         """
         z1 = check_int("z1", z1, lo=8, hi=MAX_TEETH)
         z2 = check_int("z2", z2, lo=8, hi=MAX_TEETH)
@@ -159,6 +159,16 @@ class VHCattPair:
                                      f"{pair.z1 if mem == 'pinion' else pair.z2}: the {mem} is "
                                      "undercut above its start of active profile (allowed: "
                                      "undercut below it only); raise the tooth number")
+            for mem, mate, zs in (("pinion", "gear", "z1"), ("gear", "pinion", "z2")):
+                roll = form[mem]["start_active_roll_mm"]
+                if roll < 0.0:
+                    raise ValueError(
+                        f"{zs} = {pair.z1 if mem == 'pinion' else pair.z2}: the {mate} tip "
+                        f"passes the {mem}'s interference point by {-roll:.4g} mm along the "
+                        f"line of action (involute interference: the {mem} flank would be "
+                        "needed below its base circle; allowed: start of active profile at or "
+                        f"beyond the interference point); raise {zs} or lower the {mate}'s "
+                        "tooth number")
         return pair
 
     def cutter_radius(self, member: str):
@@ -438,6 +448,8 @@ def _form_arrays(pair: VHCattPair) -> dict:
     m, al = pn.module, pn.pressure_angle
     u_lo = -BLADE_DEPTH * m / np.cos(al)
     out = {}
+    g_line = geo["a"] * np.sin(al)
+    roll = {"pinion": geo["rho_A"], "gear": g_line - geo["rho_E"]}
     for mem, ra, sap in (("pinion", geo["ra1"], geo["start_radius1"]),
                          ("gear", geo["ra2"], geo["start_radius2"])):
         k = tool_data(m, al, pn.cutter_radius(mem), pn.teeth(mem), HANDS[mem], sig,
@@ -468,7 +480,8 @@ def _form_arrays(pair: VHCattPair) -> dict:
         with np.errstate(invalid="ignore"):
             r_und = np.fmax(r_u[:3], r_u[3:])
         out[mem] = dict(top_land=ra * (ang[3:] - ang[:3]), residual=np.maximum(res[:3], res[3:]),
-                        undercut=und[:3] | und[3:], undercut_radius=r_und, sap=np.asarray(sap))
+                        undercut=und[:3] | und[3:], undercut_radius=r_und, sap=np.asarray(sap),
+                        roll_start=np.asarray(roll[mem]))
     return out
 
 
@@ -481,7 +494,14 @@ def tooth_form(pair: VHCattPair) -> dict:
     some section (the generated profile folds back: ``d radius/du <= 0``);
     ``undercut_radius_mm`` -- the highest radius reached by the folded part (the
     regular flank starts above it); ``active_undercut`` -- that radius lies above the
-    start of active profile (the mating tip would reach the undercut).
+    start of active profile (the mating tip would reach the undercut);
+    ``start_active_roll_mm`` -- distance along the line of action from the member's
+    interference point (the tangency of the line of action with its base circle) to the
+    start of active profile, ``rho_A`` (pinion) or ``a sin(alpha) - rho_E`` (gear);
+    ``tip_interference`` -- it is negative: the mating tip passes the interference
+    point and would need the flank below the base circle, where there is no involute
+    (``start_active_radius_mm`` = sqrt(rb² + roll²) then lies above the base circle and
+    alone would not show it).
 
     Plain NumPy on the closed-form envelope (:func:`envelope_point_np`), no JAX
     program: it runs on every :meth:`VHCattPair.create` (every design file load) in
@@ -497,6 +517,8 @@ def tooth_form(pair: VHCattPair) -> dict:
                         undercut=und, undercut_radius_mm=r_und,
                         active_undercut=bool(und and r_und >= float(d["sap"])),
                         start_active_radius_mm=float(d["sap"]),
+                        start_active_roll_mm=float(d["roll_start"]),
+                        tip_interference=bool(float(d["roll_start"]) < 0.0),
                         residual_mm=float(d["residual"].max()))
     return out
 
