@@ -220,9 +220,11 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
     contact actually made (traceable).
 
     ``path``, ``margin`` : the surface contact path and its boundary margin (mm).
-    ``margin_parts(p1_body, p2_body) -> (face1, tip1, root1, face2, tip2, root2)`` :
+    ``margin_parts(p1_body, p2_body, uv1, uv2) -> (face1, tip1, root1, face2, tip2, root2)`` :
     boundary margins (mm, >= 0 inside) of each member's face width, tip and root (form
-    circle / fillet) boundaries at body-frame points (N, 3); without ``tips`` also
+    circle / fillet) boundaries at body-frame points (N, 3) with their flank parameters
+    (N, 2) (a generated flank continues past its edge of regression onto a second
+    branch at the same radii: the parameters tell the branches apart); without ``tips`` also
     ``(face1, rest1, face2, rest2)``, tip and root together.  ``g1, g2`` : face-end
     functions of pinion and gear (module docstring).  ``tips = (t1, t2)`` : tip-edge
     functions ``t_k(q)`` (mm, zero on the tip surface, > 0 below it) of pinion and
@@ -316,7 +318,7 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
 
     (ph2, uv1, uv2, q1, q2, n1, n2, psi1, psi2) = jax.vmap(
         lambda zz: jax.vmap(post)(zz, path.phi1))(Z)
-    parts = jax.vmap(margin_parts)(q1, q2)
+    parts = jax.vmap(margin_parts)(q1, q2, uv1, uv2)
     if len(parts) == 4:
         # face ends only: (face1, rest1, face2, rest2), tip and root margins together
         if tips is not None:

@@ -27,18 +27,22 @@ JSON_KEYS_DOC = """JSON keys:
   envelope_arcsec  unloaded TE envelope (max over pairs on the drive side, min on coast)
   ptp_arcsec       peak-to-peak of the sampled envelope over one pitch
   transfer_phi1_rad  pinion angles of the transfers into and out of pair 0
-  contact_ratio    on-flank interval of pair 0 / angular pitch
+  contact_ratio    on-flank interval of pair 0 / angular pitch (involute line contact:
+                   the transverse contact ratio, interval in roll distance / base pitch)
+  overlap_ratio    involute line contact: b tan(beta)/(r1 2 pi/z1) (null otherwise)
   path             {axial1_mm, radial1_mm, axial2_mm, radial2_mm}: contact point on
                    pinion and gear flank in axial projection (body z, radius; for
                    bevel gears z is measured from the crossing point); bevel gears
                    also {xi1, h1_mm, xi2, h2_mm}: face-width position (-1 toe, +1
-                   heel) and height above the root cone
+                   heel) and height above the root cone; null where pair 0 does
+                   not touch
   (with --side both the output is {"drive": {...}, "coast": {...}})
   error            only for a side whose TCA failed: the reason and what to try (that
                    side's object is {"error": "..."}; with one side, the key sits next
                    to "input"); the exit status is then 3
   ellipses         {semi_major_mm, semi_minor_mm}: contact ellipse (elastic approach
-                   0.00632 mm; null = infinite, line contact)
+                   0.00632 mm; null = infinite, line contact, and where pair 0
+                   does not touch or touches at an edge)
   flags            per grid point: converged, on_flank (the flanks touch inside both
                    flank boundaries), edge (pair 0 touches at an edge: a face end or a
                    tooth tip, no ellipse and no kinematics there), edge_end (null, or
@@ -123,10 +127,13 @@ def _side_json(res):
     kinds = (np.full(conv.shape, -1) if path.edge_kind is None
              else np.asarray(path.edge_kind))
     te = np.where(touch, np.asarray(path.te), np.nan) / ARCSEC
-    pth = {k: _nan_list(getattr(path, k[:-3])) for k in
+    # where pair 0 does not touch (off the flanks, not converged) there is no contact
+    # point: null, never a number that reads as a position on the flank
+    touched = lambda a: _nan_list(np.where(touch, np.asarray(a, float), np.nan))  # noqa: E731
+    pth = {k: touched(getattr(path, k[:-3])) for k in
            ("axial1_mm", "radial1_mm", "axial2_mm", "radial2_mm")}
     if res.family == "hypoid":
-        pth.update({k: _nan_list(res.coords[c]) for k, c in
+        pth.update({k: touched(res.coords[c]) for k, c in
                     (("xi1", "xi1"), ("h1_mm", "h1"), ("xi2", "xi2"), ("h2_mm", "h2"))})
     out = {
         "phi1_rad": _nan_list(path.phi1),
@@ -136,9 +143,11 @@ def _side_json(res):
         "ptp_arcsec": float(multi.ptp) / ARCSEC,
         "transfer_phi1_rad": _nan_list(multi.transfer_phi1),
         "contact_ratio": float(multi.contact_ratio),
+        "overlap_ratio": (float(res.coords["overlap_ratio"]) if "overlap_ratio" in res.coords
+                          else None),
         "path": pth,
-        "ellipses": {"semi_major_mm": _nan_list(path.semi_major),
-                     "semi_minor_mm": _nan_list(path.semi_minor)},
+        "ellipses": {"semi_major_mm": touched(path.semi_major),
+                     "semi_minor_mm": touched(path.semi_minor)},
         "flags": {"converged": conv.tolist(), "on_flank": on.tolist(),
                   "edge": edge.tolist(), "off_flank": (conv & ~touch).tolist(),
                   "edge_end": [EDGE_NAMES[k] if e else None for k, e in zip(kinds, edge)]},
@@ -251,7 +260,11 @@ def run(args) -> int:
         on = np.asarray(out["flags"]["on_flank"])
         edge = np.asarray(out["flags"]["edge"])
         te = np.array([np.nan if v is None else v for v in out["te_arcsec"]])
-        sm = np.asarray(path.semi_major)
+        touch = on | edge
+        sm = np.where(touch, np.asarray(path.semi_major), np.nan)
+        sn = np.where(touch, np.asarray(path.semi_minor), np.nan)
+        ax = np.where(touch, np.asarray(path.axial1), np.nan)
+        rad = np.where(touch, np.asarray(path.radial1), np.nan)
         print(f"# TCA {args.design} ({sd}); misalign {mis_kv or 'none'}")
         print(f"# TE p-t-p {out['ptp_arcsec']:.4f} arcsec, contact ratio {out['contact_ratio']:.4f}")
         print(f"{'phi1[deg]':>10s} {'TE[arcsec]':>11s} {'axial1':>9s} {'radius1':>9s} "
@@ -260,8 +273,8 @@ def run(args) -> int:
             flag = ("ok" if on[i] else "edge" if edge[i] else "off" if conv[i]
                     else "no-conv")
             print(f"{math.degrees(float(path.phi1[i])):10.4f} {_cell(te[i], 11, 5)} "
-                  f"{float(path.axial1[i]):9.4f} {float(path.radial1[i]):9.4f} "
-                  f"{_cell(2 * sm[i], 8, 4)} {_cell(2 * float(path.semi_minor[i]), 8, 4)} {flag}")
+                  f"{_cell(ax[i], 9, 4)} {_cell(rad[i], 9, 4)} "
+                  f"{_cell(2 * sm[i], 8, 4)} {_cell(2 * sn[i], 8, 4)} {flag}")
     for sd, msg in failed.items():
         print(f"# TCA {args.design} ({sd}): FAILED, no result: {msg}")
     return status

@@ -274,7 +274,7 @@ def hypoid_face_ends(pair: HypoidPair):
         return (0.5 * fl.blank.face_width * (1.0 - jnp.abs(xi)), tip_gap,
                 above_root - h_fillet)
 
-    def margin_parts(q1, q2):
+    def margin_parts(q1, q2, uv1=None, uv2=None):
         return (jax.vmap(lambda q: parts(*members[0], q))(q1)
                 + jax.vmap(lambda q: parts(*members[1], q))(q2))
 

@@ -39,8 +39,9 @@ Units: mm, rad.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import partial
+from typing import NamedTuple
 
 import jax
 import jax.numpy as jnp
@@ -56,12 +57,13 @@ from gearjax.loaded_contact import TeethOf
 from gearjax.tca_result import (TCAResult, check_side, contact_kinematics, register_family,
                                 strong_float64)
 from gearjax.tca import (DEFAULT_APPROACH, Assembly, ContactPath, Misalignment, MultiPair,
-                  contact_path, multi_pair, check_on_flank_converged, check_tca_options,
-                  pinion_angle_grid)
+                  contact_path, first_crossing, multi_pair, check_on_flank_converged,
+                  check_tca_options, pinion_angle_grid)
 
 __all__ = ["InvoluteTCA", "crowned_pinion_flank", "involute_assembly", "involute_tca_traced",
            "involute_tca", "involute_margin", "tca_summary", "SUMMARY_KEYS", "reference_guess",
            "misalignment_sensitivity", "check_on_flank_converged", "involute_limits",
+           "MemberLimits", "signed_roll", "transverse_contact_ratio", "overlap_ratio",
            "involute_result_traced"]
 
 
@@ -99,6 +101,24 @@ class InvoluteTCA:
         return cls(pair, f(da * (np.pi / 180.0)), f(a), f(c), f(b))
 
 
+def split_teeth(des: InvoluteTCA):
+    """``(blank, teeth)``: the design with its tooth numbers replaced by 0 and the tooth
+    numbers as a (2,) float array -- the arguments of the jitted programs of this
+    module, so that one compiled program serves every pair of the same options
+    (tooth numbers are static fields of :class:`InvolutePair`, part of a program's
+    cache key; inside the program they only enter arithmetic: pitch radii, angular
+    pitch, ratio).  :func:`join_teeth` puts them back inside the trace."""
+    pair = des.pair
+    teeth = jnp.asarray(np.array([pair.z1, pair.z2], dtype=float))
+    return replace(des, pair=replace(pair, z1=0, z2=0)), teeth
+
+
+def join_teeth(blank: InvoluteTCA, teeth) -> InvoluteTCA:
+    """The design of :func:`split_teeth` with traced tooth numbers (inside a trace only:
+    the result is not passed through a JAX transformation as a pytree)."""
+    return replace(blank, pair=replace(blank.pair, z1=teeth[0], z2=teeth[1]))
+
+
 def crowned_pinion_flank(des: InvoluteTCA, side: int) -> GeneratedSurface:
     """Pinion flank enveloped by the modified rack (body frame, as in
     :func:`gearjax.gears.involute.geometry.generated_flank`)."""
@@ -134,21 +154,85 @@ def _form_radius(m_n, alpha_n, beta, x, z):
     return jnp.sqrt(rb ** 2 + rho_f ** 2)
 
 
+class MemberLimits(NamedTuple):
+    """Working-flank boundaries of one rack-generated member in roll distance (mm).
+
+    A point of the transverse involute at radius ``R`` has the roll distance
+    ``rho = +-sqrt(R^2 - r_b^2)`` (the length of its tangent to the base circle).  The
+    rack's straight flank at height ``h`` above the gear's pitch line generates the
+    point ``rho(h) = r sin(alpha_t) + h/sin(alpha_t)`` (ISO 21771: the rack point meets
+    the line of action there), so the working flank -- heights from the end of the
+    straight rack flank ``h_F = -m_n (1 - x)`` (the form circle) to the tip -- is
+    ``rho_F <= rho <= rho_a`` with ``rho_F = max(r sin alpha_t - m_n (1 - x)/sin alpha_t, 0)``,
+    ``rho_a = sqrt(r_a^2 - r_b^2)``.  The envelope of the unbounded rack plane goes on
+    past the base circle (``rho < 0``, heights below ``-r sin^2 alpha_t``) onto the
+    second branch of the involute, which lies at the same radii as the working
+    flank: a test of the radius alone (``R >= r_F``) takes that branch for flank.  The
+    sign of ``rho`` is therefore read from the generating rack coordinate ``u``
+    (``rho < 0`` for ``u < u_b``, the rack point generating the base-circle point).
+
+    rb : base radius.  rho_a, rho_f : roll distances of the tip and form circles.
+    u_b : rack profile coordinate (mm, from the datum line, as in
+        :func:`~gearjax.gears.involute.geometry.rack_family_data`) of the base-circle point.
+    ra : tip radius (the tip-edge function).
+    """
+
+    rb: jax.Array
+    rho_a: jax.Array
+    rho_f: jax.Array
+    u_b: jax.Array
+    ra: jax.Array
+
+
+def _member_limits(m_n, alpha_n, beta, x, z, ra) -> MemberLimits:
+    """:class:`MemberLimits` of the member cut by the rack (m_n, alpha_n, beta, x) with
+    ``z`` teeth and tip radius ``ra`` (mm, rad; traceable)."""
+    m_t = m_n / jnp.cos(beta)
+    at = jnp.arctan(jnp.tan(alpha_n) / jnp.cos(beta))
+    r = 0.5 * z * m_t
+    rb = r * jnp.cos(at)
+    rho_f = jnp.maximum(r * jnp.sin(at) - m_n * (1.0 - x) / jnp.sin(at), 0.0)
+    rho_a = jnp.sqrt(jnp.maximum(ra ** 2 - rb ** 2, 0.0))
+    u_b = (-r * jnp.sin(at) ** 2 - x * m_n) / jnp.cos(alpha_n)
+    return MemberLimits(rb, rho_a, rho_f, u_b, ra)
+
+
+def signed_roll(lim: MemberLimits, q, u):
+    """Signed roll distance (mm) of the body point ``q`` (..., 3) generated by the rack
+    coordinate ``u`` (...): ``sign(u - u_b) sqrt(max(|q_xy|^2 - r_b^2, 0))``
+    (:class:`MemberLimits`)."""
+    R2 = jnp.sum(q[..., :2] ** 2, axis=-1)
+    mag = jnp.sqrt(jnp.maximum(R2 - lim.rb ** 2, 0.0))
+    return jnp.where(u >= lim.u_b, mag, -mag)
+
+
 def _flank_limits(des: InvoluteTCA):
-    """``(ra1, rf1, ra2, rf2, b/2)``: tip and form radii of pinion and gear and the half
+    """``(pinion, gear, b/2)``: the :class:`MemberLimits` of pinion and gear and the half
     face width (mm), the boundaries of both working flanks."""
     p = des.pair
     geo = pair_geometry(p)
-    rf1 = _form_radius(p.module, p.pressure_angle + des.dalpha, p.helix, p.x1, p.z1)
-    rf2 = _form_radius(p.module, p.pressure_angle, p.helix, p.x2, p.z2)
-    return geo["ra1"], rf1, geo["ra2"], rf2, 0.5 * des.face_width
+    lim1 = _member_limits(p.module, p.pressure_angle + des.dalpha, p.helix, p.x1, p.z1,
+                          geo["ra1"])
+    lim2 = _member_limits(p.module, p.pressure_angle, p.helix, p.x2, p.z2, geo["ra2"])
+    return lim1, lim2, 0.5 * des.face_width
+
+
+def _margins(lim1, lim2, hb, q1, q2, uv1, uv2):
+    """The six boundary margins (mm, >= 0 inside): pinion tip, form circle, face width,
+    then the same of the gear; tip and form in roll distance (:class:`MemberLimits`),
+    so that they are linear in the pinion angle along an involute path of contact."""
+    rho1 = signed_roll(lim1, q1, uv1[..., 0])
+    rho2 = signed_roll(lim2, q2, uv2[..., 0])
+    return (lim1.rho_a - rho1, rho1 - lim1.rho_f, hb - jnp.abs(q1[..., 2]),
+            lim2.rho_a - rho2, rho2 - lim2.rho_f, hb - jnp.abs(q2[..., 2]))
 
 
 def involute_margin(des: InvoluteTCA, path: ContactPath):
-    """Boundary margin (mm, >= 0 inside both flanks) along the path, and its parts."""
-    ra1, rf1, ra2, rf2, hb = _flank_limits(des)
-    parts = jnp.stack([ra1 - path.radial1, path.radial1 - rf1, hb - jnp.abs(path.axial1),
-                       ra2 - path.radial2, path.radial2 - rf2, hb - jnp.abs(path.axial2)])
+    """Boundary margin (mm, >= 0 inside both flanks) along the path, and its parts
+    (pinion tip, form circle and face width, the same of the gear; tip and form circle
+    in roll distance, :class:`MemberLimits`)."""
+    lim1, lim2, hb = _flank_limits(des)
+    parts = jnp.stack(_margins(lim1, lim2, hb, path.p1_body, path.p2_body, path.uv1, path.uv2))
     return jnp.min(parts, axis=0), parts
 
 
@@ -169,25 +253,24 @@ def default_line_contact(des: InvoluteTCA) -> bool:
 
 def involute_face_ends(des: InvoluteTCA):
     """``(margin_parts, g1, g2, (t1, t2))`` of :func:`gearjax.edge_contact.face_end_contact`:
-    the boundary margins (face width, tip circle, form circle) of each member at body
-    points, the face-end functions ``g(q, e) = q_z - e b/2`` of pinion and gear and
-    their tip-edge functions ``t_k(q) = r_ak - |q_xy|`` (addendum cylinder; mm)."""
-    ra1, rf1, ra2, rf2, hb = _flank_limits(des)
+    the boundary margins (face width, tip circle, form circle; :func:`_margins`) of each
+    member at body points and their flank parameters, the face-end functions
+    ``g(q, e) = q_z - e b/2`` of pinion and gear and their tip-edge functions
+    ``t_k(q) = r_ak - |q_xy|`` (addendum cylinder; mm)."""
+    lim1, lim2, hb = _flank_limits(des)
 
-    def margin_parts(q1, q2):
-        r1 = jnp.linalg.norm(q1[..., :2], axis=-1)
-        r2 = jnp.linalg.norm(q2[..., :2], axis=-1)
-        return (hb - jnp.abs(q1[..., 2]), ra1 - r1, r1 - rf1,
-                hb - jnp.abs(q2[..., 2]), ra2 - r2, r2 - rf2)
+    def margin_parts(q1, q2, uv1, uv2):
+        t1, f1, w1, t2, f2, w2 = _margins(lim1, lim2, hb, q1, q2, uv1, uv2)
+        return (w1, t1, f1, w2, t2, f2)
 
     def g(q, e):
         return q[2] - e * hb
 
     def t1(q):
-        return ra1 - jnp.linalg.norm(q[:2])
+        return lim1.ra - jnp.linalg.norm(q[:2])
 
     def t2(q):
-        return ra2 - jnp.linalg.norm(q[:2])
+        return lim2.ra - jnp.linalg.norm(q[:2])
 
     return margin_parts, g, g, (t1, t2)
 
@@ -264,7 +347,54 @@ def involute_tca_traced(des: InvoluteTCA, mis: Misalignment, *, side: int = -1,
                                            steps_per_pitch=steps_per_pitch,
                                            tips=tips if tip_edges else None)
     multi = multi_pair(path, margin, steps_per_pitch, p.z1, drive=(side < 0), n_pairs=n_pairs)
+    if line_contact:
+        multi = multi._replace(contact_ratio=transverse_contact_ratio(des, path, margin,
+                                                                      multi.contact_ratio))
     return path, margin, multi
+
+
+def transverse_contact_ratio(des: InvoluteTCA, path: ContactPath, margin, cr_angle):
+    """Transverse contact ratio of a line-contact path (traceable).
+
+    In line-contact mode one curve of the contact lines is solved (a fixed rack lead
+    coordinate ``v1``); on a helical pair its points lie at different face-width
+    positions, so its interval of pinion angles mixes the transverse motion with the
+    screw motion along the face.  The roll distance ``rho1`` of the pinion point
+    (:class:`MemberLimits`) is the same in every transverse section of the screw
+    surface, so the transverse contact ratio is the on-flank interval in roll distance
+    over the transverse base pitch, ``eps_alpha = (rho1_out - rho1_in)/p_bt1``,
+    ``p_bt1 = 2 pi r_b1/z1`` (ISO 21771), with the boundary crossings interpolated
+    linearly in the margin (exact for an involute path: the margins are linear in the
+    roll distance).  For a spur pair it equals the angular interval over the pitch.
+    NaN where ``cr_angle`` (the angular contact ratio of :func:`gearjax.tca.multi_pair`)
+    is NaN (no entry before the exit within the grid).
+    """
+    lim1, _, _ = _flank_limits(des)
+    rho1 = signed_roll(lim1, path.p1_body, path.uv1[:, 0])
+    m = jnp.where(path.converged, margin, -1.0)
+    lo = first_crossing(rho1, m)
+    hi = first_crossing(rho1[::-1], m[::-1])
+    p_bt1 = 2.0 * jnp.pi * lim1.rb / des.pair.z1
+    return jnp.where(jnp.isfinite(cr_angle), jnp.abs(hi - lo) / p_bt1, jnp.nan)
+
+
+def overlap_ratio(des: InvoluteTCA, path: ContactPath, r1):
+    """Overlap ratio of a line-contact pair from the generated pinion flank (traceable).
+
+    The contact lines of a helical pair sweep the face width while the pinion turns
+    by ``b k`` more than a transverse section needs, ``k = d theta/dz`` the lead of the
+    flank (polar angle per axial length along a line of constant radius:
+    ``tan(beta)/r1`` for a helicoid).  ``k`` is taken from the enveloped flank ``r1``
+    itself, by differentiating its point along the rack's lead direction at the
+    reference contact, so ``eps_beta = b |k| / (2 pi/z1)`` is independent of the
+    closed form ``b sin(beta)/(pi m_n)`` of ISO 21771 it is tested against.
+    """
+    mid = path.phi1.shape[0] // 2
+    uv = jax.lax.stop_gradient(path.uv1[mid])
+    q, dq = jax.jvp(lambda v: r1(jnp.stack([uv[0], v])), (uv[1],), (jnp.ones(()),))
+    dtheta = (q[0] * dq[1] - q[1] * dq[0]) / (q[0] ** 2 + q[1] ** 2)
+    k = dtheta / dq[2]
+    return des.face_width * jnp.abs(k) / (2.0 * jnp.pi / des.pair.z1)
 
 
 # the side code (-1 drive, +1 coast) enters the flanks and the envelope only as a
@@ -273,9 +403,9 @@ def involute_tca_traced(des: InvoluteTCA, mis: Misalignment, *, side: int = -1,
 
 @partial(jax.jit, static_argnames=("steps_per_pitch", "half_pitches", "line_contact",
                                    "n_pairs"))
-def _involute_tca_jit(des, mis, side, steps_per_pitch, half_pitches, line_contact, n_pairs,
-                      approach):
-    return involute_tca_traced(des, mis, side=side, steps_per_pitch=steps_per_pitch,
+def _involute_tca_jit(blank, teeth, mis, side, steps_per_pitch, half_pitches, line_contact,
+                      n_pairs, approach):
+    return involute_tca_traced(join_teeth(blank, teeth), mis, side=side, steps_per_pitch=steps_per_pitch,
                                half_pitches=half_pitches, line_contact=line_contact,
                                n_pairs=n_pairs, approach=approach)
 
@@ -297,7 +427,7 @@ def involute_tca(des: InvoluteTCA, mis: Misalignment | None = None, *, side: int
         mis = Misalignment.zero()
     if line_contact is None:
         line_contact = default_line_contact(des)
-    out = _involute_tca_jit(strong_float64(des), strong_float64(mis), float(side),
+    out = _involute_tca_jit(*split_teeth(strong_float64(des)), strong_float64(mis), float(side),
                             int(steps_per_pitch),
                             float(half_pitches), bool(line_contact), int(n_pairs), float(approach))
     if strict:
@@ -326,8 +456,9 @@ def tca_summary(path: ContactPath, multi: MultiPair):
 
 
 @partial(jax.jit, static_argnames=("steps_per_pitch", "half_pitches", "line_contact"))
-def _sensitivity_jit(des, mis, side, steps_per_pitch, half_pitches, line_contact):
+def _sensitivity_jit(des, teeth, mis, side, steps_per_pitch, half_pitches, line_contact):
     def f(d, m):
+        d = join_teeth(d, teeth)
         path, _, multi = involute_tca_traced(d, m, side=side, steps_per_pitch=steps_per_pitch,
                                              half_pitches=half_pitches,
                                              line_contact=line_contact)
@@ -353,12 +484,14 @@ def misalignment_sensitivity(des: InvoluteTCA, mis: Misalignment | None = None, 
         mis = Misalignment.zero()
     if line_contact is None:
         line_contact = default_line_contact(des)
-    vals, (jac_des, jac) = _sensitivity_jit(strong_float64(des), strong_float64(mis), float(side),
+    vals, (jac_des, jac) = _sensitivity_jit(*split_teeth(strong_float64(des)), strong_float64(mis),
+                                            float(side),
                                             int(steps_per_pitch), float(half_pitches),
                                             bool(line_contact))
     values = {k: float(v) for k, v in zip(SUMMARY_KEYS, np.asarray(vals))}
     table = {k: {name: float(np.asarray(getattr(jac, name))[i])
                  for name in ("dE", "dP", "dG", "dSigma")} for i, k in enumerate(SUMMARY_KEYS)}
+    jac_des = replace(jac_des, pair=replace(jac_des.pair, z1=des.pair.z1, z2=des.pair.z2))
     return values, table, jac_des
 
 
@@ -387,14 +520,17 @@ def _result_parts(des: InvoluteTCA, mis: Misalignment, code, *, steps_per_pitch:
                                               half_pitches=half_pitches, line_contact=line_contact,
                                               n_pairs=n_pairs, approach=approach)
     _, parts = involute_margin(des, path)
+    p = des.pair
+    r1 = crowned_pinion_flank(des, code)
+    coords = {"margin_parts": parts}
+    if line_contact:
+        coords["overlap_ratio"] = overlap_ratio(des, path, r1)
     kin = None
     if kinematics:
-        p = des.pair
-        r1 = crowned_pinion_flank(des, code)
         r2 = generated_flank(p.module, p.pressure_angle, -p.helix, p.x2, p.z2, code)
         kin = contact_kinematics(r1, r2, involute_assembly(p), mis, path,
                                  line_contact=line_contact)
-    return path, margin, multi, {"margin_parts": parts}, kin
+    return path, margin, multi, coords, kin
 
 
 def involute_result_traced(des: InvoluteTCA, mis: Misalignment, *, side: str = "drive",
@@ -411,16 +547,16 @@ def involute_result_traced(des: InvoluteTCA, mis: Misalignment, *, side: str = "
 
 @partial(jax.jit, static_argnames=("steps_per_pitch", "half_pitches", "line_contact",
                                    "n_pairs", "kinematics"))
-def _result_jit(des, mis, approach, code, *, steps_per_pitch, half_pitches, line_contact,
-                n_pairs, kinematics):
-    return _result_parts(des, mis, code, steps_per_pitch=steps_per_pitch,
+def _result_jit(blank, teeth, mis, approach, code, *, steps_per_pitch, half_pitches,
+                line_contact, n_pairs, kinematics):
+    return _result_parts(join_teeth(blank, teeth), mis, code, steps_per_pitch=steps_per_pitch,
                          half_pitches=half_pitches, line_contact=line_contact, n_pairs=n_pairs,
                          approach=approach, kinematics=kinematics)
 
 
 def _result(des, mis, approach, side, **static) -> TCAResult:
     """The jitted TCA of ``side`` (one program for both sides) as a TCAResult."""
-    parts = _result_jit(strong_float64(des), strong_float64(mis), approach,
+    parts = _result_jit(*split_teeth(strong_float64(des)), strong_float64(mis), approach,
                         float(_side_code(side)), **static)
     return TCAResult(*parts, side, "involute")
 

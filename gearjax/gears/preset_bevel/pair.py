@@ -113,7 +113,7 @@ def preset_face_ends(des: PresetBevelDesign):
         L, h = flank_coordinates(des, q, member)
         return jnp.minimum(Ao - L, L - Ai), des.addendum - h, h + des.dedendum
 
-    def margin_parts(q1, q2):
+    def margin_parts(q1, q2, uv1=None, uv2=None):
         return parts(q1, 1) + parts(q2, 2)
 
     def end(q, e):

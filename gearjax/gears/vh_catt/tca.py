@@ -99,7 +99,7 @@ def vh_margin(pair: VHCattPair, path: ContactPath):
 def _face_ends(pair: VHCattPair):
     ra1, rf1, ra2, rf2, hb = _limits(pair)
 
-    def margin_parts(q1, q2):
+    def margin_parts(q1, q2, uv1=None, uv2=None):
         r1 = jnp.linalg.norm(q1[..., :2], axis=-1)
         r2 = jnp.linalg.norm(q2[..., :2], axis=-1)
         return (hb - jnp.abs(q1[..., 2]), jnp.minimum(ra1 - r1, r1 - rf1),
