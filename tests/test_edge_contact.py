@@ -93,12 +93,16 @@ def test_aligned_conjugate_pair_has_no_edge_contact_and_is_unchanged(traced, des
     path, margin, multi = traced[True](des, mis)
     ref, ref_margin, ref_multi = traced[False](des, mis)
     assert np.all(np.asarray(path.edge_kind) == -1)
-    np.testing.assert_array_equal(np.asarray(path.te), np.asarray(ref.te))
-    np.testing.assert_array_equal(np.asarray(margin), np.asarray(ref_margin))
-    assert float(multi.contact_ratio) == float(ref_multi.contact_ratio)
+    # the two programs (with and without the edge solves) are compiled separately and
+    # may round the common surface solve differently (1e-16 rad seen); an edge that
+    # replaced the surface contact would lead it by more than EDGE_LEAD = 1e-9 rad
+    np.testing.assert_allclose(np.asarray(path.te), np.asarray(ref.te), rtol=0, atol=1e-14)
+    np.testing.assert_allclose(np.asarray(margin), np.asarray(ref_margin), rtol=0, atol=1e-12)
+    assert float(multi.contact_ratio) == pytest.approx(float(ref_multi.contact_ratio), abs=1e-12)
     # no spurious tip contact: a tip corner off the line of action has clearance, so
-    # the TE envelope is the same to the last bit with and without the edge solve
-    np.testing.assert_array_equal(np.asarray(multi.envelope), np.asarray(ref_multi.envelope))
+    # the TE envelope is the same (to rounding) with and without the edge solve
+    np.testing.assert_allclose(np.asarray(multi.envelope), np.asarray(ref_multi.envelope),
+                               rtol=0, atol=1e-14)
 
 
 def _d_mis(traced, des, mis, direction):

@@ -73,9 +73,11 @@ def register(sub):
                    help="grid positions, 10k+1 (k >= 1): 4k steps per pitch, "
                         "1.25 pitches each side (with --pitches P: P pitches each side, "
                         "8kP+1 positions)")
-    p.add_argument("--pitches", type=float, default=1.25,
-                   help="half-range of the grid in angular pitches (0.75 ... 4, default 1.25); "
-                        "widen it when the contact of one tooth pair spans more than the grid")
+    p.add_argument("--pitches", type=float, default=None,
+                   help="half-range of the grid in angular pitches (0.75 ... 4, default 1.25; "
+                        "an involute pair whose path of contact reaches further from the pitch "
+                        "point gets 2, 3 or 4 and 5, 7 or 9 tooth pairs); widen it when the "
+                        "contact of one tooth pair spans more than the grid")
     p.add_argument("--kinematics", action="store_true",
                    help="also compute rolling/sliding velocities, SRR and effective radii at "
                         "the contact points (JSON key 'kinematics')")
@@ -185,7 +187,7 @@ def _failure(side, exc, args) -> str:
     tries = []
     if args.misalign.strip():
         tries.append("smaller or fewer --misalign values")
-    if args.pitches < 2.0:
+    if args.pitches is None or args.pitches < 2.0:
         tries.append("a wider grid (--pitches 2)")
     if isinstance(exc, NoContactError):
         what = "the flanks do not touch"
@@ -208,7 +210,11 @@ def run(args) -> int:
     if (n - 1) % 10:
         raise ValueError(f"positions = {n} must be of the form 10k+1 (11, 21, ..., 61, ...)")
     m = 4 * ((n - 1) // 10)
-    half = check_range("pitches", args.pitches, 0.75, 4.0)
+    # default: 1.25 pitches; an involute pair without --pitches gets the family's
+    # default grid (wider for a path of contact that reaches further)
+    auto = args.pitches is None and args.design.startswith("involute:")
+    half = None if auto else check_range("pitches", 1.25 if args.pitches is None
+                                         else args.pitches, 0.75, 4.0)
     if args.plot:
         check_output_path(args.plot, "--plot", (".png",))
     sides = ["drive", "coast"] if args.side == "both" else [args.side]
@@ -244,6 +250,10 @@ def run(args) -> int:
         for w in res.warnings():
             sys.stderr.write(f"gearjax: warning: {sd} side: {w}\n")
     outs = {sd: _side_json(r[0]) for sd, r in results.items()}
+    if half is None and results:           # the family's default grid: report what ran
+        n_grid = len(next(iter(results.values()))[0].path.phi1)
+        half = (n_grid - 1) / (2 * m)
+        n = n_grid
     inp = {"design": args.design, "side": args.side, "misalign": mis_kv, "positions": n,
            "pitches": half}
     if args.json:
@@ -269,7 +279,7 @@ def run(args) -> int:
         print(f"# TE p-t-p {out['ptp_arcsec']:.4f} arcsec, contact ratio {out['contact_ratio']:.4f}")
         print(f"{'phi1[deg]':>10s} {'TE[arcsec]':>11s} {'axial1':>9s} {'radius1':>9s} "
               f"{'2a[mm]':>8s} {'2b[mm]':>8s} flag")
-        for i in range(n):
+        for i in range(len(path.phi1)):
             flag = ("ok" if on[i] else "edge" if edge[i] else "off" if conv[i]
                     else "no-conv")
             print(f"{math.degrees(float(path.phi1[i])):10.4f} {_cell(te[i], 11, 5)} "

@@ -8,7 +8,8 @@ that may deviate from the pair's basic rack, to produce deliberate mismatches:
   (base-pitch mismatch: the pinion base pitch becomes ``pi m_t cos alpha_t1``).
 * ``profile_crown`` ``a`` and ``lead_crown`` ``b`` (1/mm): the pinion rack flank is
   moved along its normal by ``a u^2 + b v^2`` (u: profile coordinate in the normal
-  section from the datum line, v: lead coordinate), towards the generated tooth,
+  section from the pinion's pitch line -- the profile shift is carried by the rack's
+  tooth thickness --, v: lead coordinate), towards the generated tooth,
   so the pinion tooth is crowned (material removed away from u = v = 0).
 
 Mounting (see :mod:`gearjax.tca`): pinion about +z through the origin, gear about
@@ -63,7 +64,7 @@ from gearjax.tca import (DEFAULT_APPROACH, Assembly, ContactPath, Misalignment, 
 __all__ = ["InvoluteTCA", "crowned_pinion_flank", "involute_assembly", "involute_tca_traced",
            "involute_tca", "involute_margin", "tca_summary", "SUMMARY_KEYS", "reference_guess",
            "misalignment_sensitivity", "check_on_flank_converged", "involute_limits",
-           "MemberLimits", "signed_roll", "transverse_contact_ratio", "overlap_ratio",
+           "MemberLimits", "flank_limits", "signed_roll", "transverse_contact_ratio", "overlap_ratio",
            "involute_result_traced"]
 
 
@@ -172,8 +173,10 @@ class MemberLimits(NamedTuple):
     (``rho < 0`` for ``u < u_b``, the rack point generating the base-circle point).
 
     rb : base radius.  rho_a, rho_f : roll distances of the tip and form circles.
-    u_b : rack profile coordinate (mm, from the datum line, as in
-        :func:`~gearjax.gears.involute.geometry.rack_family_data`) of the base-circle point.
+    u_b : rack profile coordinate of the base-circle point (mm; ``u`` of
+        :func:`~gearjax.gears.involute.geometry.rack_family_data` is measured from the
+        gear's pitch line, the shift being carried by the rack's tooth thickness, so
+        the height above the pitch line is ``u cos(alpha_n)`` and ``u_b = -r sin^2(alpha_t)/cos(alpha_n)``).
     ra : tip radius (the tip-edge function).
     """
 
@@ -193,7 +196,7 @@ def _member_limits(m_n, alpha_n, beta, x, z, ra) -> MemberLimits:
     rb = r * jnp.cos(at)
     rho_f = jnp.maximum(r * jnp.sin(at) - m_n * (1.0 - x) / jnp.sin(at), 0.0)
     rho_a = jnp.sqrt(jnp.maximum(ra ** 2 - rb ** 2, 0.0))
-    u_b = (-r * jnp.sin(at) ** 2 - x * m_n) / jnp.cos(alpha_n)
+    u_b = -r * jnp.sin(at) ** 2 / jnp.cos(alpha_n)
     return MemberLimits(rb, rho_a, rho_f, u_b, ra)
 
 
@@ -206,7 +209,7 @@ def signed_roll(lim: MemberLimits, q, u):
     return jnp.where(u >= lim.u_b, mag, -mag)
 
 
-def _flank_limits(des: InvoluteTCA):
+def flank_limits(des: InvoluteTCA):
     """``(pinion, gear, b/2)``: the :class:`MemberLimits` of pinion and gear and the half
     face width (mm), the boundaries of both working flanks."""
     p = des.pair
@@ -231,7 +234,7 @@ def involute_margin(des: InvoluteTCA, path: ContactPath):
     """Boundary margin (mm, >= 0 inside both flanks) along the path, and its parts
     (pinion tip, form circle and face width, the same of the gear; tip and form circle
     in roll distance, :class:`MemberLimits`)."""
-    lim1, lim2, hb = _flank_limits(des)
+    lim1, lim2, hb = flank_limits(des)
     parts = jnp.stack(_margins(lim1, lim2, hb, path.p1_body, path.p2_body, path.uv1, path.uv2))
     return jnp.min(parts, axis=0), parts
 
@@ -257,7 +260,7 @@ def involute_face_ends(des: InvoluteTCA):
     member at body points and their flank parameters, the face-end functions
     ``g(q, e) = q_z - e b/2`` of pinion and gear and their tip-edge functions
     ``t_k(q) = r_ak - |q_xy|`` (addendum cylinder; mm)."""
-    lim1, lim2, hb = _flank_limits(des)
+    lim1, lim2, hb = flank_limits(des)
 
     def margin_parts(q1, q2, uv1, uv2):
         t1, f1, w1, t2, f2, w2 = _margins(lim1, lim2, hb, q1, q2, uv1, uv2)
@@ -322,7 +325,11 @@ def involute_tca_traced(des: InvoluteTCA, mis: Misalignment, *, side: int = -1,
 
     With ``face_ends`` (default) the contact at the face ends of both members is
     solved too, with ``tip_edges`` (default) also the contact of each member's tip
-    edge with the mating flank, and the contact made at each pinion angle is the
+    edge with the mating flank (not for a helical pair in line contact: its solved
+    curve, a fixed rack lead coordinate, is not a transverse section, so the corner of
+    that curve at the tip is not where a tip edge first touches -- taken for one, it
+    replaced conjugate contacts at the ends of the path by spurious tip contacts of
+    -0.7 arcsec; such tip contacts are not solved for helical line contact), and the contact made at each pinion angle is the
     surface or the edge contact (:func:`gearjax.edge_contact.face_end_contact`;
     ``path.edge_kind``).
 
@@ -345,7 +352,8 @@ def involute_tca_traced(des: InvoluteTCA, mis: Misalignment, *, side: int = -1,
         path, margin, _ = face_end_contact(r1, r2, asm, mis, path, margin, parts, g1, g2,
                                            drive=side < 0, line_contact=line_contact,
                                            steps_per_pitch=steps_per_pitch,
-                                           tips=tips if tip_edges else None)
+                                           tips=tips if tip_edges else None,
+                                           tips_valid=(p.helix == 0.0) if line_contact else True)
     multi = multi_pair(path, margin, steps_per_pitch, p.z1, drive=(side < 0), n_pairs=n_pairs)
     if line_contact:
         multi = multi._replace(contact_ratio=transverse_contact_ratio(des, path, margin,
@@ -369,7 +377,7 @@ def transverse_contact_ratio(des: InvoluteTCA, path: ContactPath, margin, cr_ang
     NaN where ``cr_angle`` (the angular contact ratio of :func:`gearjax.tca.multi_pair`)
     is NaN (no entry before the exit within the grid).
     """
-    lim1, _, _ = _flank_limits(des)
+    lim1, _, _ = flank_limits(des)
     rho1 = signed_roll(lim1, path.p1_body, path.uv1[:, 0])
     m = jnp.where(path.converged, margin, -1.0)
     lo = first_crossing(rho1, m)
@@ -505,6 +513,27 @@ def involute_limits(des: InvoluteTCA, side: int = -1) -> dict:
                 tip_radius=float(geo["ra1"]))
 
 
+#: half-ranges (pitches) of the default grids and the tooth pairs they take: a pair whose
+#: contact reaches further from the pitch point gets the next one (few static shapes)
+DEFAULT_GRIDS = ((1.25, 3), (2.0, 5), (3.0, 7), (4.0, 9))
+
+
+def default_grid(des: InvoluteTCA) -> tuple[float, int]:
+    """``(half_pitches, n_pairs)`` of the default grid of a concrete design: the first of
+    :data:`DEFAULT_GRIDS` that spans the path of contact from the start of active
+    profile to the pinion tip, seen from the pitch point (the grid's reference), with
+    a quarter pitch to spare (ISO 21771 roll distances; conjugate pair).  Most pairs
+    (contact ratio below about 2) keep ``(1.25, 3)``; high-contact-ratio pairs get a
+    wider grid instead of a contact ratio cut off by the grid's end."""
+    geo = pair_geometry(des.pair)
+    p_bt = float(2.0 * jnp.pi * geo["rb1"] / des.pair.z1)
+    reach = max(float(geo["rho_P"] - geo["rho_A"]), float(geo["rho_E"] - geo["rho_P"])) / p_bt
+    for half, pairs in DEFAULT_GRIDS:
+        if reach + 0.25 <= half:
+            return half, pairs
+    return DEFAULT_GRIDS[-1]
+
+
 # -- the common TCA interface (gearjax.tca_result) --------------------------------------
 
 def _side_code(side: str) -> int:
@@ -572,10 +601,20 @@ class _Adapter:
     def _options(des, line_contact):
         return default_line_contact(des) if line_contact is None else bool(line_contact)
 
-    def run(self, des, mis=None, *, side="drive", steps_per_pitch=24, half_pitches=1.25,
-            n_pairs=3, line_contact=None, approach=DEFAULT_APPROACH, kinematics=True,
+    @staticmethod
+    def _grid(des, half_pitches, n_pairs):
+        """The grid options, :func:`default_grid` for those not given (None)."""
+        if half_pitches is None or n_pairs is None:
+            h, k = default_grid(des)
+            half_pitches = h if half_pitches is None else half_pitches
+            n_pairs = k if n_pairs is None else n_pairs
+        return half_pitches, n_pairs
+
+    def run(self, des, mis=None, *, side="drive", steps_per_pitch=24, half_pitches=None,
+            n_pairs=None, line_contact=None, approach=DEFAULT_APPROACH, kinematics=True,
             strict=True):
         side = check_side(side)
+        half_pitches, n_pairs = self._grid(des, half_pitches, n_pairs)
         check_tca_options(steps_per_pitch, half_pitches, n_pairs, approach)
         mis = Misalignment.zero() if mis is None else mis
         res = _result(des, mis, float(approach), side,
@@ -586,9 +625,10 @@ class _Adapter:
             check_on_flank_converged(res.path, res.margin)
         return res
 
-    def traced(self, des, *, side="drive", steps_per_pitch=24, half_pitches=1.25, n_pairs=3,
+    def traced(self, des, *, side="drive", steps_per_pitch=24, half_pitches=None, n_pairs=None,
                line_contact=None, approach=DEFAULT_APPROACH, kinematics=True):
         side = check_side(side)
+        half_pitches, n_pairs = self._grid(des, half_pitches, n_pairs)
         check_tca_options(steps_per_pitch, half_pitches, n_pairs, approach)
         lc = self._options(des, line_contact)
 
