@@ -17,9 +17,9 @@ pair pytree is an argument).  Perturbations, uniform within (all leaves of
 * cutter: point radius +-0.1 mm, blade angle +-0.05 deg;
 * misalignment: dE, dP, dG in [-0.05, 0.05] mm, dSigma in [-0.01, 0.01] deg.
 
-Involute: (z1, z2) = (19, 47), and (31, 62) as well in the wide run
-(``GEARJAX_FUZZ_EXAMPLES`` > 1; tooth numbers are static: each pair is one compiled
-program); module 2..6 mm, normal pressure angle 17.5..25 deg, helix 0..30
+Involute: tooth numbers drawn too, z1 in 12..40 and z2 in z1..4 z1 (they are traced:
+every pair runs the one compiled program of these options; until 2026-11-26 they were
+static and the property ran on (19, 47) only); module 2..6 mm, normal pressure angle 17.5..25 deg, helix 0..30
 deg, x1, x2 in [-0.2, 0.4] (a combination the constructor refuses -- undercut,
 pointed teeth, interference -- counts as "refused": a ``ValueError``), face width
 6..12 modules, pressure-angle modification +-0.05 deg, profile crown 0..5e-4 1/mm,
@@ -84,7 +84,10 @@ GRADIENT_SEEDS = (0, 1)      # numpy default_rng seeds of the gradient cases
 RESIDUAL_TOL = 1e-9          # contact solve residual at a touching point (mm / -)
 DEG = math.pi / 180.0
 HYPOID_OPTIONS = dict(side="drive", steps_per_pitch=6, half_pitches=1.5, n_pairs=3)
-INVOLUTE_OPTIONS = dict(side="drive", steps_per_pitch=8, kinematics=False)
+# the grid is given explicitly (the family's default grid widens for long paths of
+# contact: another program); a grid too short for a pair is a flagged result
+INVOLUTE_OPTIONS = dict(side="drive", steps_per_pitch=8, half_pitches=1.25, n_pairs=3,
+                        kinematics=False)
 
 # the hypoid/spiral-bevel examples (other families' kinds have their own tests)
 ALL_EXAMPLES = [n for n in gj.list_examples()
@@ -243,17 +246,19 @@ def _face_end_carrying(res, face_width):
     return bool(np.any(carrying & at_end))
 
 
-@pytest.mark.parametrize("z1,z2", TOOTH_PAIRS)
+@pytest.mark.parametrize("run", range(len(TOOTH_PAIRS)))
 @settings(max_examples=INVOLUTE_EXAMPLES, **_SETTINGS)
 @given(data=st.data())
-def test_involute_designs_are_valid_flagged_or_refused(z1, z2, data):
+def test_involute_designs_are_valid_flagged_or_refused(run, data):
+    z1 = data.draw(st.integers(12, 40))
+    z2 = data.draw(st.integers(z1, 4 * z1))
     d, m = data.draw(_involute_case(z1, z2))
     try:
         des, mis = _involute(z1, z2, d, m)
     except ValueError as exc:            # undercut, pointed teeth, interference
         msg = str(exc)
         assert "\n" not in msg and any(k in msg for k in ("x1", "x2", "module", "helix")), msg
-        OUTCOMES[f"involute {z1}/{z2}: refused"] += 1
+        OUTCOMES["involute: refused"] += 1
         return
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -262,8 +267,8 @@ def test_involute_designs_are_valid_flagged_or_refused(z1, z2, data):
     # face-end contact from the contact points' own coordinates
     face_end = res.flags()["face_end_contact"]
     assert face_end == _face_end_carrying(res, d["b"]), (d, m)
-    OUTCOMES[f"involute {z1}/{z2}: {outcome}"] += 1
-    OUTCOMES[f"involute {z1}/{z2}: face_end_contact raised"] += face_end
+    OUTCOMES[f"involute: {outcome}"] += 1
+    OUTCOMES["involute: face_end_contact raised"] += face_end
 
 
 # ----------------------------------------------------------------------------- gradients

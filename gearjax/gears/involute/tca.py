@@ -120,9 +120,17 @@ def join_teeth(blank: InvoluteTCA, teeth) -> InvoluteTCA:
     return replace(blank, pair=replace(blank.pair, z1=teeth[0], z2=teeth[1]))
 
 
-def crowned_pinion_flank(des: InvoluteTCA, side: int) -> GeneratedSurface:
+def crowned_pinion_flank(des: InvoluteTCA, side: int, transverse: bool = False) -> GeneratedSurface:
     """Pinion flank enveloped by the modified rack (body frame, as in
-    :func:`gearjax.gears.involute.geometry.generated_flank`)."""
+    :func:`gearjax.gears.involute.geometry.generated_flank`).
+
+    With ``transverse`` the flank is parametrised by ``(u, w)``, ``v = w + c u`` with
+    ``c`` chosen so that the rack's profile direction ``e_prof + c e_lead`` has no axial
+    component: a line ``w = const`` is then a transverse section (the same surface;
+    the height above the pitch line is still ``u cos(alpha_n)``, the normal keeps its
+    orientation).  The line-contact TCA solves the section ``w = 0`` (``z = 0``) of a
+    helical pair this way, so its on-flank interval is the transverse one.  (A lead
+    crown, point contact only, would be ``c_v (w + c u)^2``; not used with it.)"""
     p = des.pair
     alpha = p.pressure_angle + des.dalpha
     beta = p.helix
@@ -135,6 +143,8 @@ def crowned_pinion_flank(des: InvoluteTCA, side: int) -> GeneratedSurface:
     # rack point moved by -side (c_u u^2 + c_v v^2) along nr (profile and lead crown)
     k = rack_family_data(p.module, alpha, beta, p.x1, p.z1, side, crown_dir=-side * nr,
                          crowns=jnp.stack([des.profile_crown, des.lead_crown]))
+    if transverse:
+        k = k._replace(e_prof=k.e_prof - (k.e_prof[2] / k.e_lead[2]) * k.e_lead)
     P = jax.tree_util.Partial
     return GeneratedSurface(P(rack_family, k), P(rack_psi0, k))
 
@@ -278,7 +288,7 @@ def involute_face_ends(des: InvoluteTCA):
     return margin_parts, g, g, (t1, t2)
 
 
-def reference_guess(des: InvoluteTCA, side: int):
+def reference_guess(des: InvoluteTCA, side: int, transverse: bool = False):
     """Initial guess (u1, v1, u2, v2, phi2) and phi1 near the pitch-point contact.
 
     From the rack geometry: a rack point at profile coordinate u is at height
@@ -301,7 +311,9 @@ def reference_guess(des: InvoluteTCA, side: int):
     u2 = u_of(rho2, geo["r2"], p.x2)
     v1 = -u1 * side * jnp.sin(an) * jnp.tan(beta)
     v2 = u2 * side * jnp.sin(an) * jnp.tan(beta)
-    q1 = crowned_pinion_flank(des, side)(jnp.stack([u1, v1]))
+    if transverse:
+        v1 = jnp.zeros_like(v1)     # w = 0: the section z = 0 (crowned_pinion_flank)
+    q1 = crowned_pinion_flank(des, side, transverse)(jnp.stack([u1, v1]))
     q2 = generated_flank(p.module, an, -beta, p.x2, p.z2, side)(jnp.stack([u2, v2]))
     aw = geo["alpha_wt"]
     rw1 = geo["a_w"] * p.z1 / (p.z1 + p.z2)
@@ -325,11 +337,8 @@ def involute_tca_traced(des: InvoluteTCA, mis: Misalignment, *, side: int = -1,
 
     With ``face_ends`` (default) the contact at the face ends of both members is
     solved too, with ``tip_edges`` (default) also the contact of each member's tip
-    edge with the mating flank (not for a helical pair in line contact: its solved
-    curve, a fixed rack lead coordinate, is not a transverse section, so the corner of
-    that curve at the tip is not where a tip edge first touches -- taken for one, it
-    replaced conjugate contacts at the ends of the path by spurious tip contacts of
-    -0.7 arcsec; such tip contacts are not solved for helical line contact), and the contact made at each pinion angle is the
+    edge with the mating flank (in line contact: the tip corner of the transverse
+    section solved, :func:`crowned_pinion_flank` with ``transverse``), and the contact made at each pinion angle is the
     surface or the edge contact (:func:`gearjax.edge_contact.face_end_contact`;
     ``path.edge_kind``).
 
@@ -338,9 +347,9 @@ def involute_tca_traced(des: InvoluteTCA, mis: Misalignment, *, side: int = -1,
     (``2 round(half_pitches steps_per_pitch) + 1`` positions).
     """
     p = des.pair
-    x_ref, phi1_ref, ok = reference_guess(des, side)
+    x_ref, phi1_ref, ok = reference_guess(des, side, line_contact)
     grid = pinion_angle_grid(phi1_ref, p.z1, steps_per_pitch, half_pitches)
-    r1 = crowned_pinion_flank(des, side)
+    r1 = crowned_pinion_flank(des, side, line_contact)
     r2 = generated_flank(p.module, p.pressure_angle, -p.helix, p.x2, p.z2, side)
     asm = involute_assembly(p)
     path = contact_path(r1, r2, asm, mis, grid, x_ref,
@@ -352,8 +361,7 @@ def involute_tca_traced(des: InvoluteTCA, mis: Misalignment, *, side: int = -1,
         path, margin, _ = face_end_contact(r1, r2, asm, mis, path, margin, parts, g1, g2,
                                            drive=side < 0, line_contact=line_contact,
                                            steps_per_pitch=steps_per_pitch,
-                                           tips=tips if tip_edges else None,
-                                           tips_valid=(p.helix == 0.0) if line_contact else True)
+                                           tips=tips if tip_edges else None)
     multi = multi_pair(path, margin, steps_per_pitch, p.z1, drive=(side < 0), n_pairs=n_pairs)
     if line_contact:
         multi = multi._replace(contact_ratio=transverse_contact_ratio(des, path, margin,
@@ -364,13 +372,11 @@ def involute_tca_traced(des: InvoluteTCA, mis: Misalignment, *, side: int = -1,
 def transverse_contact_ratio(des: InvoluteTCA, path: ContactPath, margin, cr_angle):
     """Transverse contact ratio of a line-contact path (traceable).
 
-    In line-contact mode one curve of the contact lines is solved (a fixed rack lead
-    coordinate ``v1``); on a helical pair its points lie at different face-width
-    positions, so its interval of pinion angles mixes the transverse motion with the
-    screw motion along the face.  The roll distance ``rho1`` of the pinion point
-    (:class:`MemberLimits`) is the same in every transverse section of the screw
-    surface, so the transverse contact ratio is the on-flank interval in roll distance
-    over the transverse base pitch, ``eps_alpha = (rho1_out - rho1_in)/p_bt1``,
+    In line-contact mode the transverse section ``z = 0`` of the contact lines is
+    solved (:func:`crowned_pinion_flank` with ``transverse``).  The transverse contact
+    ratio is its on-flank interval in roll distance ``rho1`` (:class:`MemberLimits`;
+    the same in every transverse section of the screw surface) over the transverse
+    base pitch, ``eps_alpha = (rho1_out - rho1_in)/p_bt1``,
     ``p_bt1 = 2 pi r_b1/z1`` (ISO 21771), with the boundary crossings interpolated
     linearly in the margin (exact for an involute path: the margins are linear in the
     roll distance).  For a spur pair it equals the angular interval over the pitch.
@@ -550,7 +556,7 @@ def _result_parts(des: InvoluteTCA, mis: Misalignment, code, *, steps_per_pitch:
                                               n_pairs=n_pairs, approach=approach)
     _, parts = involute_margin(des, path)
     p = des.pair
-    r1 = crowned_pinion_flank(des, code)
+    r1 = crowned_pinion_flank(des, code, line_contact)
     coords = {"margin_parts": parts}
     if line_contact:
         coords["overlap_ratio"] = overlap_ratio(des, path, r1)
