@@ -315,7 +315,8 @@ class TCAResult:
             while it still carries the load) instead of where the TE curves of the
             two pairs cross -- the load is then carried at the edge of a tooth.  Pairs
             whose TE curves coincide (conjugate pairs) touch simultaneously and are
-            not flagged.
+            not flagged, also where their overlap is shorter than a grid step
+            (contact ratio just above 1: the curves meet between grid points).
             Also raised with ``face_end_contact``.
         face_end_contact : pair 0 carries the load (it is the active pair of the
             envelope) at a face end of a flank -- toe or heel of pinion or gear
@@ -341,6 +342,7 @@ class TCAResult:
         k0 = inside.shape[0] // 2
         phi = np.asarray(self.path.phi1)
         edge = False
+        cr = float(self.multi.contact_ratio)
         for t_phi, (a, b) in zip(np.asarray(self.multi.transfer_phi1), ((k0 - 1, k0), (k0, k0 + 1))):
             if not np.isfinite(t_phi):
                 edge = True
@@ -353,7 +355,14 @@ class TCAResult:
             # hand-over point is arbitrary and no pair carries the load alone
             with np.errstate(invalid="ignore"):
                 same = both & (np.abs(te[a, sl] - te[b, sl]) < _SAME_TE)
-            edge = edge or not (crossing or bool(same.any()))
+                # an overlap of the two pairs shorter than a grid step (contact ratio
+                # just above 1): one pair on the flank at the step's start, the other at
+                # its end, and their TE continuous across it -- coincident
+                # curves meeting between grid points, not a pair running off its flank
+                handed = cr >= 1.0 and any(
+                    inside[p, i] and inside[q, i + 1] and abs(te[p, i] - te[q, i + 1]) < _SAME_TE
+                    for p, q in ((a, b), (b, a)))
+            edge = edge or not (crossing or bool(same.any()) or handed)
         face_end = bool(self.face_ends_loaded())
         tip = bool(self.tips_loaded())
         cr = float(self.multi.contact_ratio)

@@ -304,3 +304,26 @@ def test_design_file(design):
         design_from_dict(_data(cutter_radius2_mm=5.0))
     with pytest.raises(ValueError, match="unknown|not allowed|helix"):
         design_from_dict(_data(helix_deg=10.0))
+
+
+def test_second_branch_past_the_edge_of_regression_is_off_the_flank(pair):
+    """The envelope of the unbounded blade cone continues past the base circle onto a
+    second branch at the same radii (the defect found on involute pairs: a radius-only
+    form-circle test took it for flank).  In the middle section the blade point
+    ``u = -2 r sin^2(alpha)/cos(alpha)`` generates the roll distance ``-r sin(alpha)``:
+    the second-branch point at the pitch radius, between the form and tip circles.
+    The working point at ``u = 0`` (same radius) is on the flank, the other is not."""
+    from gearjax.gears.vh_catt.tca import margin_parts, vh_flanks
+    r1f, _ = vh_flanks(pair, -1.0)
+    r = 0.5 * pair.z1 * float(pair.module)
+    al = float(pair.pressure_angle)
+    u2 = -2.0 * r * math.sin(al) ** 2 / math.cos(al)
+    work, second = (np.asarray(r1f(jnp.array([u, 0.0]))) for u in (0.0, u2))
+    np.testing.assert_allclose(np.hypot(*second[:2]), np.hypot(*work[:2]), rtol=1e-9)
+    parts = margin_parts(pair)
+    q2 = jnp.asarray(work)[None]          # any on-flank gear point: only the pinion matters
+    uv = jnp.zeros((1, 2))
+    _, root_work, _, _ = parts(jnp.asarray(work)[None], q2, uv, uv)
+    _, root_second, _, _ = parts(jnp.asarray(second)[None], q2, jnp.array([[u2, 0.0]]), uv)
+    assert float(root_work[0]) > 0.0
+    assert float(root_second[0]) < 0.0

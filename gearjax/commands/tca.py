@@ -28,7 +28,7 @@ JSON_KEYS_DOC = """JSON keys:
   ptp_arcsec       peak-to-peak of the sampled envelope over one pitch
   transfer_phi1_rad  pinion angles of the transfers into and out of pair 0
   contact_ratio    on-flank interval of pair 0 / angular pitch (involute line contact:
-                   the transverse contact ratio, interval in roll distance / base pitch)
+                   the transverse section z = 0 is solved, so this is eps_alpha)
   overlap_ratio    involute line contact: b tan(beta)/(r1 2 pi/z1) (null otherwise)
   path             {axial1_mm, radial1_mm, axial2_mm, radial2_mm}: contact point on
                    pinion and gear flank in axial projection (body z, radius; for

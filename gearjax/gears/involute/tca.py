@@ -58,13 +58,13 @@ from gearjax.loaded_contact import TeethOf
 from gearjax.tca_result import (TCAResult, check_side, contact_kinematics, register_family,
                                 strong_float64)
 from gearjax.tca import (DEFAULT_APPROACH, Assembly, ContactPath, Misalignment, MultiPair,
-                  contact_path, first_crossing, multi_pair, check_on_flank_converged,
-                  check_tca_options, pinion_angle_grid)
+                  contact_path, multi_pair, check_on_flank_converged, check_tca_options,
+                  pinion_angle_grid)
 
 __all__ = ["InvoluteTCA", "crowned_pinion_flank", "involute_assembly", "involute_tca_traced",
            "involute_tca", "involute_margin", "tca_summary", "SUMMARY_KEYS", "reference_guess",
            "misalignment_sensitivity", "check_on_flank_converged", "involute_limits",
-           "MemberLimits", "flank_limits", "signed_roll", "transverse_contact_ratio", "overlap_ratio",
+           "MemberLimits", "flank_limits", "signed_roll", "overlap_ratio",
            "involute_result_traced"]
 
 
@@ -157,12 +157,9 @@ def involute_assembly(pair: InvolutePair) -> Assembly:
 
 
 def _form_radius(m_n, alpha_n, beta, x, z):
-    m_t = m_n / jnp.cos(beta)
-    at = jnp.arctan(jnp.tan(alpha_n) / jnp.cos(beta))
-    r = 0.5 * z * m_t
-    rb = r * jnp.cos(at)
-    rho_f = jnp.maximum(r * jnp.sin(at) - m_n * (1.0 - x) / jnp.sin(at), 0.0)
-    return jnp.sqrt(rb ** 2 + rho_f ** 2)
+    """Form-circle radius (mm) of the straight rack flank (:class:`MemberLimits`)."""
+    lim = _member_limits(m_n, alpha_n, beta, x, z, 0.0)
+    return jnp.sqrt(lim.rb ** 2 + lim.rho_f ** 2)
 
 
 class MemberLimits(NamedTuple):
@@ -363,33 +360,7 @@ def involute_tca_traced(des: InvoluteTCA, mis: Misalignment, *, side: int = -1,
                                            steps_per_pitch=steps_per_pitch,
                                            tips=tips if tip_edges else None)
     multi = multi_pair(path, margin, steps_per_pitch, p.z1, drive=(side < 0), n_pairs=n_pairs)
-    if line_contact:
-        multi = multi._replace(contact_ratio=transverse_contact_ratio(des, path, margin,
-                                                                      multi.contact_ratio))
     return path, margin, multi
-
-
-def transverse_contact_ratio(des: InvoluteTCA, path: ContactPath, margin, cr_angle):
-    """Transverse contact ratio of a line-contact path (traceable).
-
-    In line-contact mode the transverse section ``z = 0`` of the contact lines is
-    solved (:func:`crowned_pinion_flank` with ``transverse``).  The transverse contact
-    ratio is its on-flank interval in roll distance ``rho1`` (:class:`MemberLimits`;
-    the same in every transverse section of the screw surface) over the transverse
-    base pitch, ``eps_alpha = (rho1_out - rho1_in)/p_bt1``,
-    ``p_bt1 = 2 pi r_b1/z1`` (ISO 21771), with the boundary crossings interpolated
-    linearly in the margin (exact for an involute path: the margins are linear in the
-    roll distance).  For a spur pair it equals the angular interval over the pitch.
-    NaN where ``cr_angle`` (the angular contact ratio of :func:`gearjax.tca.multi_pair`)
-    is NaN (no entry before the exit within the grid).
-    """
-    lim1, _, _ = flank_limits(des)
-    rho1 = signed_roll(lim1, path.p1_body, path.uv1[:, 0])
-    m = jnp.where(path.converged, margin, -1.0)
-    lo = first_crossing(rho1, m)
-    hi = first_crossing(rho1[::-1], m[::-1])
-    p_bt1 = 2.0 * jnp.pi * lim1.rb / des.pair.z1
-    return jnp.where(jnp.isfinite(cr_angle), jnp.abs(hi - lo) / p_bt1, jnp.nan)
 
 
 def overlap_ratio(des: InvoluteTCA, path: ContactPath, r1):
