@@ -335,56 +335,57 @@ def run_sweep(n, seed):
     return [check_pair(sample(rng)) for _ in range(n)]
 
 
+#: rows of the summary table: label, the per-side value reported as "worst" (None: none),
+#: the text that marks a failed check of that row, which pairs it applies to
+_TABLE = (
+    ("conjugate TE p-t-p < 0.01 arcsec", "ptp_arcsec", "TE p-t-p ", "conjugate"),
+    ("transverse contact ratio vs ISO 21771 (1e-3 rel.)", "eps_alpha_rel_err", "eps_alpha",
+     "conjugate"),
+    ("overlap ratio vs b sin β/(π m_n) (1e-3 rel.)", "eps_beta_rel_err", "eps_beta", "helical"),
+    ("contact points on the line of action (1e-6 mm)", "line_of_action_err_mm",
+     "line of action", "conjugate"),
+    ("path from the start of active profile to the tip (one grid step)", None, "SAP",
+     "conjugate"),
+    ("no tip/edge/face-end/off-flank flag, reference on the flank", None, "flags", "all"),
+    ("crowned spur: first-order TE (Richardson a, a/2, a/4) = ∓a u²/r_b2 (0.5 % of span)",
+     "crown_te_rel_err", "crown TE off", "crowned"),
+    ("crowned spur: TE vertex at the pitch circle (0.005 m)", "crown_vertex_err_mm",
+     "vertex", "crowned"),
+    ("crowned spur: first-order envelope p-t-p vs the parabolas on the grid (0.5 %)",
+     "crown_ptp_rel_err", "crown TE p-t-p", "crowned checked"),
+    ("crowned spur: no tip/edge contact where the parabolas cross on the flanks", None,
+     "crowned: tip/edge", "crowned checked"),
+)
+
+
 def summary_table(rows) -> str:
+    """Markdown table of the sweep: per check the sides it applies to, passed, failed,
+    and the worst value."""
     acc = [r for r in rows if r["status"] == "accepted"]
-    ref = [r for r in rows if r["status"] == "refused"]
-    lines = ["| check | pairs | pass | fail | worst |", "|---|---|---|---|---|"]
-
-    def worst(key, sides=("drive", "coast"), filt=lambda r: True):
-        vals = [r[s][key] for r in acc if filt(r) for s in sides
-                if s in r and r[s].get(key) is not None]
-        return (max(vals) if vals else float("nan")), len(vals)
-
-    n_fail = lambda pred: sum(1 for r in acc if any(pred(f) for f in r["fails"]))  # noqa: E731
-    lines.append(f"| classification (refused exactly where the closed forms say invalid) | {len(rows)} | "
-                 f"{sum(1 for r in rows if not any('refused' in f or 'accepted a pair' in f for f in r['fails']))} | "
-                 f"{sum(1 for r in rows if any('refused' in f or 'accepted a pair' in f for f in r['fails']))} | – |")
-    cons = lambda r: r["design"]["crown"] == 0.0  # noqa: E731
-    w, k = worst("ptp_arcsec", filt=cons)
-    lines.append(f"| conjugate TE p-t-p < {TE_TOL_ARCSEC} arcsec (both sides) | {k} | "
-                 f"{k - n_fail(lambda f: 'TE p-t-p' in f and 'crown' not in f)} | "
-                 f"{n_fail(lambda f: 'TE p-t-p' in f and 'crown' not in f)} | {w:.2e} arcsec |")
-    w, k = worst("eps_alpha_rel_err")
-    lines.append(f"| transverse contact ratio vs ISO 21771 (1e-3 rel.) | {k} | "
-                 f"{k - n_fail(lambda f: 'eps_alpha' in f)} | {n_fail(lambda f: 'eps_alpha' in f)} | {w:.2e} |")
-    w, k = worst("eps_beta_rel_err")
-    lines.append(f"| overlap ratio vs b sin β/(π m_n) (1e-3 rel.) | {k} | "
-                 f"{k - n_fail(lambda f: 'eps_beta' in f)} | {n_fail(lambda f: 'eps_beta' in f)} | {w:.2e} |")
-    w, k = worst("line_of_action_err_mm")
-    lines.append(f"| contact points on the line of action ({LINE_TOL_MM} mm) | {k} | "
-                 f"{k - n_fail(lambda f: 'line of action' in f)} | {n_fail(lambda f: 'line of action' in f)} | {w:.2e} mm |")
-    lines.append(f"| path from the start of active profile to the tip (one grid step) | {2 * len(acc)} | "
-                 f"{2 * len(acc) - n_fail(lambda f: 'SAP' in f)} | {n_fail(lambda f: 'SAP' in f)} | – |")
-    lines.append(f"| no tip/edge/face-end/off-flank flag, reference on the flank | {2 * len(acc)} | "
-                 f"{2 * len(acc) - n_fail(lambda f: 'flags' in f or 'edge points' in f)} | "
-                 f"{n_fail(lambda f: 'flags' in f or 'edge points' in f)} | – |")
-    w, k = worst("crown_te_rel_err")
-    lines.append(f"| crowned spur: first-order TE (Richardson a, a/2, a/4) = ∓a u²/r_b2 (0.5 % of span) | {k} | "
-                 f"{k - n_fail(lambda f: 'crown TE off' in f)} | {n_fail(lambda f: 'crown TE off' in f)} | {w:.2e} |")
-    w, k = worst("crown_vertex_err_mm")
-    lines.append(f"| crowned spur: TE vertex at the pitch circle (0.005 m) | {k} | "
-                 f"{k - n_fail(lambda f: 'vertex' in f)} | {n_fail(lambda f: 'vertex' in f)} | {w:.2e} mm |")
-    w, k = worst("crown_ptp_rel_err")
-    lines.append(f"| crowned spur: first-order envelope p-t-p vs the closed form on the grid (0.5 %) | {k} | "
-                 f"{k - n_fail(lambda f: 'crown TE p-t-p' in f)} | {n_fail(lambda f: 'crown TE p-t-p' in f)} | {w:.2e} |")
+    kinds = {
+        "all": lambda r, s: True,
+        "conjugate": lambda r, s: r["design"]["crown"] == 0.0,
+        "helical": lambda r, s: r["design"]["crown"] == 0.0 and r["design"]["helix"] > 0,
+        "crowned": lambda r, s: r["design"]["crown"] > 0.0,
+        "crowned checked": lambda r, s: r["design"]["crown"] > 0.0 and r[s]["crown_ptp_checked"],
+    }
+    bad = sum(1 for r in rows if any("refused" in f or "accepted a pair" in f for f in r["fails"]))
+    lines = ["| check | cases | pass | fail | worst |", "|---|---|---|---|---|",
+             f"| classification: refused exactly where the closed forms say invalid | "
+             f"{len(rows)} pairs | {len(rows) - bad} | {bad} | – |"]
+    for label, key, mark, kind in _TABLE:
+        sides = [(r, s) for r in acc for s in ("drive", "coast") if s in r and kinds[kind](r, s)]
+        fail = sum(1 for r, s in sides if any(mark in f for f in r[s]["fails"]))
+        vals = [r[s][key] for r, s in sides if key and r[s].get(key) is not None]
+        worst = f"{max(vals):.2e}" if vals else "–"
+        lines.append(f"| {label} | {len(sides)} sides | {len(sides) - fail} | {fail} | {worst} |")
     classes = {}
     for r in rows:
-        key = r["expected"] if r["status"] == "refused" else "accepted"
-        classes[key] = classes.get(key, 0) + 1
-    tail = ["", "Pairs by class: " + ", ".join(f"{k} {v}" for k, v in sorted(classes.items())),
-            f"({len(acc)} accepted, {len(ref)} refused; {sum(1 for r in rows if r['fails'])} "
-            "with a failed check.)"]
-    return "\n".join(lines + tail)
+        k = r["expected"] if r["status"] == "refused" else "accepted"
+        classes[k] = classes.get(k, 0) + 1
+    n_fail = sum(1 for r in rows if r["fails"])
+    return "\n".join(lines + ["", "Pairs by class: " + ", ".join(
+        f"{k} {v}" for k, v in sorted(classes.items())) + f"; {n_fail} with a failed check."])
 
 
 def main(argv=None):
@@ -392,10 +393,16 @@ def main(argv=None):
     ap.add_argument("--pairs", type=int, default=320)
     ap.add_argument("--seed", type=int, default=2026)
     ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "involute_sweep"))
+    ap.add_argument("--from-json", action="store_true",
+                    help="re-render the tables from the JSON of an earlier run (OUT.json)")
     args = ap.parse_args(argv)
-    t0 = time.time()
-    rows = run_sweep(args.pairs, args.seed)
-    wall = time.time() - t0
+    if args.from_json:
+        old = json.loads(Path(args.out + ".json").read_text())
+        rows, wall, args.pairs, args.seed = old["rows"], old["wall_s"], old["pairs"], old["seed"]
+    else:
+        t0 = time.time()
+        rows = run_sweep(args.pairs, args.seed)
+        wall = time.time() - t0
     table = summary_table(rows)
     fails = [(r["design"], r["fails"]) for r in rows if r["fails"]]
     md = (f"# Involute sweep ({args.pairs} pairs, seed {args.seed})\n\n"
@@ -404,9 +411,10 @@ def main(argv=None):
     if fails:
         md += "\n## Failures\n\n" + "\n".join(f"* {d}: {f}" for d, f in fails) + "\n"
     Path(args.out + ".md").write_text(md)
-    Path(args.out + ".json").write_text(json.dumps({"seed": args.seed, "pairs": args.pairs,
-                                                    "wall_s": wall, "rows": rows}, indent=1,
-                                                   default=float))
+    if not args.from_json:
+        Path(args.out + ".json").write_text(json.dumps({"seed": args.seed, "pairs": args.pairs,
+                                                        "wall_s": wall, "rows": rows}, indent=1,
+                                                       default=float))
     print(md)
     return 0 if not fails else 1
 

@@ -30,6 +30,15 @@ def test_json_te_is_the_parabola_of_the_profile_crown(capsys, tmp_path):
     # first-order closed form; the O(a^2) remainder is < 0.5 % at a = 1e-4/mm
     assert np.max(np.abs(te[on] - theory[on])) < 5e-3 * np.max(np.abs(theory[on]))
     assert all(v is None for v in out["ellipses"]["semi_major_mm"])   # line contact
+    # no contact of pair 0, no path point: null (0.0 read as a contact at mid-face)
+    touch = on | np.array(out["flags"]["edge"])
+    assert (~touch).sum() > 10
+    for key in ("axial1_mm", "radial1_mm", "axial2_mm", "radial2_mm"):
+        vals = out["path"][key]
+        assert all((v is None) != bool(t) for v, t in zip(vals, touch)), key
+        assert all((v is None) != bool(t) for v, t in zip(out["ellipses"]["semi_minor_mm"], touch))
+    assert out["overlap_ratio"] == 0.0          # spur line contact: no overlap
+    assert out["input"]["pitches"] == 1.25      # the family's default grid for this pair
     assert png.read_bytes()[:4] == b"\x89PNG"
 
 
