@@ -61,8 +61,8 @@ from gearjax.tribology.losses import mesh_losses_traced
 from gearjax.tribology.lubricant import Oil
 
 __all__ = ["MeshEfficiency", "mesh_efficiency", "efficiency_function", "mesh_efficiency_traced",
-           "efficiency_warnings", "cycle_window", "check_operating_point",
-           "TORQUE_RANGE_NM", "RPM_RANGE"]
+           "efficiency_warnings", "cycle_window", "check_operating_point", "cycle_summary",
+           "CycleSummary", "TORQUE_RANGE_NM", "RPM_RANGE"]
 
 #: accepted pinion torque (N m) and speed (rpm)
 TORQUE_RANGE_NM = (1e-3, 1e6)
@@ -95,6 +95,9 @@ class MeshEfficiency(NamedTuple):
         edge of regression of a generated flank, where the flank is undercut) would be
         compressed under the load; such contacts carry no modelled load, and the
         position is not valid.
+    n_valid : number of valid positions, over which the four summaries are taken.
+    te_loaded_ptp : peak-to-peak of the loaded TE over the valid positions (rad; NaN
+        when none).
     """
 
     phi1: jax.Array
@@ -114,6 +117,57 @@ class MeshEfficiency(NamedTuple):
     truncated: jax.Array
     edge_loaded: jax.Array
     degenerate: jax.Array
+    n_valid: jax.Array
+    te_loaded_ptp: jax.Array
+
+
+class CycleSummary(NamedTuple):
+    """Summaries of one mesh cycle over its valid positions (:func:`cycle_summary`)."""
+
+    mean_efficiency: jax.Array
+    mean_mu: jax.Array
+    max_p_max: jax.Array
+    te_loaded_ptp: jax.Array
+    n_valid: jax.Array
+
+
+def cycle_summary(power_loss, power_in, mu, load, u_s, p_max, te_loaded, valid) -> CycleSummary:
+    """Summaries of a mesh cycle over its valid positions only (traceable).
+
+    ``power_loss`` (M,) W, ``power_in`` W, ``mu``, ``load`` (N), ``u_s``, ``p_max`` (MPa)
+    (K, M), ``te_loaded`` (M,) rad, ``valid`` (M,) bool.  With ``V`` the valid positions
+    (equally spaced in time)::
+
+        eta_bar = 1 - sum_V P_f / (|V| P_in)
+        mean mu = sum_V,k mu F |u_s| / sum_V,k F |u_s|      (loaded contacts)
+        max p_max = max_V,k p_max                           (loaded contacts)
+        loaded TE p-t-p = max_V te - min_V te
+
+    A position that is not valid (load balance or friction not converged, a loaded
+    edge or degenerate contact, no pair carrying load, a truncated grid) has no
+    modelled loss: counting it with ``P_f = 0`` would report a silent 100 %.  Every
+    summary is NaN when no position is valid (``n_valid = 0``); when only some are,
+    the summaries describe the modelled part of the cycle and the result is flagged
+    (:func:`efficiency_warnings`).  Gradients are finite (the masks are constants of
+    the derivative).
+    """
+    valid = jnp.asarray(valid, bool)
+    n_valid = jnp.sum(valid)
+    some = n_valid > 0
+    nan = jnp.nan
+    vf = valid.astype(float)
+    pin = jnp.asarray(power_in, float)
+    mean_eff = 1.0 - jnp.sum(vf * power_loss) / (jnp.maximum(n_valid, 1) * pin)
+    loaded = (load > 0.0) & valid[None, :]
+    w = jnp.where(loaded, load * jnp.abs(u_s), 0.0)
+    den = jnp.sum(w)
+    mean_mu = jnp.sum(jnp.where(loaded, mu, 0.0) * w) / jnp.where(den > 0.0, den, 1.0)
+    pm = jnp.max(jnp.where(loaded, p_max, -jnp.inf))
+    te_hi = jnp.max(jnp.where(valid, te_loaded, -jnp.inf))
+    te_lo = jnp.min(jnp.where(valid, te_loaded, jnp.inf))
+    return CycleSummary(jnp.where(some, mean_eff, nan), jnp.where(den > 0.0, mean_mu, nan),
+                        jnp.where(jnp.any(loaded), pm, nan),
+                        jnp.where(some, te_hi - te_lo, nan), n_valid)
 
 
 def cycle_window(n_grid: int, steps_per_pitch: int) -> np.ndarray:
@@ -213,8 +267,6 @@ def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, speed_ra
                             viscosity_model=viscosity_model, film_method=film_method)
     fr = FrictionResult(*(jnp.swapaxes(v, 0, 1) for v in ml.friction))
     loaded_on = F > 0.0
-    w_loss = F * us * loaded_on
-    mean_mu = jnp.sum(ml.mu.T * w_loss) / jnp.sum(w_loss)
     share = l1 * F / T1
     lc = LoadedContact(F, share, w, p_max, a_ax, b_ax, y, te_loaded, bal, conv,
                        jnp.sum(loaded_on, axis=0))
@@ -234,11 +286,13 @@ def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, speed_ra
 
     edge_loaded = pressed(res.edge_points)          # face-end (edge) contacts
     degenerate = pressed(degenerate0)              # beyond an edge of regression
+    # a position where no pair carries load has no modelled loss: never valid
     valid = (conv & jnp.all(fr.converged | ~loaded_on, axis=0) & ~edge_loaded & ~truncated
-             & ~degenerate)
+             & ~degenerate & jnp.any(loaded_on, axis=0))
+    sm = cycle_summary(ml.power_loss, power_in, ml.mu.T, F, us, p_max, te_loaded, valid)
     return MeshEfficiency(path.phi1[win], lc, ue, us, R_x, R_y, fr, ml.power_loss, ml.efficiency,
-                          ml.mean_efficiency, mean_mu, jnp.max(p_max), power_in, valid, truncated,
-                          edge_loaded, degenerate)
+                          sm.mean_efficiency, sm.mean_mu, sm.max_p_max, power_in, valid, truncated,
+                          edge_loaded, degenerate, sm.n_valid, sm.te_loaded_ptp)
 
 
 def efficiency_function(design, *, side=None, compliance: str = "weber", E_prime=STEEL_E_PRIME,
@@ -336,6 +390,11 @@ def efficiency_warnings(eff: MeshEfficiency, res: TCAResult) -> list[str]:
     if not np.all(np.asarray(eff.loaded.converged)):
         out.append("load sharing did not converge at some positions")
     if not np.all(valid):
-        out.append(f"{int(np.sum(~valid))} of {valid.size} positions are not valid "
-                   "(see the 'valid' flags)")
+        nv = int(np.sum(valid))
+        if nv:
+            out.append(f"{int(np.sum(~valid))} of {valid.size} positions are not valid "
+                       f"(see the 'valid' flags): eta_bar, mean mu, max p_max and loaded TE "
+                       f"are over the {nv} valid positions only (a partial cycle)")
+        else:
+            out.append(f"none of the {valid.size} positions is valid: no summary")
     return out

@@ -58,6 +58,10 @@ def test_textbook_load_sharing_and_balance(spur, iso_run):
     share = np.asarray(eff.loaded.share)
     n = np.asarray(eff.loaded.n_loaded)
     assert np.all(np.asarray(eff.valid)) and efficiency_warnings(eff, res) == []
+    # every position valid: the summaries are over the whole cycle
+    assert int(eff.n_valid) == n.size
+    te = np.asarray(eff.loaded.te_loaded)
+    assert float(eff.te_loaded_ptp) == pytest.approx(te.max() - te.min(), rel=1e-12)
     assert set(n.tolist()) == {1, 2}
     np.testing.assert_allclose(share.sum(axis=0), 1.0, atol=1e-12)
     np.testing.assert_allclose(share[:, n == 2][share[:, n == 2] > 0], 0.5, rtol=1e-10)
@@ -156,3 +160,33 @@ def test_gradients_against_central_differences(spur, oil_surface, iso_run):
         np.testing.assert_allclose(g[i], fd, rtol=1e-5, atol=1e-12)
     # the separations matter: a TE slope unbalances the double-contact sharing
     assert abs(float(g[3])) > 1e-6
+
+
+def test_cycle_summary_over_valid_positions_only():
+    """The summaries on a small synthetic cycle against values by hand.  Planted bugs
+    caught: a mean over all positions (the invalid ones, with no modelled loss, pull
+    eta_bar towards 100 %: 0.95 instead of 0.90), invalid or unloaded contacts in mean
+    mu / max p_max / loaded TE, and a silent number (instead of NaN) when nothing is
+    valid."""
+    from gearjax.mesh_efficiency import cycle_summary
+    P_in = 100.0
+    P_f = jnp.array([10.0, 0.0, 10.0, 0.0])          # positions 1, 3 carry no modelled load
+    load = jnp.array([[100.0, 0.0, 50.0, 0.0], [0.0, 0.0, 50.0, 0.0]])
+    us = jnp.array([[2.0, 1.0, 1.0, 1.0], [1.0, 1.0, 4.0, 1.0]])
+    mu = jnp.array([[0.05, 9.0, 0.02, 9.0], [9.0, 9.0, 0.07, 9.0]])
+    p_max = jnp.array([[1000.0, 0.0, 900.0, 5e4], [0.0, 0.0, 1100.0, 0.0]])
+    te = jnp.array([-1e-5, 3e-3, -4e-5, -3e-3])
+    valid = jnp.array([True, False, True, False])
+    s = cycle_summary(P_f, P_in, mu, load, us, p_max, te, valid)
+    assert int(s.n_valid) == 2
+    assert float(s.mean_efficiency) == pytest.approx(1.0 - 20.0 / (2 * 100.0), rel=1e-14)
+    w = np.array([200.0, 50.0, 200.0])
+    assert float(s.mean_mu) == pytest.approx(np.dot([0.05, 0.02, 0.07], w) / w.sum(), rel=1e-14)
+    assert float(s.max_p_max) == 1100.0
+    assert float(s.te_loaded_ptp) == pytest.approx(3e-5, rel=1e-12)
+    none = cycle_summary(P_f, P_in, mu, load, us, p_max, te, valid & False)
+    assert int(none.n_valid) == 0
+    assert all(np.isnan(float(v)) for v in none[:4])
+    g = jax.grad(lambda p: cycle_summary(p, P_in, mu, load, us, p_max, te, valid)
+                 .mean_efficiency)(P_f)
+    np.testing.assert_allclose(g, [-1 / 200.0, 0.0, -1 / 200.0, 0.0], rtol=1e-14)
