@@ -56,19 +56,36 @@ from gearjax.loaded_contact import (COMPLIANCE_MODELS, LoadedContact, MeshTeeth,
                                     hertz_coefficient,
                                     lever_arms, pair_arrays, pair_compliance, share_torque)
 from gearjax.tca_result import TCAResult, family_of
-from gearjax.tribology.friction import STEEL_E_PRIME, FrictionResult, Surface
+from gearjax.tribology.friction import FILM_MIN_MM, STEEL_E_PRIME, FrictionResult, Surface
 from gearjax.tribology.losses import mesh_losses_traced
 from gearjax.tribology.lubricant import Oil
 
 __all__ = ["MeshEfficiency", "mesh_efficiency", "efficiency_function", "mesh_efficiency_traced",
            "efficiency_warnings", "cycle_window", "check_operating_point", "cycle_summary",
-           "CycleSummary", "TORQUE_RANGE_NM", "RPM_RANGE"]
+           "CycleSummary", "plausibility", "Plausibility", "TORQUE_RANGE_NM", "RPM_RANGE",
+           "MU_MAX", "P_MAX_LIMIT_MPA", "DEFLECTION_MAX_PITCH", "FILM_MIN_MM"]
 
 #: accepted pinion torque (N m) and speed (rpm)
 TORQUE_RANGE_NM = (1e-3, 1e6)
 #: largest accepted r_y / r_x of a point contact (beyond: degenerate, flagged)
 MAX_RADIUS_RATIO = 1e4
 RPM_RANGE = (1e-3, 1e6)
+
+# -- plausibility of the results (:func:`plausibility`; docs/efficiency.md) ----------
+#: largest plausible friction coefficient of a lubricated steel contact: boundary
+#: friction of steel on steel under oil is 0.1-0.15, dry steel ~0.6; above 0.3 the
+#: mixed-lubrication model is outside anything it was fitted to
+MU_MAX = 0.3
+#: largest plausible maximum Hertz pressure (MPa) of a steel gear contact: far above
+#: the contact-fatigue allowables of case-hardened steel (~1500 MPa) and at the onset
+#: of gross subsurface yield, where the elastic Hertz/EHL model no longer holds
+P_MAX_LIMIT_MPA = 5000.0
+#: largest plausible loaded fall-back ``y`` of the gear behind the unloaded TE envelope,
+#: as a fraction of the pinion's angular pitch (2 % of a pitch: ~0.25 mm of arc at
+#: m = 4; elastic tooth deflections at rated load are tens of micrometres)
+DEFLECTION_MAX_PITCH = 0.02
+#: FILM_MIN_MM (gearjax.tribology.friction): the thinnest film inside the film model's
+#: range (a warning, not a failure)
 
 
 class MeshEfficiency(NamedTuple):
@@ -86,7 +103,8 @@ class MeshEfficiency(NamedTuple):
     mean_mu : load- and sliding-weighted mean mu, ``sum mu F |u_s| / sum F |u_s|``.
     max_p_max : highest Hertz pressure over the cycle (MPa).
     power_in : P_in (W).
-    valid : (M,) every loaded contact converged (load balance, Hertz, load sharing).
+    valid : (M,) every loaded contact converged (load balance, Hertz, load sharing),
+        some pair carries load, and the result is plausible (:func:`plausibility`).
     truncated : the grid or the number of pairs does not cover every pair in contact.
     edge_loaded : (M,) an edge contact would be compressed under the load (its load
         is not modelled: the result is then not valid).
@@ -168,6 +186,54 @@ def cycle_summary(power_loss, power_in, mu, load, u_s, p_max, te_loaded, valid) 
     return CycleSummary(jnp.where(some, mean_eff, nan), jnp.where(den > 0.0, mean_mu, nan),
                         jnp.where(jnp.any(loaded), pm, nan),
                         jnp.where(some, te_hi - te_lo, nan), n_valid)
+
+
+class Plausibility(NamedTuple):
+    """(M,) per position: the result passes each plausibility check
+    (:func:`plausibility`)."""
+
+    efficiency: jax.Array
+    mu: jax.Array
+    p_max: jax.Array
+    deflection: jax.Array
+
+    @property
+    def all(self):
+        return self.efficiency & self.mu & self.p_max & self.deflection
+
+
+#: the reason printed for each failed check of :class:`Plausibility`
+PLAUSIBILITY_TEXT = {
+    "efficiency": "eta_m outside (0, 1]",
+    "mu": f"mu above {MU_MAX:g} (MU_MAX)",
+    "p_max": f"p_max above {P_MAX_LIMIT_MPA:g} MPa (P_MAX_LIMIT_MPA: beyond the elastic "
+             "range of steel)",
+    "deflection": f"loaded fall-back behind the unloaded TE above {DEFLECTION_MAX_PITCH:g} of "
+                  "a pinion pitch (DEFLECTION_MAX_PITCH: beyond what a tooth allows)",
+}
+
+
+def plausibility(efficiency, mu, load, p_max, deflection, pitch) -> Plausibility:
+    """Plausibility of the results at each position (traceable; (M,) booleans).
+
+    ``efficiency`` (M,) eta_m, ``mu``, ``load`` (N), ``p_max`` (MPa) (K, M),
+    ``deflection`` (M,) loaded fall-back y (rad), ``pitch`` the pinion angular pitch
+    (rad).  A position passes when ``0 < eta_m <= 1``, every loaded contact has
+    ``mu <= MU_MAX`` and ``p_max <= P_MAX_LIMIT_MPA``, and
+    ``y <= DEFLECTION_MAX_PITCH * pitch`` (NaN fails every check).  A position that
+    fails one is not valid (:class:`MeshEfficiency`): its numbers are not a result.
+    """
+    loaded = load > 0.0
+    eff_ok = (efficiency > 0.0) & (efficiency <= 1.0)
+    mu_ok = jnp.all(~loaded | (mu <= MU_MAX), axis=0)
+    p_ok = jnp.all(~loaded | (p_max <= P_MAX_LIMIT_MPA), axis=0)
+    y_ok = deflection <= DEFLECTION_MAX_PITCH * pitch
+    return Plausibility(eff_ok, mu_ok, p_ok, y_ok)
+
+
+def _pitch(phi1, steps_per_pitch):
+    """The pinion angular pitch (rad) from the grid spacing of the positions."""
+    return jnp.abs(phi1[1] - phi1[0]) * steps_per_pitch
 
 
 def cycle_window(n_grid: int, steps_per_pitch: int) -> np.ndarray:
@@ -287,8 +353,10 @@ def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, speed_ra
     edge_loaded = pressed(res.edge_points)          # face-end (edge) contacts
     degenerate = pressed(degenerate0)              # beyond an edge of regression
     # a position where no pair carries load has no modelled loss: never valid
+    # an implausible result (plausibility) is not a result either
+    plaus = plausibility(ml.efficiency, ml.mu.T, F, p_max, y, _pitch(path.phi1, steps_per_pitch))
     valid = (conv & jnp.all(fr.converged | ~loaded_on, axis=0) & ~edge_loaded & ~truncated
-             & ~degenerate & jnp.any(loaded_on, axis=0))
+             & ~degenerate & jnp.any(loaded_on, axis=0) & plaus.all)
     sm = cycle_summary(ml.power_loss, power_in, ml.mu.T, F, us, p_max, te_loaded, valid)
     return MeshEfficiency(path.phi1[win], lc, ue, us, R_x, R_y, fr, ml.power_loss, ml.efficiency,
                           sm.mean_efficiency, sm.mean_mu, sm.max_p_max, power_in, valid, truncated,
@@ -372,11 +440,46 @@ def _post_jit(res, pair, T, w, oil, surface, E_prime, *, teeth_of, steps_per_pit
 
 
 
-def efficiency_warnings(eff: MeshEfficiency, res: TCAResult) -> list[str]:
+def efficiency_warnings(eff: MeshEfficiency, res: TCAResult, *, film_method: str = "auto"
+                        ) -> list[str]:
     """One line per problem of a concrete result: TCA quality flags, load balance or
-    friction solves not converged, grid too short, loaded edge contact."""
+    friction solves not converged, grid too short, loaded edge contact, implausible
+    results (:func:`plausibility`: one line per failed check with the worst value), a
+    film below :data:`FILM_MIN_MM`, the film formula outside its fitted ellipticity
+    range (``film_method`` as given to the friction model)."""
     out = list(res.warnings())
     valid = np.asarray(eff.valid)
+    F = np.asarray(eff.loaded.load, float)
+    loaded = F > 0.0
+    phi = np.asarray(eff.phi1, float)
+    pl = plausibility(np.asarray(eff.efficiency), np.asarray(eff.friction.mu), F,
+                      np.asarray(eff.loaded.p_max), np.asarray(eff.loaded.deflection),
+                      float(np.abs(phi[1] - phi[0]) * phi.shape[0]) if phi.size > 1 else np.inf)
+    worst = {
+        "efficiency": lambda: f"eta_m from {np.nanmin(np.asarray(eff.efficiency)):.6g} to "
+                              f"{np.nanmax(np.asarray(eff.efficiency)):.6g}",
+        "mu": lambda: f"mu up to {np.nanmax(np.where(loaded, np.asarray(eff.friction.mu), -np.inf)):.4g}",
+        "p_max": lambda: f"p_max up to "
+                         f"{np.nanmax(np.where(loaded, np.asarray(eff.loaded.p_max), -np.inf)):.0f} MPa",
+        "deflection": lambda: f"fall-back up to "
+                              f"{np.nanmax(np.asarray(eff.loaded.deflection)) * 206264.80624709636:.0f} arcsec",
+    }
+    for name, ok in pl._asdict().items():
+        bad = ~np.asarray(ok)
+        if np.any(bad):
+            out.append(f"implausible result at {int(bad.sum())} of {bad.size} positions: "
+                       f"{PLAUSIBILITY_TEXT[name]}; {worst[name]()} (not valid)")
+    h_c = np.asarray(eff.friction.h_c, float)
+    thin = loaded & (h_c < FILM_MIN_MM)
+    if np.any(thin):
+        out.append(f"film h_c down to {1e6 * np.nanmin(np.where(thin, h_c, np.inf)):.3g} nm "
+                   f"at {int(thin.sum())} loaded contacts, below the film/asperity model's range "
+                   f"({1e6 * FILM_MIN_MM:g} nm, FILM_MIN_MM): regime and asperity share there "
+                   "are not reliable (boundary lubrication)")
+    k = np.asarray(eff.friction.k, float)[loaded]
+    if k.size and film_method in ("auto", "point") and np.any(k < 1.0):
+        out.append(f"Hamrock-Dowson film formula used outside its fitted ellipticity range "
+                   f"1 <= k <= 8 (k down to {k.min():.3g})")
     if bool(np.asarray(eff.truncated)):
         out.append("the TCA grid or the number of tooth pairs does not cover every pair in "
                    "contact: widen --pitches / raise the number of pairs")

@@ -190,3 +190,47 @@ def test_cycle_summary_over_valid_positions_only():
     g = jax.grad(lambda p: cycle_summary(p, P_in, mu, load, us, p_max, te, valid)
                  .mean_efficiency)(P_f)
     np.testing.assert_allclose(g, [-1 / 200.0, 0.0, -1 / 200.0, 0.0], rtol=1e-14)
+
+
+def test_plausibility_thresholds_on_synthetic_positions():
+    """Each check at its documented threshold on a synthetic cycle (one position
+    failing one check each).  Planted bugs caught: a check dropped or with a flipped
+    comparison, eta = 0 or eta > 1 accepted, an unloaded contact's value counted, a
+    NaN passing, a deflection limit not scaled by the pitch."""
+    from gearjax.mesh_efficiency import (DEFLECTION_MAX_PITCH, MU_MAX, P_MAX_LIMIT_MPA,
+                                         plausibility)
+    pitch = 2 * np.pi / 20
+    eta = jnp.array([0.99, 1.0, 0.0, 1.0 + 1e-12, 0.98, 0.98, 0.98, np.nan])
+    load = jnp.array([[1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0],
+                      [0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]])
+    mu = jnp.array([[0.05, MU_MAX, 0.05, 0.05, MU_MAX * 1.01, 0.05, 0.05, 0.05],
+                    [9.0, 0.05, 9.0, 9.0, 9.0, 9.0, 9.0, 9.0]])      # unloaded: ignored
+    pm = jnp.array([[1e3, P_MAX_LIMIT_MPA, 1e3, 1e3, 1e3, 5001.0, 1e3, 1e3],
+                    [9e9, 1e3, 9e9, 9e9, 9e9, 9e9, 9e9, 9e9]])
+    y = jnp.array([0.0, DEFLECTION_MAX_PITCH * pitch, 0.0, 0.0, 0.0, 0.0,
+                   DEFLECTION_MAX_PITCH * pitch * 1.001, 0.0])
+    p = plausibility(eta, mu, load, pm, y, pitch)
+    np.testing.assert_array_equal(p.efficiency, [1, 1, 0, 0, 1, 1, 1, 0])
+    np.testing.assert_array_equal(p.mu, [1, 1, 1, 1, 0, 1, 1, 1])
+    np.testing.assert_array_equal(p.p_max, [1, 1, 1, 1, 1, 0, 1, 1])
+    np.testing.assert_array_equal(p.deflection, [1, 1, 1, 1, 1, 1, 0, 1])
+    np.testing.assert_array_equal(p.all, [1, 1, 0, 0, 0, 0, 0, 0])
+
+
+def test_implausible_results_are_flagged_and_not_valid(spur, iso_run):
+    """The iso run's result with planted implausible values, through
+    ``efficiency_warnings`` (concrete, no new program): a warning line per failed
+    check naming the threshold; a film below FILM_MIN_MM warns.  Planted bugs caught:
+    a check that never fires on a real result's fields (wrong field, wrong axis), a
+    warning line without the value."""
+    from gearjax.mesh_efficiency import FILM_MIN_MM, MU_MAX, P_MAX_LIMIT_MPA
+    eff, res = iso_run
+    assert all("implausible" not in w for w in efficiency_warnings(eff, res))
+    fr = eff.friction._replace(mu=eff.friction.mu * 100.0, h_c=eff.friction.h_c * 0 + 1e-6)
+    ld = eff.loaded._replace(p_max=eff.loaded.p_max * 100.0,
+                             deflection=eff.loaded.deflection + 1.0)
+    bad = eff._replace(friction=fr, loaded=ld, efficiency=eff.efficiency - 2.0)
+    w = "\n".join(efficiency_warnings(bad, res))
+    assert f"mu above {MU_MAX:g}" in w and f"p_max above {P_MAX_LIMIT_MPA:g} MPa" in w
+    assert "eta_m outside (0, 1]" in w and "fall-back" in w and "of a pinion pitch" in w
+    assert f"{1e6 * FILM_MIN_MM:g} nm" in w and "1 nm" in w

@@ -281,7 +281,7 @@ def run(args) -> int:
         bar.update()
     for w in caught:
         sys.stderr.write(f"gearjax: warning: {w.message}\n")
-    warn_lines = gj.efficiency_warnings(eff, res)
+    warn_lines = gj.efficiency_warnings(eff, res, film_method=args.film)
     for w in warn_lines:
         sys.stderr.write(f"gearjax: warning: {args.side} side: {w}\n")
 
