@@ -63,7 +63,7 @@ from gearjax.tribology.lubricant import Oil
 __all__ = ["MeshEfficiency", "mesh_efficiency", "efficiency_function", "mesh_efficiency_traced",
            "efficiency_warnings", "cycle_window", "check_operating_point", "cycle_summary",
            "CycleSummary", "plausibility", "Plausibility", "TORQUE_RANGE_NM", "RPM_RANGE",
-           "MU_MAX", "P_MAX_LIMIT_MPA", "DEFLECTION_MAX_PITCH", "FILM_MIN_MM"]
+           "MU_MAX", "P_MAX_LIMIT_MPA", "DEFLECTION_MAX_PITCH", "HERTZ_SIZE_MAX", "FILM_MIN_MM"]
 
 #: accepted pinion torque (N m) and speed (rpm)
 TORQUE_RANGE_NM = (1e-3, 1e6)
@@ -84,6 +84,11 @@ P_MAX_LIMIT_MPA = 5000.0
 #: as a fraction of the pinion's angular pitch (2 % of a pitch: ~0.25 mm of arc at
 #: m = 4; elastic tooth deflections at rated load are tens of micrometres)
 DEFLECTION_MAX_PITCH = 0.02
+#: largest plausible Hertz half-width (semi-minor axis) of a loaded contact relative to
+#: its radius R_x along the entrainment: Hertz theory needs a contact small against the
+#: radii (a few per cent at rated load); half the radius means a contact as wide as the
+#: tooth flank, an approach beyond what the tooth allows
+HERTZ_SIZE_MAX = 0.5
 #: FILM_MIN_MM (gearjax.tribology.friction): the thinnest film inside the film model's
 #: range (a warning, not a failure)
 
@@ -196,10 +201,11 @@ class Plausibility(NamedTuple):
     mu: jax.Array
     p_max: jax.Array
     deflection: jax.Array
+    contact: jax.Array
 
     @property
     def all(self):
-        return self.efficiency & self.mu & self.p_max & self.deflection
+        return self.efficiency & self.mu & self.p_max & self.deflection & self.contact
 
 
 #: the reason printed for each failed check of :class:`Plausibility`
@@ -210,16 +216,21 @@ PLAUSIBILITY_TEXT = {
              "range of steel)",
     "deflection": f"loaded fall-back behind the unloaded TE above {DEFLECTION_MAX_PITCH:g} of "
                   "a pinion pitch (DEFLECTION_MAX_PITCH: beyond what a tooth allows)",
+    "contact": f"Hertz half-width above {HERTZ_SIZE_MAX:g} R_x (HERTZ_SIZE_MAX: an approach "
+               "beyond what the tooth allows, outside Hertz theory)",
 }
 
 
-def plausibility(efficiency, mu, load, p_max, deflection, pitch) -> Plausibility:
+def plausibility(efficiency, mu, load, p_max, deflection, pitch, semi_minor, r_x
+                 ) -> Plausibility:
     """Plausibility of the results at each position (traceable; (M,) booleans).
 
     ``efficiency`` (M,) eta_m, ``mu``, ``load`` (N), ``p_max`` (MPa) (K, M),
     ``deflection`` (M,) loaded fall-back y (rad), ``pitch`` the pinion angular pitch
-    (rad).  A position passes when ``0 < eta_m <= 1``, every loaded contact has
-    ``mu <= MU_MAX`` and ``p_max <= P_MAX_LIMIT_MPA``, and
+    (rad), ``semi_minor`` (K, M) Hertz half-width and ``r_x`` (K, M) radius along the
+    entrainment (mm).  A position passes when ``0 < eta_m <= 1``, every loaded contact
+    has ``mu <= MU_MAX``, ``p_max <= P_MAX_LIMIT_MPA`` and
+    ``semi_minor <= HERTZ_SIZE_MAX r_x``, and
     ``y <= DEFLECTION_MAX_PITCH * pitch`` (NaN fails every check).  A position that
     fails one is not valid (:class:`MeshEfficiency`): its numbers are not a result.
     """
@@ -228,7 +239,8 @@ def plausibility(efficiency, mu, load, p_max, deflection, pitch) -> Plausibility
     mu_ok = jnp.all(~loaded | (mu <= MU_MAX), axis=0)
     p_ok = jnp.all(~loaded | (p_max <= P_MAX_LIMIT_MPA), axis=0)
     y_ok = deflection <= DEFLECTION_MAX_PITCH * pitch
-    return Plausibility(eff_ok, mu_ok, p_ok, y_ok)
+    c_ok = jnp.all(~loaded | (semi_minor <= HERTZ_SIZE_MAX * r_x), axis=0)
+    return Plausibility(eff_ok, mu_ok, p_ok, y_ok, c_ok)
 
 
 def _pitch(phi1, steps_per_pitch):
@@ -354,7 +366,8 @@ def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, speed_ra
     degenerate = pressed(degenerate0)              # beyond an edge of regression
     # a position where no pair carries load has no modelled loss: never valid
     # an implausible result (plausibility) is not a result either
-    plaus = plausibility(ml.efficiency, ml.mu.T, F, p_max, y, _pitch(path.phi1, steps_per_pitch))
+    plaus = plausibility(ml.efficiency, ml.mu.T, F, p_max, y, _pitch(path.phi1, steps_per_pitch),
+                         b_ax, R_x)
     valid = (conv & jnp.all(fr.converged | ~loaded_on, axis=0) & ~edge_loaded & ~truncated
              & ~degenerate & jnp.any(loaded_on, axis=0) & plaus.all)
     sm = cycle_summary(ml.power_loss, power_in, ml.mu.T, F, us, p_max, te_loaded, valid)
@@ -454,21 +467,29 @@ def efficiency_warnings(eff: MeshEfficiency, res: TCAResult, *, film_method: str
     phi = np.asarray(eff.phi1, float)
     pl = plausibility(np.asarray(eff.efficiency), np.asarray(eff.friction.mu), F,
                       np.asarray(eff.loaded.p_max), np.asarray(eff.loaded.deflection),
-                      float(np.abs(phi[1] - phi[0]) * phi.shape[0]) if phi.size > 1 else np.inf)
+                      float(np.abs(phi[1] - phi[0]) * phi.shape[0]) if phi.size > 1 else np.inf,
+                      np.asarray(eff.loaded.semi_minor), np.asarray(eff.r_x))
+    # only where the load sharing converged (elsewhere the values are not results and
+    # the non-convergence is its own warning)
+    conv = np.asarray(eff.loaded.converged, bool)
+    eta = np.asarray(eff.efficiency, float)
+    mu = np.where(loaded, np.asarray(eff.friction.mu, float), -np.inf)
+    pm = np.where(loaded, np.asarray(eff.loaded.p_max, float), -np.inf)
+    y = np.asarray(eff.loaded.deflection, float)
+    hw = np.where(loaded, np.asarray(eff.loaded.semi_minor, float) / np.asarray(eff.r_x, float),
+                  -np.inf)
     worst = {
-        "efficiency": lambda: f"eta_m from {np.nanmin(np.asarray(eff.efficiency)):.6g} to "
-                              f"{np.nanmax(np.asarray(eff.efficiency)):.6g}",
-        "mu": lambda: f"mu up to {np.nanmax(np.where(loaded, np.asarray(eff.friction.mu), -np.inf)):.4g}",
-        "p_max": lambda: f"p_max up to "
-                         f"{np.nanmax(np.where(loaded, np.asarray(eff.loaded.p_max), -np.inf)):.0f} MPa",
-        "deflection": lambda: f"fall-back up to "
-                              f"{np.nanmax(np.asarray(eff.loaded.deflection)) * 206264.80624709636:.0f} arcsec",
+        "efficiency": lambda b: f"eta_m from {np.min(eta[b]):.9g} to {np.max(eta[b]):.9g}",
+        "mu": lambda b: f"mu up to {np.max(mu[:, b]):.4g}",
+        "p_max": lambda b: f"p_max up to {np.max(pm[:, b]):.0f} MPa",
+        "deflection": lambda b: f"fall-back up to {np.max(y[b]) * 206264.80624709636:.0f} arcsec",
+        "contact": lambda b: f"half-width / R_x up to {np.max(hw[:, b]):.3g}",
     }
     for name, ok in pl._asdict().items():
-        bad = ~np.asarray(ok)
+        bad = ~np.asarray(ok) & conv
         if np.any(bad):
             out.append(f"implausible result at {int(bad.sum())} of {bad.size} positions: "
-                       f"{PLAUSIBILITY_TEXT[name]}; {worst[name]()} (not valid)")
+                       f"{PLAUSIBILITY_TEXT[name]}; {worst[name](bad)} (not valid)")
     h_c = np.asarray(eff.friction.h_c, float)
     thin = loaded & (h_c < FILM_MIN_MM)
     if np.any(thin):

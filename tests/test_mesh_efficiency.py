@@ -197,8 +197,8 @@ def test_plausibility_thresholds_on_synthetic_positions():
     failing one check each).  Planted bugs caught: a check dropped or with a flipped
     comparison, eta = 0 or eta > 1 accepted, an unloaded contact's value counted, a
     NaN passing, a deflection limit not scaled by the pitch."""
-    from gearjax.mesh_efficiency import (DEFLECTION_MAX_PITCH, MU_MAX, P_MAX_LIMIT_MPA,
-                                         plausibility)
+    from gearjax.mesh_efficiency import (DEFLECTION_MAX_PITCH, HERTZ_SIZE_MAX, MU_MAX,
+                                         P_MAX_LIMIT_MPA, plausibility)
     pitch = 2 * np.pi / 20
     eta = jnp.array([0.99, 1.0, 0.0, 1.0 + 1e-12, 0.98, 0.98, 0.98, np.nan])
     load = jnp.array([[1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0],
@@ -209,11 +209,15 @@ def test_plausibility_thresholds_on_synthetic_positions():
                     [9e9, 1e3, 9e9, 9e9, 9e9, 9e9, 9e9, 9e9]])
     y = jnp.array([0.0, DEFLECTION_MAX_PITCH * pitch, 0.0, 0.0, 0.0, 0.0,
                    DEFLECTION_MAX_PITCH * pitch * 1.001, 0.0])
-    p = plausibility(eta, mu, load, pm, y, pitch)
+    r_x = jnp.full((2, 8), 10.0)
+    hw = jnp.array([[0.1, 10.0 * HERTZ_SIZE_MAX, 0.1, 0.1, 0.1, 0.1, 0.1, 5.01],
+                    [99.0, 0.1, 99.0, 99.0, 99.0, 99.0, 99.0, 99.0]])
+    p = plausibility(eta, mu, load, pm, y, pitch, hw, r_x)
     np.testing.assert_array_equal(p.efficiency, [1, 1, 0, 0, 1, 1, 1, 0])
     np.testing.assert_array_equal(p.mu, [1, 1, 1, 1, 0, 1, 1, 1])
     np.testing.assert_array_equal(p.p_max, [1, 1, 1, 1, 1, 0, 1, 1])
     np.testing.assert_array_equal(p.deflection, [1, 1, 1, 1, 1, 1, 0, 1])
+    np.testing.assert_array_equal(p.contact, [1, 1, 1, 1, 1, 1, 1, 0])
     np.testing.assert_array_equal(p.all, [1, 1, 0, 0, 0, 0, 0, 0])
 
 
@@ -228,9 +232,14 @@ def test_implausible_results_are_flagged_and_not_valid(spur, iso_run):
     assert all("implausible" not in w for w in efficiency_warnings(eff, res))
     fr = eff.friction._replace(mu=eff.friction.mu * 100.0, h_c=eff.friction.h_c * 0 + 1e-6)
     ld = eff.loaded._replace(p_max=eff.loaded.p_max * 100.0,
-                             deflection=eff.loaded.deflection + 1.0)
+                             deflection=eff.loaded.deflection + 1.0,
+                             semi_minor=eff.loaded.semi_minor * 1e3)
     bad = eff._replace(friction=fr, loaded=ld, efficiency=eff.efficiency - 2.0)
     w = "\n".join(efficiency_warnings(bad, res))
     assert f"mu above {MU_MAX:g}" in w and f"p_max above {P_MAX_LIMIT_MPA:g} MPa" in w
     assert "eta_m outside (0, 1]" in w and "fall-back" in w and "of a pinion pitch" in w
     assert f"{1e6 * FILM_MIN_MM:g} nm" in w and "1 nm" in w
+    assert "Hertz half-width above" in w
+    # the spur run's own contacts are far inside Hertz theory (half-width / R_x)
+    hw = np.asarray(eff.loaded.semi_minor) / np.asarray(eff.r_x)
+    assert np.max(hw[np.asarray(eff.loaded.load) > 0]) < 0.1
