@@ -9,7 +9,9 @@ checked against :data:`gearjax.TORQUE_RANGE_NM` and :data:`gearjax.RPM_RANGE`.
 
 Exit status as ``gearjax tca``: 0 with a result (problems of the result -- TCA
 quality flags, positions whose load balance or friction solve did not converge, a
-loaded edge contact, a grid too short -- are ``gearjax: warning:`` lines on stderr
+loaded edge contact, a grid too short, implausible results (``plausibility`` of
+:mod:`gearjax.mesh_efficiency`), a partial cycle (summaries over the valid positions
+only) -- are ``gearjax: warning:`` lines on stderr
 and ``valid``/``warnings`` in the output); 2 bad input, refused before any work; 3
 no position of the cycle is valid (the result is printed, with one error line).
 """
@@ -52,7 +54,11 @@ EFFICIENCY_KEYS_DOC = """JSON keys (K tooth pairs, M positions over one mesh cyc
   efficiency            (M,) eta_m = 1 - P_f / P_in
   te_loaded_arcsec      (M,) loaded transmission error (arcsec)
   valid                 (M,) every loaded contact converged (load balance, Hertz,
-                        friction), no loaded edge contact, grid not truncated
+                        friction), no loaded edge contact, grid not truncated, some
+                        pair loaded, and the result plausible: 0 < eta_m <= 1,
+                        mu <= 0.3, p_max <= 5000 MPa, fall-back <= 0.02 pitch, Hertz
+                        half-width <= 0.5 R_x (docs/efficiency.md; a warning line per
+                        failed check)
   edge_loaded           (M,) an edge contact would carry load (not modelled)
   n_valid               number of valid positions; the five summaries below are over
                         the valid positions only (null when none; a partial cycle,
