@@ -453,13 +453,14 @@ def _post_jit(res, pair, T, w, oil, surface, E_prime, *, teeth_of, steps_per_pit
 
 
 
-def efficiency_warnings(eff: MeshEfficiency, res: TCAResult, *, film_method: str = "auto"
-                        ) -> list[str]:
+def efficiency_warnings(eff: MeshEfficiency, res: TCAResult, *, film_method: str = "auto",
+                        viscosity_model: str = "roelands") -> list[str]:
     """One line per problem of a concrete result: TCA quality flags, load balance or
     friction solves not converged, grid too short, loaded edge contact, implausible
     results (:func:`plausibility`: one line per failed check with the worst value), a
     film below :data:`FILM_MIN_MM`, the film formula outside its fitted ellipticity
-    range (``film_method`` as given to the friction model)."""
+    range and the viscosity law above 3 GPa (``film_method``, ``viscosity_model`` as
+    given to the friction model)."""
     out = list(res.warnings())
     valid = np.asarray(eff.valid)
     F = np.asarray(eff.loaded.load, float)
@@ -501,6 +502,11 @@ def efficiency_warnings(eff: MeshEfficiency, res: TCAResult, *, film_method: str
     if k.size and film_method in ("auto", "point") and np.any(k < 1.0):
         out.append(f"Hamrock-Dowson film formula used outside its fitted ellipticity range "
                    f"1 <= k <= 8 (k down to {k.min():.3g})")
+    pmx = np.asarray(eff.loaded.p_max, float)[loaded]
+    if pmx.size and np.any(pmx > 3000.0):
+        out.append(f"{viscosity_model.capitalize()} viscosity law extrapolated above 3 GPa "
+                   f"(p_max up to {pmx.max():.0f} MPa at {int(np.sum(pmx > 3000.0))} loaded "
+                   "contacts); its validity range is about 0-3 GPa")
     if bool(np.asarray(eff.truncated)):
         out.append("the TCA grid or the number of tooth pairs does not cover every pair in "
                    "contact: widen --pitches / raise the number of pairs")

@@ -239,7 +239,7 @@ def test_implausible_results_are_flagged_and_not_valid(spur, iso_run):
     assert f"mu above {MU_MAX:g}" in w and f"p_max above {P_MAX_LIMIT_MPA:g} MPa" in w
     assert "eta_m outside (0, 1]" in w and "fall-back" in w and "of a pinion pitch" in w
     assert f"{1e6 * FILM_MIN_MM:g} nm" in w and "1 nm" in w
-    assert "Hertz half-width above" in w
+    assert "Hertz half-width above" in w and "viscosity law extrapolated above 3 GPa" in w
     # the spur run's own contacts are far inside Hertz theory (half-width / R_x)
     hw = np.asarray(eff.loaded.semi_minor) / np.asarray(eff.r_x)
     assert np.max(hw[np.asarray(eff.loaded.load) > 0]) < 0.1

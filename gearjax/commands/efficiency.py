@@ -287,7 +287,8 @@ def run(args) -> int:
         bar.update()
     for w in caught:
         sys.stderr.write(f"gearjax: warning: {w.message}\n")
-    warn_lines = gj.efficiency_warnings(eff, res, film_method=args.film)
+    warn_lines = gj.efficiency_warnings(eff, res, film_method=args.film,
+                                        viscosity_model=args.viscosity)
     for w in warn_lines:
         sys.stderr.write(f"gearjax: warning: {args.side} side: {w}\n")
 
