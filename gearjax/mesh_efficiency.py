@@ -56,19 +56,41 @@ from gearjax.loaded_contact import (COMPLIANCE_MODELS, LoadedContact, MeshTeeth,
                                     hertz_coefficient,
                                     lever_arms, pair_arrays, pair_compliance, share_torque)
 from gearjax.tca_result import TCAResult, family_of
-from gearjax.tribology.friction import STEEL_E_PRIME, FrictionResult, Surface
+from gearjax.tribology.friction import FILM_MIN_MM, STEEL_E_PRIME, FrictionResult, Surface
 from gearjax.tribology.losses import mesh_losses_traced
 from gearjax.tribology.lubricant import Oil
 
 __all__ = ["MeshEfficiency", "mesh_efficiency", "efficiency_function", "mesh_efficiency_traced",
-           "efficiency_warnings", "cycle_window", "check_operating_point",
-           "TORQUE_RANGE_NM", "RPM_RANGE"]
+           "efficiency_warnings", "cycle_window", "check_operating_point", "cycle_summary",
+           "CycleSummary", "plausibility", "Plausibility", "TORQUE_RANGE_NM", "RPM_RANGE",
+           "MU_MAX", "P_MAX_LIMIT_MPA", "DEFLECTION_MAX_PITCH", "HERTZ_SIZE_MAX", "FILM_MIN_MM"]
 
 #: accepted pinion torque (N m) and speed (rpm)
 TORQUE_RANGE_NM = (1e-3, 1e6)
 #: largest accepted r_y / r_x of a point contact (beyond: degenerate, flagged)
 MAX_RADIUS_RATIO = 1e4
 RPM_RANGE = (1e-3, 1e6)
+
+# -- plausibility of the results (:func:`plausibility`; docs/efficiency.md) ----------
+#: largest plausible friction coefficient of a lubricated steel contact: boundary
+#: friction of steel on steel under oil is 0.1-0.15, dry steel ~0.6; above 0.3 the
+#: mixed-lubrication model is outside anything it was fitted to
+MU_MAX = 0.3
+#: largest plausible maximum Hertz pressure (MPa) of a steel gear contact: far above
+#: the contact-fatigue allowables of case-hardened steel (~1500 MPa) and at the onset
+#: of gross subsurface yield, where the elastic Hertz/EHL model no longer holds
+P_MAX_LIMIT_MPA = 5000.0
+#: largest plausible loaded fall-back ``y`` of the gear behind the unloaded TE envelope,
+#: as a fraction of the pinion's angular pitch (2 % of a pitch: ~0.25 mm of arc at
+#: m = 4; elastic tooth deflections at rated load are tens of micrometres)
+DEFLECTION_MAX_PITCH = 0.02
+#: largest plausible Hertz half-width (semi-minor axis) of a loaded contact relative to
+#: its radius R_x along the entrainment: Hertz theory needs a contact small against the
+#: radii (a few per cent at rated load); half the radius means a contact as wide as the
+#: tooth flank, an approach beyond what the tooth allows
+HERTZ_SIZE_MAX = 0.5
+#: FILM_MIN_MM (gearjax.tribology.friction): the thinnest film inside the film model's
+#: range (a warning, not a failure)
 
 
 class MeshEfficiency(NamedTuple):
@@ -86,7 +108,8 @@ class MeshEfficiency(NamedTuple):
     mean_mu : load- and sliding-weighted mean mu, ``sum mu F |u_s| / sum F |u_s|``.
     max_p_max : highest Hertz pressure over the cycle (MPa).
     power_in : P_in (W).
-    valid : (M,) every loaded contact converged (load balance, Hertz, load sharing).
+    valid : (M,) every loaded contact converged (load balance, Hertz, load sharing),
+        some pair carries load, and the result is plausible (:func:`plausibility`).
     truncated : the grid or the number of pairs does not cover every pair in contact.
     edge_loaded : (M,) an edge contact would be compressed under the load (its load
         is not modelled: the result is then not valid).
@@ -95,6 +118,9 @@ class MeshEfficiency(NamedTuple):
         edge of regression of a generated flank, where the flank is undercut) would be
         compressed under the load; such contacts carry no modelled load, and the
         position is not valid.
+    n_valid : number of valid positions, over which the four summaries are taken.
+    te_loaded_ptp : peak-to-peak of the loaded TE over the valid positions (rad; NaN
+        when none).
     """
 
     phi1: jax.Array
@@ -114,6 +140,112 @@ class MeshEfficiency(NamedTuple):
     truncated: jax.Array
     edge_loaded: jax.Array
     degenerate: jax.Array
+    n_valid: jax.Array
+    te_loaded_ptp: jax.Array
+
+
+class CycleSummary(NamedTuple):
+    """Summaries of one mesh cycle over its valid positions (:func:`cycle_summary`)."""
+
+    mean_efficiency: jax.Array
+    mean_mu: jax.Array
+    max_p_max: jax.Array
+    te_loaded_ptp: jax.Array
+    n_valid: jax.Array
+
+
+def cycle_summary(power_loss, power_in, mu, load, u_s, p_max, te_loaded, valid) -> CycleSummary:
+    """Summaries of a mesh cycle over its valid positions only (traceable).
+
+    ``power_loss`` (M,) W, ``power_in`` W, ``mu``, ``load`` (N), ``u_s``, ``p_max`` (MPa)
+    (K, M), ``te_loaded`` (M,) rad, ``valid`` (M,) bool.  With ``V`` the valid positions
+    (equally spaced in time)::
+
+        eta_bar = 1 - sum_V P_f / (|V| P_in)
+        mean mu = sum_V,k mu F |u_s| / sum_V,k F |u_s|      (loaded contacts)
+        max p_max = max_V,k p_max                           (loaded contacts)
+        loaded TE p-t-p = max_V te - min_V te
+
+    A position that is not valid (load balance or friction not converged, a loaded
+    edge or degenerate contact, no pair carrying load, a truncated grid) has no
+    modelled loss: counting it with ``P_f = 0`` would report a silent 100 %.  Every
+    summary is NaN when no position is valid (``n_valid = 0``); when only some are,
+    the summaries describe the modelled part of the cycle and the result is flagged
+    (:func:`efficiency_warnings`).  Gradients are finite (the masks are constants of
+    the derivative).
+    """
+    valid = jnp.asarray(valid, bool)
+    n_valid = jnp.sum(valid)
+    some = n_valid > 0
+    nan = jnp.nan
+    vf = valid.astype(float)
+    pin = jnp.asarray(power_in, float)
+    mean_eff = 1.0 - jnp.sum(vf * power_loss) / (jnp.maximum(n_valid, 1) * pin)
+    loaded = (load > 0.0) & valid[None, :]
+    w = jnp.where(loaded, load * jnp.abs(u_s), 0.0)
+    den = jnp.sum(w)
+    mean_mu = jnp.sum(jnp.where(loaded, mu, 0.0) * w) / jnp.where(den > 0.0, den, 1.0)
+    pm = jnp.max(jnp.where(loaded, p_max, -jnp.inf))
+    te_hi = jnp.max(jnp.where(valid, te_loaded, -jnp.inf))
+    te_lo = jnp.min(jnp.where(valid, te_loaded, jnp.inf))
+    return CycleSummary(jnp.where(some, mean_eff, nan), jnp.where(den > 0.0, mean_mu, nan),
+                        jnp.where(jnp.any(loaded), pm, nan),
+                        jnp.where(some, te_hi - te_lo, nan), n_valid)
+
+
+class Plausibility(NamedTuple):
+    """(M,) per position: the result passes each plausibility check
+    (:func:`plausibility`)."""
+
+    efficiency: jax.Array
+    mu: jax.Array
+    p_max: jax.Array
+    deflection: jax.Array
+    contact: jax.Array
+
+    @property
+    def all(self):
+        return self.efficiency & self.mu & self.p_max & self.deflection & self.contact
+
+
+#: the reason printed for each failed check of :class:`Plausibility`
+PLAUSIBILITY_TEXT = {
+    "efficiency": "eta_m outside (0, 1]",
+    "mu": f"mu above {MU_MAX:g} (MU_MAX)",
+    "p_max": f"p_max above {P_MAX_LIMIT_MPA:g} MPa (P_MAX_LIMIT_MPA: beyond the elastic "
+             "range of steel)",
+    "deflection": f"loaded fall-back behind the unloaded TE above {DEFLECTION_MAX_PITCH:g} of "
+                  "a pinion pitch (DEFLECTION_MAX_PITCH: beyond what a tooth allows)",
+    "contact": f"Hertz half-width above {HERTZ_SIZE_MAX:g} R_x (HERTZ_SIZE_MAX: an approach "
+               "beyond what the tooth allows, outside Hertz theory)",
+}
+
+
+def plausibility(efficiency, mu, load, p_max, deflection, pitch, semi_minor, r_x
+                 ) -> Plausibility:
+    """Plausibility of the results at each position (traceable; (M,) booleans).
+
+    ``efficiency`` (M,) eta_m, ``mu``, ``load`` (N), ``p_max`` (MPa) (K, M),
+    ``deflection`` (M,) loaded fall-back y (rad), ``pitch`` the pinion angular pitch
+    (rad), ``semi_minor`` (K, M) Hertz half-width and ``r_x`` (K, M) radius along the
+    entrainment (mm).  A position passes when ``0 < eta_m <= 1``, every loaded contact
+    has ``mu <= MU_MAX``, ``p_max <= P_MAX_LIMIT_MPA`` and
+    ``semi_minor <= HERTZ_SIZE_MAX r_x``, and
+    ``y <= DEFLECTION_MAX_PITCH * pitch`` (NaN fails every check).  A position that
+    fails one is not valid (:class:`MeshEfficiency`): its numbers are not a result.
+    """
+    loaded = load > 0.0
+    eff_ok = (efficiency > 0.0) & (efficiency <= 1.0)
+    mu_ok = jnp.all(~loaded | (mu <= MU_MAX), axis=0)
+    p_ok = jnp.all(~loaded | (p_max <= P_MAX_LIMIT_MPA), axis=0)
+    y_ok = deflection <= DEFLECTION_MAX_PITCH * pitch
+    c_ok = jnp.all(~loaded | (semi_minor <= HERTZ_SIZE_MAX * r_x), axis=0)
+    return Plausibility(eff_ok, mu_ok, p_ok, y_ok, c_ok)
+
+
+def _pitch(phi1, steps_per_pitch):
+    """The pinion angular pitch (rad) from the grid spacing of the positions."""
+    return jnp.abs(phi1[1] - phi1[0]) * steps_per_pitch
 
 
 def cycle_window(n_grid: int, steps_per_pitch: int) -> np.ndarray:
@@ -213,8 +345,6 @@ def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, speed_ra
                             viscosity_model=viscosity_model, film_method=film_method)
     fr = FrictionResult(*(jnp.swapaxes(v, 0, 1) for v in ml.friction))
     loaded_on = F > 0.0
-    w_loss = F * us * loaded_on
-    mean_mu = jnp.sum(ml.mu.T * w_loss) / jnp.sum(w_loss)
     share = l1 * F / T1
     lc = LoadedContact(F, share, w, p_max, a_ax, b_ax, y, te_loaded, bal, conv,
                        jnp.sum(loaded_on, axis=0))
@@ -234,11 +364,16 @@ def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, speed_ra
 
     edge_loaded = pressed(res.edge_points)          # face-end (edge) contacts
     degenerate = pressed(degenerate0)              # beyond an edge of regression
+    # a position where no pair carries load has no modelled loss: never valid
+    # an implausible result (plausibility) is not a result either
+    plaus = plausibility(ml.efficiency, ml.mu.T, F, p_max, y, _pitch(path.phi1, steps_per_pitch),
+                         b_ax, R_x)
     valid = (conv & jnp.all(fr.converged | ~loaded_on, axis=0) & ~edge_loaded & ~truncated
-             & ~degenerate)
+             & ~degenerate & jnp.any(loaded_on, axis=0) & plaus.all)
+    sm = cycle_summary(ml.power_loss, power_in, ml.mu.T, F, us, p_max, te_loaded, valid)
     return MeshEfficiency(path.phi1[win], lc, ue, us, R_x, R_y, fr, ml.power_loss, ml.efficiency,
-                          ml.mean_efficiency, mean_mu, jnp.max(p_max), power_in, valid, truncated,
-                          edge_loaded, degenerate)
+                          sm.mean_efficiency, sm.mean_mu, sm.max_p_max, power_in, valid, truncated,
+                          edge_loaded, degenerate, sm.n_valid, sm.te_loaded_ptp)
 
 
 def efficiency_function(design, *, side=None, compliance: str = "weber", E_prime=STEEL_E_PRIME,
@@ -318,11 +453,60 @@ def _post_jit(res, pair, T, w, oil, surface, E_prime, *, teeth_of, steps_per_pit
 
 
 
-def efficiency_warnings(eff: MeshEfficiency, res: TCAResult) -> list[str]:
+def efficiency_warnings(eff: MeshEfficiency, res: TCAResult, *, film_method: str = "auto",
+                        viscosity_model: str = "roelands") -> list[str]:
     """One line per problem of a concrete result: TCA quality flags, load balance or
-    friction solves not converged, grid too short, loaded edge contact."""
+    friction solves not converged, grid too short, loaded edge contact, implausible
+    results (:func:`plausibility`: one line per failed check with the worst value), a
+    film below :data:`FILM_MIN_MM`, the film formula outside its fitted ellipticity
+    range and the viscosity law above 3 GPa (``film_method``, ``viscosity_model`` as
+    given to the friction model)."""
     out = list(res.warnings())
     valid = np.asarray(eff.valid)
+    F = np.asarray(eff.loaded.load, float)
+    loaded = F > 0.0
+    phi = np.asarray(eff.phi1, float)
+    pl = plausibility(np.asarray(eff.efficiency), np.asarray(eff.friction.mu), F,
+                      np.asarray(eff.loaded.p_max), np.asarray(eff.loaded.deflection),
+                      float(np.abs(phi[1] - phi[0]) * phi.shape[0]) if phi.size > 1 else np.inf,
+                      np.asarray(eff.loaded.semi_minor), np.asarray(eff.r_x))
+    # only where the load sharing converged (elsewhere the values are not results and
+    # the non-convergence is its own warning)
+    conv = np.asarray(eff.loaded.converged, bool)
+    eta = np.asarray(eff.efficiency, float)
+    mu = np.where(loaded, np.asarray(eff.friction.mu, float), -np.inf)
+    pm = np.where(loaded, np.asarray(eff.loaded.p_max, float), -np.inf)
+    y = np.asarray(eff.loaded.deflection, float)
+    hw = np.where(loaded, np.asarray(eff.loaded.semi_minor, float) / np.asarray(eff.r_x, float),
+                  -np.inf)
+    worst = {
+        "efficiency": lambda b: f"eta_m from {np.min(eta[b]):.9g} to {np.max(eta[b]):.9g}",
+        "mu": lambda b: f"mu up to {np.max(mu[:, b]):.4g}",
+        "p_max": lambda b: f"p_max up to {np.max(pm[:, b]):.0f} MPa",
+        "deflection": lambda b: f"fall-back up to {np.max(y[b]) * 206264.80624709636:.0f} arcsec",
+        "contact": lambda b: f"half-width / R_x up to {np.max(hw[:, b]):.3g}",
+    }
+    for name, ok in pl._asdict().items():
+        bad = ~np.asarray(ok) & conv
+        if np.any(bad):
+            out.append(f"implausible result at {int(bad.sum())} of {bad.size} positions: "
+                       f"{PLAUSIBILITY_TEXT[name]}; {worst[name](bad)} (not valid)")
+    h_c = np.asarray(eff.friction.h_c, float)
+    thin = loaded & (h_c < FILM_MIN_MM)
+    if np.any(thin):
+        out.append(f"film h_c down to {1e6 * np.nanmin(np.where(thin, h_c, np.inf)):.3g} nm "
+                   f"at {int(thin.sum())} loaded contacts, below the film/asperity model's range "
+                   f"({1e6 * FILM_MIN_MM:g} nm, FILM_MIN_MM): regime and asperity share there "
+                   "are not reliable (boundary lubrication)")
+    k = np.asarray(eff.friction.k, float)[loaded]
+    if k.size and film_method in ("auto", "point") and np.any(k < 1.0):
+        out.append(f"Hamrock-Dowson film formula used outside its fitted ellipticity range "
+                   f"1 <= k <= 8 (k down to {k.min():.3g})")
+    pmx = np.asarray(eff.loaded.p_max, float)[loaded]
+    if pmx.size and np.any(pmx > 3000.0):
+        out.append(f"{viscosity_model.capitalize()} viscosity law extrapolated above 3 GPa "
+                   f"(p_max up to {pmx.max():.0f} MPa at {int(np.sum(pmx > 3000.0))} loaded "
+                   "contacts); its validity range is about 0-3 GPa")
     if bool(np.asarray(eff.truncated)):
         out.append("the TCA grid or the number of tooth pairs does not cover every pair in "
                    "contact: widen --pitches / raise the number of pairs")
@@ -336,6 +520,11 @@ def efficiency_warnings(eff: MeshEfficiency, res: TCAResult) -> list[str]:
     if not np.all(np.asarray(eff.loaded.converged)):
         out.append("load sharing did not converge at some positions")
     if not np.all(valid):
-        out.append(f"{int(np.sum(~valid))} of {valid.size} positions are not valid "
-                   "(see the 'valid' flags)")
+        nv = int(np.sum(valid))
+        if nv:
+            out.append(f"{int(np.sum(~valid))} of {valid.size} positions are not valid "
+                       f"(see the 'valid' flags): eta_bar, mean mu, max p_max and loaded TE "
+                       f"are over the {nv} valid positions only (a partial cycle)")
+        else:
+            out.append(f"none of the {valid.size} positions is valid: no summary")
     return out

@@ -226,6 +226,13 @@ def contact_kinematics(r1: Callable, r2: Callable, asm: Assembly, mis: Misalignm
     return ContactKinematics(*out)
 
 
+class MaskCheck(NamedTuple):
+    """:meth:`TCAResult.mask_check`: mask points off the flank and a smooth penalty."""
+
+    n_off: jax.Array
+    penalty: jax.Array
+
+
 @functools.partial(jax.tree_util.register_dataclass,
                    data_fields=["path", "margin", "multi", "coords", "kinematics"],
                    meta_fields=["side", "family"])
@@ -294,7 +301,9 @@ class TCAResult:
         :attr:`on_flank`, so that every objective is smooth in the design): TE
         peak-to-peak (arcsec), mean and max |SRR|, min R_x (mm), and the contact
         position at the reference (hypoid: face-width position ``xi1``; otherwise the
-        radius on the pinion, mm).  Order: :attr:`OBJECTIVES`."""
+        radius on the pinion, mm).  Order: :attr:`OBJECTIVES`.  A mask point that
+        leaves the flank still enters (extrapolated): check :meth:`mask_check` --
+        an optimisation is an improvement only with ``n_off == 0`` at its end."""
         on = np.asarray(on)
         mid = on.shape[0] // 2
         k = self.kinematics
@@ -302,6 +311,31 @@ class TCAResult:
         pos = self.coords["xi1"][mid] if self.family == "hypoid" else self.path.radial1[mid]
         return jnp.stack([self.multi.ptp / ARCSEC, jnp.sum(srr) / on.sum(), jnp.max(srr),
                           jnp.min(jnp.where(on, k.r_x, jnp.inf)), pos])
+
+    def mask_check(self, on) -> "MaskCheck":
+        """Whether the fixed mask ``on`` of :meth:`objectives` is still on the flank
+        (traceable).  Returns :class:`MaskCheck`:
+
+        n_off : number of mask points that are no longer surface contacts inside both
+            flank boundaries (:attr:`on_flank` false: beyond a boundary, at an edge or
+            not converged).  There the objectives' values are extrapolations of the
+            flank surfaces, not contacts: an optimiser can "improve" :meth:`objectives`
+            by moving mask points off the flank, so a run is only a true improvement
+            when ``n_off == 0`` at its end -- otherwise it is a flagged failure.
+        penalty : ``sum_mask max(0, -margin)^2`` (mm^2) over the converged mask points,
+            plus 1 per mask point whose contact solve did not converge: 0 while every
+            mask point is inside the boundaries, C^1 in the design (its gradient pushes
+            the points back onto the flank).  The recipe: minimise ``objective + w *
+            penalty`` (``w`` in objective units per mm^2, e.g. 1e3 for |SRR|) and check
+            ``n_off == 0`` at the end (docs/optimisation.md).
+        """
+        on = np.asarray(on)
+        conv = self.path.converged
+        n_off = jnp.sum(on & ~self.on_flank)
+        m = jnp.where(conv & jnp.isfinite(self.margin), self.margin, 0.0)
+        out = jnp.where(on & conv, jnp.maximum(-m, 0.0) ** 2, 0.0)
+        penalty = jnp.sum(out) + jnp.sum(on & ~conv)
+        return MaskCheck(n_off, penalty)
 
     def flags(self) -> dict:
         """Contact-quality flags of a concrete result (Python bools).

@@ -185,3 +185,25 @@ def test_bad_ehl_check_options_refused(capsys, monkeypatch, flags, name):
     rc = main(["efficiency", *BASE, *flags])
     err = capsys.readouterr().err
     assert rc == 2 and name in err and len(err.strip().splitlines()) == 1, err
+
+
+def test_implausible_result_exits_3_with_warnings(run):
+    """Issue 28's finding: --E-prime-MPa 1e-3 printed eta_bar = -18.9 % and mean mu 7.2
+    with every row "ok" (exit 0).  Same static options as the module's run (8
+    positions; E' is traced): no new program.  Planted bugs caught: the plausibility
+    not part of ``valid`` (exit 0, rows "ok"), summaries over all positions (a
+    number instead of null), the warning lines not reaching stderr."""
+    out, errs = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(errs):
+        rc = main(["efficiency", *BASE, "--positions", "8", "--json", "--E-prime-MPa", "1e-3"])
+    err = errs.getvalue()
+    assert rc == 3, err
+    d = _strict(out.getvalue())
+    assert d["n_valid"] == 0 and not any(d["valid"])
+    assert d["mean_efficiency"] is None and d["mean_mu"] is None
+    assert "gearjax: warning: drive side: implausible result" in err
+    assert "mu above 0.3" in err and "Hertz half-width above 0.5 R_x" in err
+    assert "no position of the mesh cycle gives a valid" in err
+    # the module's run at steel E' is whole and plausible
+    base = _strict(run[1])
+    assert base["n_valid"] == len(base["valid"]) and "implausible" not in run[2]

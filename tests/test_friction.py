@@ -358,6 +358,12 @@ def test_bad_material_input(call, name):
 def test_mesh_bad_input():
     F, us, ue, Rx, Ry = _mesh_case()
     s = make_surface(0.5)
+    # an input power far below the losses: eta_m < 0 is implausible and warned
+    # (before: an efficiency of -59509 at 1e-3 W, silently).  Planted bug caught: the
+    # check dropped or testing eta < 1 instead of the range (0, 1]
+    with pytest.warns(UserWarning, match=r"implausible efficiency.*outside \(0, 1\]"):
+        bad = mesh_losses(F, us, ue, Rx, Ry, OIL, s, 1e-3)
+    assert float(np.min(bad.efficiency)) < 0.0
     with pytest.raises(ValueError, match="power_in"):
         mesh_losses(F, us, ue, Rx, Ry, OIL, s, -1.0)
     Fb = F.copy()
@@ -382,6 +388,11 @@ def test_validity_warnings_name_formula_and_range():
         friction_coefficient(40000.0, 3000.0, 300.0, 5.0, 10.0, OIL, make_surface(0.4))
     with pytest.warns(UserWarning, match=r"Greenwood-Tripp.*0.005..0.2"):
         make_surface(0.4, density_per_mm2=1e6)
+    # a film of ~1 nm (u_e = 1e-4 m/s) is below the film model's range (FILM_MIN_MM):
+    # before, labelled "mixed" with ~21 % of the load on the asperities, no warning.
+    # Planted bug caught: the film check dropped or in the wrong unit (um vs mm)
+    with pytest.warns(UserWarning, match=r"central film h_c down to .* nm, below .*5 nm"):
+        friction_coefficient(F, 0.1, 0.01, RX, RY, OIL, make_surface(0.4))
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         friction_coefficient(F, 3000.0, 300.0, RX, RY, OIL, make_surface(0.4))

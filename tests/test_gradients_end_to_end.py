@@ -75,6 +75,32 @@ def test_involute_chain():
                           "mis.dE", "mis.dSigma"])
     # the derivatives are not trivially zero: the crowns move the bearing and the TE
     assert abs(float(jac["lead_crown"][4])) > 1e-3 and abs(float(jac["profile_crown"][0])) > 1.0
+    _check_mask_gaming(f, des)
+
+
+def _check_mask_gaming(f, des):
+    """The end point of a "gaming" run (20 Adam steps, learning rate 0.05, on
+    ``pair.x1`` minimising mean |SRR| over the nominal mask: x1 0 -> 0.958) --
+    evaluated by the TCA program already compiled above.  mean |SRR| "falls" while 5
+    of the 13 mask points leave the flank: ``mask_check`` flags it (n_off > 0) and its
+    penalty is positive.  Planted bugs caught: a mask check that counts on the
+    nominal instead of the current result (n_off 0), a penalty of the wrong sign or
+    on inside points (nominal penalty > 0 / end penalty 0), a count that misses
+    points beyond a boundary -- against an independent count by NumPy."""
+    mis = gj.Misalignment.zero()
+    nom = f(des, mis)
+    on = np.asarray(nom.on_flank)
+    c0 = nom.mask_check(on)
+    assert int(c0.n_off) == 0 and float(c0.penalty) == 0.0
+    end = f(gj.with_fields(des, {"pair.x1": jnp.asarray(0.958)}), mis)
+    c = end.mask_check(on)
+    assert float(end.objectives(on)[1]) < float(nom.objectives(on)[1])   # the "improvement"
+    of = np.asarray(end.on_flank)
+    margin = np.asarray(end.margin)
+    conv = np.asarray(end.path.converged)
+    assert int(c.n_off) == int(np.sum(on & ~of)) >= 3
+    expect = np.sum(np.where(on & conv, np.maximum(-margin, 0.0) ** 2, 0.0)) + np.sum(on & ~conv)
+    assert float(c.penalty) == pytest.approx(expect, rel=1e-12) and expect > 0.0
 
 
 # the hypoid example only: a spiral-bevel design runs the same program with offset 0

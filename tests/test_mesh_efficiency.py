@@ -58,6 +58,10 @@ def test_textbook_load_sharing_and_balance(spur, iso_run):
     share = np.asarray(eff.loaded.share)
     n = np.asarray(eff.loaded.n_loaded)
     assert np.all(np.asarray(eff.valid)) and efficiency_warnings(eff, res) == []
+    # every position valid: the summaries are over the whole cycle
+    assert int(eff.n_valid) == n.size
+    te = np.asarray(eff.loaded.te_loaded)
+    assert float(eff.te_loaded_ptp) == pytest.approx(te.max() - te.min(), rel=1e-12)
     assert set(n.tolist()) == {1, 2}
     np.testing.assert_allclose(share.sum(axis=0), 1.0, atol=1e-12)
     np.testing.assert_allclose(share[:, n == 2][share[:, n == 2] > 0], 0.5, rtol=1e-10)
@@ -156,3 +160,86 @@ def test_gradients_against_central_differences(spur, oil_surface, iso_run):
         np.testing.assert_allclose(g[i], fd, rtol=1e-5, atol=1e-12)
     # the separations matter: a TE slope unbalances the double-contact sharing
     assert abs(float(g[3])) > 1e-6
+
+
+def test_cycle_summary_over_valid_positions_only():
+    """The summaries on a small synthetic cycle against values by hand.  Planted bugs
+    caught: a mean over all positions (the invalid ones, with no modelled loss, pull
+    eta_bar towards 100 %: 0.95 instead of 0.90), invalid or unloaded contacts in mean
+    mu / max p_max / loaded TE, and a silent number (instead of NaN) when nothing is
+    valid."""
+    from gearjax.mesh_efficiency import cycle_summary
+    P_in = 100.0
+    P_f = jnp.array([10.0, 0.0, 10.0, 0.0])          # positions 1, 3 carry no modelled load
+    load = jnp.array([[100.0, 0.0, 50.0, 0.0], [0.0, 0.0, 50.0, 0.0]])
+    us = jnp.array([[2.0, 1.0, 1.0, 1.0], [1.0, 1.0, 4.0, 1.0]])
+    mu = jnp.array([[0.05, 9.0, 0.02, 9.0], [9.0, 9.0, 0.07, 9.0]])
+    p_max = jnp.array([[1000.0, 0.0, 900.0, 5e4], [0.0, 0.0, 1100.0, 0.0]])
+    te = jnp.array([-1e-5, 3e-3, -4e-5, -3e-3])
+    valid = jnp.array([True, False, True, False])
+    s = cycle_summary(P_f, P_in, mu, load, us, p_max, te, valid)
+    assert int(s.n_valid) == 2
+    assert float(s.mean_efficiency) == pytest.approx(1.0 - 20.0 / (2 * 100.0), rel=1e-14)
+    w = np.array([200.0, 50.0, 200.0])
+    assert float(s.mean_mu) == pytest.approx(np.dot([0.05, 0.02, 0.07], w) / w.sum(), rel=1e-14)
+    assert float(s.max_p_max) == 1100.0
+    assert float(s.te_loaded_ptp) == pytest.approx(3e-5, rel=1e-12)
+    none = cycle_summary(P_f, P_in, mu, load, us, p_max, te, valid & False)
+    assert int(none.n_valid) == 0
+    assert all(np.isnan(float(v)) for v in none[:4])
+    g = jax.grad(lambda p: cycle_summary(p, P_in, mu, load, us, p_max, te, valid)
+                 .mean_efficiency)(P_f)
+    np.testing.assert_allclose(g, [-1 / 200.0, 0.0, -1 / 200.0, 0.0], rtol=1e-14)
+
+
+def test_plausibility_thresholds_on_synthetic_positions():
+    """Each check at its documented threshold on a synthetic cycle (one position
+    failing one check each).  Planted bugs caught: a check dropped or with a flipped
+    comparison, eta = 0 or eta > 1 accepted, an unloaded contact's value counted, a
+    NaN passing, a deflection limit not scaled by the pitch."""
+    from gearjax.mesh_efficiency import (DEFLECTION_MAX_PITCH, HERTZ_SIZE_MAX, MU_MAX,
+                                         P_MAX_LIMIT_MPA, plausibility)
+    pitch = 2 * np.pi / 20
+    eta = jnp.array([0.99, 1.0, 0.0, 1.0 + 1e-12, 0.98, 0.98, 0.98, np.nan])
+    load = jnp.array([[1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0],
+                      [0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]])
+    mu = jnp.array([[0.05, MU_MAX, 0.05, 0.05, MU_MAX * 1.01, 0.05, 0.05, 0.05],
+                    [9.0, 0.05, 9.0, 9.0, 9.0, 9.0, 9.0, 9.0]])      # unloaded: ignored
+    pm = jnp.array([[1e3, P_MAX_LIMIT_MPA, 1e3, 1e3, 1e3, 5001.0, 1e3, 1e3],
+                    [9e9, 1e3, 9e9, 9e9, 9e9, 9e9, 9e9, 9e9]])
+    y = jnp.array([0.0, DEFLECTION_MAX_PITCH * pitch, 0.0, 0.0, 0.0, 0.0,
+                   DEFLECTION_MAX_PITCH * pitch * 1.001, 0.0])
+    r_x = jnp.full((2, 8), 10.0)
+    hw = jnp.array([[0.1, 10.0 * HERTZ_SIZE_MAX, 0.1, 0.1, 0.1, 0.1, 0.1, 5.01],
+                    [99.0, 0.1, 99.0, 99.0, 99.0, 99.0, 99.0, 99.0]])
+    p = plausibility(eta, mu, load, pm, y, pitch, hw, r_x)
+    np.testing.assert_array_equal(p.efficiency, [1, 1, 0, 0, 1, 1, 1, 0])
+    np.testing.assert_array_equal(p.mu, [1, 1, 1, 1, 0, 1, 1, 1])
+    np.testing.assert_array_equal(p.p_max, [1, 1, 1, 1, 1, 0, 1, 1])
+    np.testing.assert_array_equal(p.deflection, [1, 1, 1, 1, 1, 1, 0, 1])
+    np.testing.assert_array_equal(p.contact, [1, 1, 1, 1, 1, 1, 1, 0])
+    np.testing.assert_array_equal(p.all, [1, 1, 0, 0, 0, 0, 0, 0])
+
+
+def test_implausible_results_are_flagged_and_not_valid(spur, iso_run):
+    """The iso run's result with planted implausible values, through
+    ``efficiency_warnings`` (concrete, no new program): a warning line per failed
+    check naming the threshold; a film below FILM_MIN_MM warns.  Planted bugs caught:
+    a check that never fires on a real result's fields (wrong field, wrong axis), a
+    warning line without the value."""
+    from gearjax.mesh_efficiency import FILM_MIN_MM, MU_MAX, P_MAX_LIMIT_MPA
+    eff, res = iso_run
+    assert all("implausible" not in w for w in efficiency_warnings(eff, res))
+    fr = eff.friction._replace(mu=eff.friction.mu * 100.0, h_c=eff.friction.h_c * 0 + 1e-6)
+    ld = eff.loaded._replace(p_max=eff.loaded.p_max * 100.0,
+                             deflection=eff.loaded.deflection + 1.0,
+                             semi_minor=eff.loaded.semi_minor * 1e3)
+    bad = eff._replace(friction=fr, loaded=ld, efficiency=eff.efficiency - 2.0)
+    w = "\n".join(efficiency_warnings(bad, res))
+    assert f"mu above {MU_MAX:g}" in w and f"p_max above {P_MAX_LIMIT_MPA:g} MPa" in w
+    assert "eta_m outside (0, 1]" in w and "fall-back" in w and "of a pinion pitch" in w
+    assert f"{1e6 * FILM_MIN_MM:g} nm" in w and "1 nm" in w
+    assert "Hertz half-width above" in w and "viscosity law extrapolated above 3 GPa" in w
+    # the spur run's own contacts are far inside Hertz theory (half-width / R_x)
+    hw = np.asarray(eff.loaded.semi_minor) / np.asarray(eff.r_x)
+    assert np.max(hw[np.asarray(eff.loaded.load) > 0]) < 0.1

@@ -9,7 +9,9 @@ checked against :data:`gearjax.TORQUE_RANGE_NM` and :data:`gearjax.RPM_RANGE`.
 
 Exit status as ``gearjax tca``: 0 with a result (problems of the result -- TCA
 quality flags, positions whose load balance or friction solve did not converge, a
-loaded edge contact, a grid too short -- are ``gearjax: warning:`` lines on stderr
+loaded edge contact, a grid too short, implausible results (``plausibility`` of
+:mod:`gearjax.mesh_efficiency`), a partial cycle (summaries over the valid positions
+only) -- are ``gearjax: warning:`` lines on stderr
 and ``valid``/``warnings`` in the output); 2 bad input, refused before any work; 3
 no position of the cycle is valid (the result is printed, with one error line).
 """
@@ -52,14 +54,21 @@ EFFICIENCY_KEYS_DOC = """JSON keys (K tooth pairs, M positions over one mesh cyc
   efficiency            (M,) eta_m = 1 - P_f / P_in
   te_loaded_arcsec      (M,) loaded transmission error (arcsec)
   valid                 (M,) every loaded contact converged (load balance, Hertz,
-                        friction), no loaded edge contact, grid not truncated
+                        friction), no loaded edge contact, grid not truncated, some
+                        pair loaded, and the result plausible: 0 < eta_m <= 1,
+                        mu <= 0.3, p_max <= 5000 MPa, fall-back <= 0.02 pitch, Hertz
+                        half-width <= 0.5 R_x (docs/efficiency.md; a warning line per
+                        failed check)
   edge_loaded           (M,) an edge contact would carry load (not modelled)
-  mean_efficiency       eta_bar = 1 - mean(P_f) / P_in over the cycle (-)
-  mean_mu               sum mu F |u_s| / sum F |u_s| over the cycle (-)
-  max_p_max_MPa         highest Hertz pressure over the cycle (MPa)
+  n_valid               number of valid positions; the five summaries below are over
+                        the valid positions only (null when none; a partial cycle,
+                        n_valid < M, is also a warning line)
+  mean_efficiency       eta_bar = 1 - mean(P_f) / P_in over the valid positions (-)
+  mean_mu               sum mu F |u_s| / sum F |u_s| over the valid positions (-)
+  max_p_max_MPa         highest Hertz pressure over the valid positions (MPa)
   power_in_W            P_in = T1 omega1 (W)
-  mean_power_loss_W     mean P_f over the cycle (W)
-  te_loaded_ptp_arcsec  peak-to-peak of the loaded TE over the cycle (arcsec)
+  mean_power_loss_W     mean P_f over the valid positions (W)
+  te_loaded_ptp_arcsec  peak-to-peak of the loaded TE over the valid positions (arcsec)
   truncated             the TCA grid or the number of pairs misses a pair in contact
   quality               contact-quality flags of the unloaded TCA (as gearjax tca)
   warnings              the warning lines (also on stderr)
@@ -171,6 +180,7 @@ def _output(eff, res, inp, warn_lines, plot):
     pf = np.asarray(eff.power_loss, float)
     fr = eff.friction
     regime = np.asarray(fr.regime)
+    valid = np.asarray(eff.valid, bool)
     return {
         "input": inp,
         "phi1_deg": _lists(np.degrees(np.asarray(eff.phi1, float))),
@@ -193,12 +203,13 @@ def _output(eff, res, inp, warn_lines, plot):
         "te_loaded_arcsec": _lists(te),
         "valid": [bool(v) for v in np.asarray(eff.valid)],
         "edge_loaded": [bool(v) for v in np.asarray(eff.edge_loaded)],
+        "n_valid": int(np.asarray(eff.n_valid)),
         "mean_efficiency": float(eff.mean_efficiency),
         "mean_mu": float(eff.mean_mu),
         "max_p_max_MPa": float(eff.max_p_max),
         "power_in_W": float(eff.power_in),
-        "mean_power_loss_W": float(np.mean(pf)),
-        "te_loaded_ptp_arcsec": float(np.max(te) - np.min(te)),
+        "mean_power_loss_W": float(np.mean(pf[valid])) if valid.any() else float("nan"),
+        "te_loaded_ptp_arcsec": float(eff.te_loaded_ptp) / ARCSEC,
         "truncated": bool(np.asarray(eff.truncated)),
         "quality": res.flags(),
         "warnings": list(warn_lines),
@@ -231,8 +242,10 @@ def _print_table(out, args):
               f"{_cell(out['lambda_min'][i], 8, '.3f')} {_cell(out['mu_position'][i], 8, '.5f')} "
               f"{_cell(out['power_loss_W'][i], 10, '.3f')} {_cell(out['efficiency'][i], 8, '.5f')} "
               f"{flag}")
+    nv, M = out["n_valid"], len(phi)
+    part = "" if nv == M else f"  -- over {nv} of {M} valid positions only (partial cycle)"
     print(f"# eta_bar = {100.0 * out['mean_efficiency']:.4f} %  (mean P_f "
-          f"{out['mean_power_loss_W']:.3f} W)")
+          f"{out['mean_power_loss_W']:.3f} W){part}")
     print(f"# mean mu = {out['mean_mu']:.5f}")
     print(f"# max p_max = {out['max_p_max_MPa']:.1f} MPa")
     print(f"# P_in = {out['power_in_W']:.2f} W")
@@ -274,7 +287,8 @@ def run(args) -> int:
         bar.update()
     for w in caught:
         sys.stderr.write(f"gearjax: warning: {w.message}\n")
-    warn_lines = gj.efficiency_warnings(eff, res)
+    warn_lines = gj.efficiency_warnings(eff, res, film_method=args.film,
+                                        viscosity_model=args.viscosity)
     for w in warn_lines:
         sys.stderr.write(f"gearjax: warning: {args.side} side: {w}\n")
 

@@ -339,6 +339,13 @@ def validate_contact_inputs(F, u_e, u_s, Rx, Ry, E_prime, allow_signed_us=False)
                          "[1e-15, 1e15]")
 
 
+#: smallest central film thickness (mm; 5 nm) inside the range of the film /
+#: asperity-load-sharing model: a continuum EHL film a few molecular layers thick is
+#: already boundary lubrication; below it the regime label and the asperity share
+#: are not reliable (:func:`warn_validity` warns)
+FILM_MIN_MM = 5e-6
+
+
 def warn_validity(out: FrictionResult, film_method: str, viscosity_model: str):
     """Warn (naming formula and range) where a correlation is used outside its fit.
 
@@ -362,6 +369,12 @@ def warn_validity(out: FrictionResult, film_method: str, viscosity_model: str):
                       f"elongated (k down to {k.min():.3g}; line contact needs k >> 8, the "
                       "Hamrock-Dowson range is 1 <= k <= 8); consider film_method='auto'",
                       stacklevel=3)
+    h_c = np.asarray(out.h_c, float)
+    if np.any(h_c < FILM_MIN_MM):
+        warnings.warn(f"central film h_c down to {1e6 * np.nanmin(h_c):.3g} nm, below the film/"
+                      f"asperity model's range ({1e6 * FILM_MIN_MM:g} nm, FILM_MIN_MM): the "
+                      "regime label and the asperity load share there are not reliable "
+                      "(boundary lubrication)", stacklevel=3)
     pm = np.asarray(out.p_max)
     if np.any(pm > 3000.0):
         warnings.warn(f"{viscosity_model.capitalize()} viscosity law extrapolated above 3 GPa "

@@ -21,6 +21,7 @@ Input power: P_in = T_p ω_p (pinion torque N·m × speed rad/s), or given direc
 
 from __future__ import annotations
 
+import warnings
 from typing import NamedTuple
 
 import jax
@@ -129,6 +130,14 @@ def mesh_losses(F, u_s, u_e, Rx, Ry, oil: Oil, surface: Surface, power_in_W,
     if strict:
         require_converged(out.friction.converged, "mesh friction (Hertz / load-sharing solves)")
     warn_validity(out.friction, film_method, viscosity_model)
+    eta = np.asarray(out.efficiency, float)
+    if not np.all((eta > 0.0) & (eta <= 1.0)):
+        # P_f >= P_in: the losses exceed the power transmitted -- an input power far
+        # below the operating point of the loads and speeds given
+        warnings.warn(f"implausible efficiency: eta_m from {np.nanmin(eta):.6g} to "
+                      f"{np.nanmax(eta):.6g}, outside (0, 1] (the sliding loss is not below "
+                      f"power_in_W = {float(np.min(pin)):g} W: check power_in_W against the "
+                      "loads and speeds)", stacklevel=2)
     return out
 
 
