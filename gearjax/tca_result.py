@@ -327,7 +327,7 @@ class TCAResult:
             mask point is inside the boundaries, C^1 in the design (its gradient pushes
             the points back onto the flank).  The recipe: minimise ``objective + w *
             penalty`` (``w`` in objective units per mm^2, e.g. 1e3 for |SRR|) and check
-            ``n_off == 0`` at the end (docs/optimisation.md).
+            ``n_off == 0`` at the end (docs/architecture.md, "Public API").
         """
         on = np.asarray(on)
         conv = self.path.converged

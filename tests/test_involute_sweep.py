@@ -104,3 +104,27 @@ def _accepts(z1, z2, alpha, beta, x1, x2):
         return True
     except ValueError:
         return False
+
+
+def test_signed_roll_derivative_is_finite_at_and_inside_the_base_circle():
+    """The boundary margins enter the optimisers' penalty (``TCAResult.mask_check``) and
+    are differentiated in reverse mode: points at or inside the base circle (off the
+    flank, e.g. a path continued past its root) must give finite derivatives (the
+    plain ``sqrt(max(R^2 - r_b^2, 0))`` gave NaN there and turned a 20-step Adam run on
+    x1 into NaN), and outside the derivative is the closed form ``R/rho dR``."""
+    import jax
+    import jax.numpy as jnp
+    from gearjax.gears.involute.tca import flank_limits, signed_roll
+    des = gj.InvoluteTCA.create(gj.InvolutePair.create(25, 41, 2.0, 20.0), 20.0)
+    lim, _, _ = flank_limits(des)
+    rb = float(lim.rb)
+
+    def total(scale):
+        q = jnp.stack([jnp.array([0.0, rb * s, 0.0]) for s in (0.9, 1.0)]) * scale
+        return jnp.sum(signed_roll(lim, q, jnp.zeros(2)))
+
+    assert np.isfinite(float(jax.grad(total)(1.0)))
+    R = 1.2 * rb
+    rho = math.sqrt(R ** 2 - rb ** 2)
+    g = jax.grad(lambda r: signed_roll(lim, jnp.stack([0.0, r, 0.0]), 0.0))(R)
+    assert float(g) == pytest.approx(R / rho, rel=1e-12)

@@ -212,7 +212,11 @@ def signed_roll(lim: MemberLimits, q, u):
     coordinate ``u`` (...): ``sign(u - u_b) sqrt(max(|q_xy|^2 - r_b^2, 0))``
     (:class:`MemberLimits`)."""
     R2 = jnp.sum(q[..., :2] ** 2, axis=-1)
-    mag = jnp.sqrt(jnp.maximum(R2 - lim.rb ** 2, 0.0))
+    d = R2 - lim.rb ** 2
+    outside = d > 0.0
+    # the double where keeps the derivative finite at and inside the base circle (the
+    # derivative of sqrt at 0 would make 0 * inf = NaN in reverse mode)
+    mag = jnp.where(outside, jnp.sqrt(jnp.where(outside, d, 1.0)), 0.0)
     return jnp.where(u >= lim.u_b, mag, -mag)
 
 
