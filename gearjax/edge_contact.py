@@ -215,8 +215,7 @@ def _continue(F, z0, thetas, fresh, n_homotopy, tol, max_steps):
 def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, margin,
                      margin_parts: Callable, g1: Callable, g2: Callable, *, drive,
                      steps_per_pitch: int, line_contact: bool = False, tips=None,
-                     tips_valid=True, tol: float = 1e-11, max_steps: int = 30,
-                     n_homotopy: int = 8):
+                     tol: float = 1e-11, max_steps: int = 30, n_homotopy: int = 8):
     """Edge contacts (face ends, and tip edges with ``tips``) beside ``path`` and the
     contact actually made (traceable).
 
@@ -232,8 +231,6 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
     gear, or ``None`` (face ends only).  ``drive`` : True on the drive side (may be traced).
     ``steps_per_pitch`` : grid steps per angular pitch (the neighbouring tooth pairs
     are pair 0 shifted by that many steps).
-    ``tips_valid`` : bool (may be traced), False to leave the tip-edge candidates out
-    of the contact made (they are still solved: one program either way).
     ``line_contact`` : ``path`` was solved in line-contact mode (one face-width section):
     a face-end contact with the TE of that section lies on its contact line and is
     not an edge contact; the tip edges are solved in that section
@@ -340,9 +337,7 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
     mate = jnp.where(pin, jnp.minimum(face2, jnp.minimum(tip2, root2)),
                      jnp.minimum(face1, jnp.minimum(tip1, root1)))
     other = jnp.minimum(jnp.minimum(own, own_root), mate)
-    # ``tips_valid`` (may be traced) switches the tip-edge candidates off where the
-    # family cannot solve them soundly (see the family's TCA)
-    valid = conv & (other >= 0.0) & (~is_tip | jnp.asarray(tips_valid))
+    valid = conv & (other >= 0.0)
     # TE from the reference contact of the path (not from the path's own value at each
     # angle: where the surface solve failed that may be NaN, and an edge contact there
     # is still a contact)

@@ -89,7 +89,7 @@ __all__ = ["pair_arrays", "Misalignment", "Assembly", "contact_equations", "cont
            "ContactPath", "contact_path", "te_arcsec", "require_path",
            "ARCSEC", "ellipse_from_weingarten", "rotation_about", "relative_curvature",
            "MultiPair", "multi_pair", "DEFAULT_APPROACH", "NoContactError",
-           "check_on_flank_converged", "check_tca_options", "pinion_angle_grid", "first_crossing"]
+           "check_on_flank_converged", "check_tca_options", "pinion_angle_grid"]
 
 class NoContactError(ConvergenceError):
     """The flanks do not touch inside their boundaries (a :class:`ConvergenceError`)."""
@@ -553,7 +553,7 @@ class MultiPair(NamedTuple):
     contact_ratio: jnp.ndarray
 
 
-def first_crossing(phi, f):
+def _crossing(phi, f):
     """Linear-interpolated first sign change of ``f`` from <0 to >=0 along ``phi`` (NaN if none)."""
     neg = f[:-1] < 0.0
     pos = f[1:] >= 0.0
@@ -620,9 +620,9 @@ def multi_pair(path: ContactPath, margin, steps_per_pitch: int, z1: int, drive: 
 
     d_in = lead(k0, k0 - 1)
     d_out = lead(k0 + 1, k0)
-    transfer = jnp.stack([first_crossing(path.phi1, d_in), first_crossing(path.phi1, d_out)])
-    lo = first_crossing(path.phi1, jnp.where(path.converged, margin, -1.0))
-    hi = first_crossing(path.phi1[::-1], jnp.where(path.converged, margin, -1.0)[::-1])
+    transfer = jnp.stack([_crossing(path.phi1, d_in), _crossing(path.phi1, d_out)])
+    lo = _crossing(path.phi1, jnp.where(path.converged, margin, -1.0))
+    hi = _crossing(path.phi1[::-1], jnp.where(path.converged, margin, -1.0)[::-1])
     # not found (NaN) unless pair 0 enters before it leaves: where it touches in several
     # intervals that reach the ends of the grid, its first entry may follow its last exit
     cr = jnp.where(hi > lo, (hi - lo) / (2.0 * jnp.pi / z1), jnp.nan)

@@ -180,7 +180,6 @@ def _output(eff, res, inp, warn_lines, plot):
     pf = np.asarray(eff.power_loss, float)
     fr = eff.friction
     regime = np.asarray(fr.regime)
-    valid = np.asarray(eff.valid, bool)
     return {
         "input": inp,
         "phi1_deg": _lists(np.degrees(np.asarray(eff.phi1, float))),
@@ -208,7 +207,8 @@ def _output(eff, res, inp, warn_lines, plot):
         "mean_mu": float(eff.mean_mu),
         "max_p_max_MPa": float(eff.max_p_max),
         "power_in_W": float(eff.power_in),
-        "mean_power_loss_W": float(np.mean(pf[valid])) if valid.any() else float("nan"),
+        # eta_bar = 1 - mean P_f / P_in over the valid positions (NaN when none)
+        "mean_power_loss_W": float((1.0 - eff.mean_efficiency) * eff.power_in),
         "te_loaded_ptp_arcsec": float(eff.te_loaded_ptp) / ARCSEC,
         "truncated": bool(np.asarray(eff.truncated)),
         "quality": res.flags(),
