@@ -58,6 +58,7 @@ from gearjax.gears.involute.geometry import InvolutePair, generated_flank, pair_
 from gearjax.gears.involute.geometry import path_kinematics as involute_path_kinematics  # noqa: E402
 from gearjax.gears.involute.geometry import path_table as involute_path_table  # noqa: E402
 from gearjax.gears.involute.tca import InvoluteTCA, involute_limits  # noqa: E402
+from gearjax.gears.involute.design_file import InvoluteFile  # noqa: E402
 from gearjax.gears.hypoid.blank import BlankInput, blank_geometry, blank_sensitivity  # noqa: E402
 from gearjax.gears.hypoid.cutter import FaceMillCutter, make_cutter  # noqa: E402
 from gearjax.gears.hypoid.machine import MachineSettings  # noqa: E402
@@ -154,7 +155,7 @@ __all__ = [
     "load_design", "save_design", "design_from_dict", "HypoidDesign", "HYPOID_KINDS", "list_examples",
     "example_path", "atomic_write",
     # pairs and blanks
-    "InvolutePair", "InvoluteTCA", "pair_geometry", "HypoidPair", "pair_flanks",
+    "InvolutePair", "InvoluteTCA", "InvoluteFile", "pair_geometry", "HypoidPair", "pair_flanks",
     "complementary_pinion", "prepare_hypoid", "pinion_outline", "involute_limits", "BlankInput", "blank_geometry",
     "blank_sensitivity",
     "VHCattPair", "VHCattDesign",

@@ -27,10 +27,20 @@ PAIRS = {"spur": SPUR, "helical": HELICAL}
 
 
 def khk_pairs():
-    """The two published profile-shifted examples (see the test below).  Built inside the
-    tests, not at import: a wrong pair geometry must fail a test, not the collection."""
-    return (InvolutePair.create(12, 24, 3.0, 20.0, 0.0, 0.6, 0.36),
-            InvolutePair.create(12, 60, 3.0, 20.0, 30.0, 0.09809, 0.0))
+    """The two published profile-shifted examples (see the test below), as packaged:
+    ``example:khk_spur_12x24`` and ``example:khk_helical_12x60``, whose inputs must be
+    those of the published examples.  Built inside the tests, not at import: a wrong pair
+    geometry must fail a test, not the collection."""
+    from gearjax import load_design
+    out = []
+    for name, ref in (("khk_spur_12x24", (12, 24, 3.0, 20.0, 0.0, 0.6, 0.36)),
+                      ("khk_helical_12x60", (12, 60, 3.0, 20.0, 30.0, 0.09809, 0.0))):
+        pair = load_design(f"example:{name}").design.pair
+        got = (pair.z1, pair.z2, float(pair.module), math.degrees(float(pair.pressure_angle)),
+               math.degrees(float(pair.helix)), float(pair.x1), float(pair.x2))
+        np.testing.assert_allclose(got, ref, rtol=1e-14, atol=1e-14, err_msg=name)
+        out.append(pair)
+    return tuple(out)
 
 
 def hand_basics(pair):

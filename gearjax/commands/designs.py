@@ -5,7 +5,8 @@ DESIGN is either an involute pair given inline,
 ``involute:z1=25,z2=41,m=2,alpha=20,b=20[,helix=0,x1=0,x2=0,dalpha=0,crown=0,lead_crown=0]``
 (tooth numbers, normal module mm, normal pressure angle deg, face width mm, helix
 deg, profile shifts, pinion pressure-angle change deg, pinion profile and lead
-crown 1/mm), or a hypoid/spiral-bevel design file (a path or ``example:NAME``).
+crown 1/mm), or a design file of any kind (a path or ``example:NAME``; kind
+``involute`` is the file form of the inline pair).
 Every function here validates and raises ``ValueError`` with one line naming the
 key, its value and the allowed range.
 """

@@ -65,7 +65,7 @@ def register(sub):
                     "with misalignments.",
         epilog=JSON_KEYS_DOC, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("design", help="involute:z1=..,z2=..,m=..,alpha=..,b=..[,...], or a "
-                                  "hypoid/spiral-bevel design file or example:NAME")
+                                  "design file of any kind (DESIGN.toml or example:NAME)")
     p.add_argument("--side", choices=["drive", "coast", "both"], default="drive")
     p.add_argument("--misalign", default="",
                    help="dE=mm,dP=mm,dG=mm,dSigma=deg (any subset; default all 0)")
@@ -91,12 +91,13 @@ def _nan_list(a):
     return [None if not np.isfinite(x) else float(x) for x in a.ravel()]
 
 
-def _involute_side(args, mis, m, side_name, half, kin):
+def _involute_side(des, mis, m, side_name, half, kin):
+    """An involute pair (inline or a design file): the family's grid (``n_pairs`` and,
+    when ``half`` is None, the pitches of :func:`default_grid`)."""
     import gearjax as gj
-    _, des = involute_design(args.design)
     res = gj.run_tca(des, mis, side=side_name, steps_per_pitch=m, half_pitches=half,
                      kinematics=kin)
-    return res, gj.involute_limits(des, side_name)
+    return res, gj.involute_limits(getattr(des, "design", des), side_name)
 
 
 def _hypoid_side(design, mis, m, side_name, half, kin):
@@ -210,22 +211,24 @@ def run(args) -> int:
     if (n - 1) % 10:
         raise ValueError(f"positions = {n} must be of the form 10k+1 (11, 21, ..., 61, ...)")
     m = 4 * ((n - 1) // 10)
-    # default: 1.25 pitches; an involute pair without --pitches gets the family's
-    # default grid (wider for a path of contact that reaches further)
-    auto = args.pitches is None and args.design.startswith("involute:")
-    half = None if auto else check_range("pitches", 1.25 if args.pitches is None
-                                         else args.pitches, 0.75, 4.0)
+    if args.pitches is not None:
+        check_range("pitches", args.pitches, 0.75, 4.0)
     if args.plot:
         check_output_path(args.plot, "--plot", (".png",))
     sides = ["drive", "coast"] if args.side == "both" else [args.side]
-    if args.design.startswith("involute:"):
-        involute_design(args.design)               # validate before any tracing
-        solve = lambda side: _involute_side(args, mis, m, side, half, args.kinematics)
-    else:
-        from gearjax import HypoidDesign, load_design
-        design = load_design(args.design)
-        side_of = _hypoid_side if isinstance(design, HypoidDesign) else _family_side
-        solve = lambda side: side_of(design, mis, m, side, half, args.kinematics)
+    from gearjax import HypoidDesign, InvoluteFile, load_design
+    # validated before any tracing
+    design = (involute_design(args.design)[1] if args.design.startswith("involute:")
+              else load_design(args.design))
+    involute = not isinstance(design, (HypoidDesign,)) and (
+        args.design.startswith("involute:") or isinstance(design, InvoluteFile))
+    # default: 1.25 pitches; an involute pair without --pitches gets the family's
+    # default grid (wider for a path of contact that reaches further)
+    half = (None if involute and args.pitches is None
+            else 1.25 if args.pitches is None else float(args.pitches))
+    side_of = (_involute_side if involute else
+               _hypoid_side if isinstance(design, HypoidDesign) else _family_side)
+    solve = lambda side: side_of(design, mis, m, side, half, args.kinematics)  # noqa: E731
     results, failed = {}, {}
     what = "contact solve" + (" + kinematics" if args.kinematics else "")
     with Progress(len(sides), "tca") as bar:    # stderr, terminals only

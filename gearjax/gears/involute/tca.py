@@ -641,4 +641,5 @@ class _Adapter:
         return values, table
 
 
-register_family(InvoluteTCA, _Adapter())
+ADAPTER = _Adapter()
+register_family(InvoluteTCA, ADAPTER)

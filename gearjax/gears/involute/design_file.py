@@ -1,0 +1,161 @@
+"""Involute design files (TOML, ``[design] kind = "involute"``): schema and validation.
+
+The file form of the inline ``involute:z1=..,z2=..,m=..,alpha=..,b=..`` DESIGN of the
+contact commands, for pairs worth keeping (the packaged published examples).  File
+units: mm and degrees.  Tables and keys:
+
+* ``[design]`` kind = "involute"; name, description, source (optional strings).
+* ``[pair]`` (all required but the helix angle and the shifts)
+  - ``z1``, ``z2`` (integers, 6..1000): tooth numbers of pinion and gear;
+  - ``normal_module_mm`` (0.01..100);
+  - ``normal_pressure_angle_deg`` (0..45, open);
+  - ``face_width_mm`` (0.1 m_n .. 1000);
+  - ``helix_angle_deg`` (0..60, default 0; the pinion's hand is the gear's opposite);
+  - ``profile_shift1``, ``profile_shift2`` (-3..3, default 0: x of ISO 21771, the
+    rack datum line moved out by x m_n).
+  Basic rack: addendum 1.0 m_n, dedendum 1.25 m_n (tip circles r + m_n (1 + x); no tip
+  shortening), zero-backlash operating centre distance a_w from
+  ``inv α_wt = 2 tan α_n (x1 + x2)/(z1 + z2) + inv α_t`` (ISO 21771).
+* ``[modification]`` (optional table, every key optional, default 0): the pinion rack's
+  ``pressure_angle_change_deg`` (-5..5), ``profile_crown_per_mm`` and
+  ``lead_crown_per_mm`` (0..0.1) of :class:`gearjax.gears.involute.tca.InvoluteTCA`.
+
+Tooth form (undercut, pointed tip, tip/fillet interference) is checked on loading by
+:meth:`InvolutePair.create`, exactly as for the inline form.  Unknown or missing keys
+and out-of-range values raise ``ValueError`` naming the table and the key.
+
+:class:`InvoluteFile` carries the validated dict (``data``) and the pytree
+(``design``, an :class:`InvoluteTCA`); ``gearjax.run_tca``, ``tca_function`` and
+``mesh_efficiency`` take either.
+"""
+
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass, field
+
+from gearjax.errors import check_range
+from gearjax.gears.involute.geometry import InvolutePair
+from gearjax.gears.involute.tca import ADAPTER, InvoluteTCA
+from gearjax.io import (check_integer, check_keys, check_number, check_string,
+                        register_design_kind, require_key)
+from gearjax.tca_result import register_family
+
+__all__ = ["InvoluteFile", "read_involute", "KIND", "PAIR_KEYS", "MODIFICATION_KEYS"]
+
+KIND = "involute"
+#: [pair] key -> (unit, default or None when required)
+PAIR_KEYS = {"z1": ("int", None), "z2": ("int", None), "normal_module_mm": ("mm", None),
+             "normal_pressure_angle_deg": ("deg", None), "face_width_mm": ("mm", None),
+             "helix_angle_deg": ("deg", 0.0), "profile_shift1": ("", 0.0),
+             "profile_shift2": ("", 0.0)}
+#: [modification] key -> unit (every key optional, default 0)
+MODIFICATION_KEYS = {"pressure_angle_change_deg": "deg", "profile_crown_per_mm": "1/mm",
+                     "lead_crown_per_mm": "1/mm"}
+
+
+@dataclass(frozen=True)
+class InvoluteFile:
+    """A validated involute design file: ``data`` (file units) and ``design`` (the
+    :class:`InvoluteTCA` pytree the TCA and the loaded chain run)."""
+
+    data: dict = field(compare=True)
+    design: InvoluteTCA = field(compare=False)
+
+    @property
+    def name(self) -> str:
+        return self.data.get("design", {}).get("name", "")
+
+    def to_dict(self) -> dict:
+        return copy.deepcopy(self.data)
+
+    def defaults_lines(self) -> list:
+        """The documented defaults this design relies on (printable lines)."""
+        pr = self.data.get("pair", {})
+        out = [f"pair.{k} = {d:g}" for k, (_, d) in PAIR_KEYS.items()
+               if d is not None and k not in pr]
+        mod = self.data.get("modification", {})
+        out += [f"modification.{k} = 0" for k in MODIFICATION_KEYS if k not in mod]
+        return out
+
+    def teeth(self, member: str) -> int:
+        if member not in ("pinion", "gear"):
+            raise ValueError(f"member = {member!r} must be 'pinion' or 'gear'")
+        return self.design.pair.z1 if member == "pinion" else self.design.pair.z2
+
+    def surface_grid(self, member, flank, n_u, n_v):
+        raise ValueError("gearjax surface: no surface export for [design] kind = 'involute' "
+                         "(hypoid, spiral_bevel, vh_catt and preset_te_bevel designs have one)")
+
+
+def read_involute(data: dict) -> InvoluteFile:
+    """Validate a parsed ``involute`` design file (module docstring) and build the pair."""
+    data = copy.deepcopy(data)
+    check_keys("", data, {"design", "pair", "modification"})
+    des = data["design"]
+    check_keys("design", des, {"kind", "name", "description", "source"})
+    check_string("design", "kind", require_key("design", des, "kind"), (KIND,))
+    for k in ("name", "description", "source"):
+        if k in des:
+            check_string("design", k, des[k])
+    pr = data.get("pair")
+    if not isinstance(pr, dict):
+        raise ValueError("missing table [pair]")
+    check_keys("pair", pr, set(PAIR_KEYS))
+    v = {}
+    for k, (unit, default) in PAIR_KEYS.items():
+        if default is not None and k not in pr:
+            v[k] = default
+            continue
+        raw = require_key("pair", pr, k)
+        v[k] = check_integer("pair", k, raw) if unit == "int" else check_number("pair", k, raw,
+                                                                               unit)
+    mod = data.get("modification", {})
+    if not isinstance(mod, dict):
+        raise ValueError("[modification] must be a table")
+    check_keys("modification", mod, set(MODIFICATION_KEYS))
+    m = {k: check_number("modification", k, mod[k], u) if k in mod else 0.0
+         for k, u in MODIFICATION_KEYS.items()}
+    try:
+        pair = InvolutePair.create(v["z1"], v["z2"], v["normal_module_mm"],
+                                   v["normal_pressure_angle_deg"], v["helix_angle_deg"],
+                                   v["profile_shift1"], v["profile_shift2"])
+        check_range("face_width_mm", v["face_width_mm"], 0.0, 1000.0, lo_open=True, unit="mm")
+    except ValueError as exc:
+        raise ValueError(f"[pair] {exc}") from None
+    try:
+        tca = InvoluteTCA.create(pair, v["face_width_mm"], m["pressure_angle_change_deg"],
+                                 m["profile_crown_per_mm"], m["lead_crown_per_mm"])
+    except ValueError as exc:
+        raise ValueError(f"[pair]/[modification] {exc}") from None
+    return InvoluteFile(data, tca)
+
+
+class _FileAdapter:
+    """The involute adapter for :class:`InvoluteFile` (the pytree is ``.design``; the
+    loaded chain passes the pytree itself back, which is taken as is)."""
+
+    family = ADAPTER.family
+    defaults = ADAPTER.defaults
+
+    @staticmethod
+    def _design(f):
+        return getattr(f, "design", f)
+
+    def run(self, f, *a, **kw):
+        return ADAPTER.run(self._design(f), *a, **kw)
+
+    def traced(self, f, **kw):
+        fn = ADAPTER.traced(self._design(f), **kw)
+        fn.pair = self._design(f)
+        return fn
+
+    def mesh(self, f, **kw):
+        return ADAPTER.mesh(self._design(f), **kw)
+
+    def sensitivity(self, f, *a, **kw):
+        return ADAPTER.sensitivity(self._design(f), *a, **kw)
+
+
+register_design_kind(KIND, read_involute)
+register_family(InvoluteFile, _FileAdapter())
