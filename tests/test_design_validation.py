@@ -66,8 +66,11 @@ def test_every_example_loads_and_passes_the_cross_checks(name):
         d.machine(m, f), d.cutter(m, f)
 
 
-def test_seven_examples_are_packaged():
-    assert len(EXAMPLES) == 7
+def test_nine_examples_are_packaged():
+    """Six with flanks, three blank-only (hypoid_6x39_7p5in and the ISO 23509 annex F
+    samples)."""
+    assert len(EXAMPLES) == 9
+    assert sum(1 for n in EXAMPLES if not load_design(f"example:{n}").flanks()) == 3
 
 
 # ----------------------------------------------------------------------------- missing keys

@@ -22,6 +22,38 @@ D = np.deg2rad
 ANGLE = ("delta", "beta", "zeta", "alpha", "theta")
 
 
+#: annex F.2 (sample 1) printed results
+SAMPLE1_F2 = dict(
+    delta1=19.747, delta2=70.253, Rm=81.273, dm1=54.918, dm2=152.987, m_mn=3.213,
+    Re2=93.973, Ri2=68.573, di2=129.080, met2=4.536, be2=12.700, bi2=12.700,
+    tzm2=27.459, tzm1=76.493, hmw=6.427, ham2=1.591, hfm2=5.639, ham1=4.836,
+    hfm1=2.394, c=0.803, hm=7.230, delta_a2=72.387, delta_f2=63.760, delta_a1=26.240,
+    delta_f1=17.613, theta_a1=6.493, theta_f1=2.134, tzF2=-1.508, tzR2=3.999,
+    tzF1=-9.931, tzR1=2.094, bp1=25.400, b1=25.400, be1=12.700, bi1=12.700,
+    beta_e2=36.846, beta_i2=33.946, beta_e1=36.846, beta_i1=33.946,
+    hae1=6.281, hae2=2.064, hfe1=2.867, hfe2=7.085, he1=9.149, he2=9.149,
+    hai1=3.391, hai2=1.117, hfi1=1.921, hfi2=4.194, hi1=5.311, hi2=5.311,
+    Re1=93.973, Ri1=68.573, de1=63.500, di1=46.337, dae1=75.324, dae2=178.288,
+    dfe1=58.102, dfe2=172.106, dai1=52.719, dai2=129.835, txo1=86.324, txo2=29.808,
+    txi1=63.395, txi2=22.117)
+
+#: annex F.3 (sample 2) printed results
+SAMPLE2_F3 = dict(
+    Rm1=73.519, Rm2=76.337, beta_m1=49.998, beta_m2=38.609, c_be2=0.504, dm1=53.383,
+    dm2=141.877, zeta_m=10.603, zeta_mp=11.390, ap=15.075, m_mn=2.640,
+    alpha_lim=-2.253, alpha_nD=17.747, alpha_nC=22.253, alpha_eD=20.0, alpha_eC=20.0,
+    Re2=91.468, Ri2=61.468, de2=170.0, di2=114.243, met2=4.047, be2=15.1314, bi2=14.869,
+    tzm2=26.621, tzm1=69.727, tz1=-1.225, tz2=1.576, hmw=5.280, ham2=1.848, hfm2=4.092,
+    ham1=3.432, hfm1=2.508, c=0.660, hm=5.939, delta_a2=69.323, delta_f2=64.324,
+    zeta_R=10.319, zeta_o=10.674, delta_a1=25.232, delta_f1=20.303, theta_a1=3.943,
+    theta_f1=0.985, bp1=30.626, be1=16.089, bi1=15.822, b1=31.910, Re21=92.163,
+    Ri21=60.907, beta_e1=57.544, beta_i1=44.879, beta_e2=47.674, beta_i2=30.826,
+    hae1=4.541, hae2=2.112, hfe1=2.784, hfe2=5.150, he1=7.325, he2=7.262, hai1=2.341,
+    hai2=1.588, hfi1=2.236, hfi2=3.052, hi1=4.577, hi2=4.640, Re1=89.608, Ri1=57.697,
+    de1=65.065, di1=41.895, dae1=73.528, dae2=171.560, dfe1=59.877, dfe2=166.196,
+    dai1=46.258, dai2=115.416, txo1=83.070, txo2=30.247, txi1=54.135, txi2=19.653)
+
+
 def _type2_to_type1(c_ham, k_d, k_c):
     """ISO 23509 table 4: data type II -> type I (k_hap, k_hfp, x_hm1)."""
     return k_d / 2.0, k_d * (k_c + 0.5), k_d * (0.5 - c_ham)
@@ -49,20 +81,7 @@ def test_annex_f2_sample1_method0():
                             khfp=khfp, xhm1=xhm1, taper="manual", theta_a2=D(2.1342),
                             theta_f2=D(6.4934), pinion_rule="method0")
     r = dict(r, delta1=pc["delta1"], delta2=pc["delta2"], Rm=pc["Rm1"])
-    expected = dict(
-        delta1=19.747, delta2=70.253, Rm=81.273, dm1=54.918, dm2=152.987, m_mn=3.213,
-        Re2=93.973, Ri2=68.573, di2=129.080, met2=4.536, be2=12.700, bi2=12.700,
-        tzm2=27.459, tzm1=76.493, hmw=6.427, ham2=1.591, hfm2=5.639, ham1=4.836,
-        hfm1=2.394, c=0.803, hm=7.230, delta_a2=72.387, delta_f2=63.760, delta_a1=26.240,
-        delta_f1=17.613, theta_a1=6.493, theta_f1=2.134, tzF2=-1.508, tzR2=3.999,
-        tzF1=-9.931, tzR1=2.094, bp1=25.400, b1=25.400, be1=12.700, bi1=12.700,
-        beta_e2=36.846, beta_i2=33.946, beta_e1=36.846, beta_i1=33.946,
-        hae1=6.281, hae2=2.064, hfe1=2.867, hfe2=7.085, he1=9.149, he2=9.149,
-        hai1=3.391, hai2=1.117, hfi1=1.921, hfi2=4.194, hi1=5.311, hi2=5.311,
-        Re1=93.973, Ri1=68.573, de1=63.500, di1=46.337, dae1=75.324, dae2=178.288,
-        dfe1=58.102, dfe2=172.106, dai1=52.719, dai2=129.835, txo1=86.324, txo2=29.808,
-        txi1=63.395, txi2=22.117)
-    _check(r, expected, 0.002, 0.005)
+    _check(r, SAMPLE1_F2, 0.002, 0.005)
     assert float(r["zeta_m"]) == 0.0 and float(r["alpha_lim"]) == 0.0
 
 
@@ -77,21 +96,7 @@ def test_annex_f3_sample2_method1():
                             theta_f2=D(4.0), pinion_rule="method1")
     r = dict(r, Rm1=pc["Rm1"], Rm2=pc["Rm2"], beta_m1=pc["beta_m1"], beta_m2=pc["beta_m2"],
              c_be2=pc["c_be2"])
-    expected = dict(
-        Rm1=73.519, Rm2=76.337, beta_m1=49.998, beta_m2=38.609, c_be2=0.504, dm1=53.383,
-        dm2=141.877, zeta_m=10.603, zeta_mp=11.390, ap=15.075, m_mn=2.640,
-        alpha_lim=-2.253, alpha_nD=17.747, alpha_nC=22.253, alpha_eD=20.0, alpha_eC=20.0,
-        Re2=91.468, Ri2=61.468, de2=170.0, di2=114.243, met2=4.047, be2=15.1314, bi2=14.869,
-        tzm2=26.621, tzm1=69.727, tz1=-1.225, tz2=1.576, hmw=5.280, ham2=1.848, hfm2=4.092,
-        ham1=3.432, hfm1=2.508, c=0.660, hm=5.939, delta_a2=69.323, delta_f2=64.324,
-        zeta_R=10.319, zeta_o=10.674, delta_a1=25.232, delta_f1=20.303, theta_a1=3.943,
-        theta_f1=0.985, bp1=30.626, be1=16.089, bi1=15.822, b1=31.910, Re21=92.163,
-        Ri21=60.907, beta_e1=57.544, beta_i1=44.879, beta_e2=47.674, beta_i2=30.826,
-        hae1=4.541, hae2=2.112, hfe1=2.784, hfe2=5.150, he1=7.325, he2=7.262, hai1=2.341,
-        hai2=1.588, hfi1=2.236, hfi2=3.052, hi1=4.577, hi2=4.640, Re1=89.608, Ri1=57.697,
-        de1=65.065, di1=41.895, dae1=73.528, dae2=171.560, dfe1=59.877, dfe2=166.196,
-        dai1=46.258, dai2=115.416, txo1=83.070, txo2=30.247, txi1=54.135, txi2=19.653)
-    _check(r, expected, 0.003, 0.005)
+    _check(r, SAMPLE2_F3, 0.003, 0.005)
     # the Method 1 condition itself, to machine precision
     np.testing.assert_allclose(pc["rho_lim"], 63.5, rtol=1e-12)
 
@@ -231,3 +236,29 @@ def test_method1_zero_offset_limit_and_gradients():
     assert np.all(np.isfinite(J))
     err = np.max(np.abs(J - Jfd) / np.max(np.abs(J), axis=1, keepdims=True))
     assert err < 1e-6, err
+
+
+@pytest.mark.parametrize("name,expected,tol_deg", [
+    ("iso23509_sample1_14x39", SAMPLE1_F2, 0.002), ("iso23509_sample2_13x42", SAMPLE2_F3, 0.003)])
+def test_packaged_samples_reproduce_the_annex(capsys, name, expected, tol_deg):
+    """The two samples packaged as blank-only designs (their [blank] tables typed in from
+    the annex's basic data, type II -> type I by table 4), through ``gearjax blank
+    --json`` (degrees, mm): every printed result the command reports, within the
+    rounding of the samples above.  Catches a wrong default or unit of the design-file
+    route that the formula tests above (called with the typed-in values) cannot."""
+    import json
+    from gearjax.cli import main
+    assert main(["blank", f"example:{name}", "--json"]) == 0
+    got = json.loads(capsys.readouterr().out)
+    rename = {"Rm": "Rm1", "ap": "a_p"}
+    bad, n = [], 0
+    for k, v in expected.items():
+        key = rename.get(k, k)
+        if key not in got:
+            continue
+        n += 1
+        tol = tol_deg if k.startswith(ANGLE) else 0.005
+        if not abs(got[key] - v) <= tol:
+            bad.append(f"{key}: {got[key]:.5f} vs {v}")
+    assert not bad, bad
+    assert n >= 50, n     # 51 of the 65 (sample 1), 58 of the 78 (sample 2) printed values
