@@ -496,8 +496,8 @@ def efficiency_warnings(eff: MeshEfficiency, res: TCAResult, *, film_method: str
     if np.any(thin):
         out.append(f"film h_c down to {1e6 * np.nanmin(np.where(thin, h_c, np.inf)):.3g} nm "
                    f"at {int(thin.sum())} loaded contacts, below the film/asperity model's range "
-                   f"({1e6 * FILM_MIN_MM:g} nm, FILM_MIN_MM): regime and asperity share there "
-                   "are not reliable (boundary lubrication)")
+                   f"({1e6 * FILM_MIN_MM:g} nm, FILM_MIN_MM): labelled boundary there; the "
+                   "asperity share and mu there are not reliable")
     k = np.asarray(eff.friction.k, float)[loaded]
     if k.size and film_method in ("auto", "point") and np.any(k < 1.0):
         out.append(f"Hamrock-Dowson film formula used outside its fitted ellipticity range "

@@ -392,7 +392,9 @@ def test_validity_warnings_name_formula_and_range():
     # before, labelled "mixed" with ~21 % of the load on the asperities, no warning.
     # Planted bug caught: the film check dropped or in the wrong unit (um vs mm)
     with pytest.warns(UserWarning, match=r"central film h_c down to .* nm, below .*5 nm"):
-        friction_coefficient(F, 0.1, 0.01, RX, RY, OIL, make_surface(0.4))
+        thin = friction_coefficient(F, 0.1, 0.01, RX, RY, OIL, make_surface(0.4))
+    # ... and labelled boundary (regime 0) whatever the asperity share (here < 0.9)
+    assert float(thin.h_c) < 5e-6 and float(thin.phi) < 0.9 and int(thin.regime) == 0
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         friction_coefficient(F, 3000.0, 300.0, RX, RY, OIL, make_surface(0.4))

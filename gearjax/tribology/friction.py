@@ -146,7 +146,8 @@ class FrictionResult(NamedTuple):
     h_c, h_min : central and minimum film under load sharing, mm.
     lam : λ = h_c/σ (under load sharing).  lam_smooth : h_c,smooth/σ (smooth-surface film).
     phi : asperity load ratio F_a/F_n.  area_ratio : A_real/A.
-    regime : 0 boundary, 1 mixed, 2 full film (from φ).
+    regime : 0 boundary, 1 mixed, 2 full film (from φ: ≥ 0.9, ≥ 0.01, below; boundary
+      also where h_c < :data:`FILM_MIN_MM`, 5 nm, below the film model's range).
     converged : both solves (Hertz ellipticity, load sharing) converged.
     """
 
@@ -265,7 +266,10 @@ def friction_point_traced(F, u_e, u_s, Rx, Ry, oil: Oil, surface: Surface, E_pri
     mu_f = F_tau / F
     mu_b = surface.f_c * ls.phi * jnp.tanh(u_s / surface.v_slip)
     mu = mu_b + mu_f
-    regime = jnp.where(ls.phi >= 0.9, 0, jnp.where(ls.phi >= 1e-2, 1, 2))
+    # bands of the asperity load ratio; a film thinner than FILM_MIN_MM (a few molecular
+    # layers) is boundary lubrication whatever the continuum model's share says
+    regime = jnp.where((ls.phi >= 0.9) | (ls.h_c < FILM_MIN_MM), 0,
+                       jnp.where(ls.phi >= 1e-2, 1, 2))
     return FrictionResult(mu, mu_b, mu_f, mu * F, hz.a, hz.b, hz.k, hz.p_max, ls.h_c, ls.h_min,
                           ls.lam, ls.h_c_smooth / surface.sigma, ls.phi, ls.area_ratio, regime,
                           hz.converged & ls.converged)
@@ -372,9 +376,9 @@ def warn_validity(out: FrictionResult, film_method: str, viscosity_model: str):
     h_c = np.asarray(out.h_c, float)
     if np.any(h_c < FILM_MIN_MM):
         warnings.warn(f"central film h_c down to {1e6 * np.nanmin(h_c):.3g} nm, below the film/"
-                      f"asperity model's range ({1e6 * FILM_MIN_MM:g} nm, FILM_MIN_MM): the "
-                      "regime label and the asperity load share there are not reliable "
-                      "(boundary lubrication)", stacklevel=3)
+                      f"asperity model's range ({1e6 * FILM_MIN_MM:g} nm, FILM_MIN_MM): labelled "
+                      "boundary there (a film a few molecular layers thick); the asperity load "
+                      "share and mu there are not reliable", stacklevel=3)
     pm = np.asarray(out.p_max)
     if np.any(pm > 3000.0):
         warnings.warn(f"{viscosity_model.capitalize()} viscosity law extrapolated above 3 GPa "
