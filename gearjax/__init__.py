@@ -87,7 +87,7 @@ from gearjax.tribology.ehl import solve_ehl  # noqa: E402
 from gearjax.loaded_contact import COMPLIANCE_MODELS, LoadedContact  # noqa: E402
 from gearjax.mesh_efficiency import (RPM_RANGE, TORQUE_RANGE_NM, MeshEfficiency,  # noqa: E402
                                      check_operating_point, efficiency_function,
-                                     efficiency_warnings, mesh_efficiency)
+                                     efficiency_guard, efficiency_warnings, mesh_efficiency)
 
 
 def run_tca(design, misalignment=None, *, side=None, **options) -> TCAResult:
@@ -175,7 +175,8 @@ __all__ = [
     "Surface", "make_surface", "FrictionResult", "friction_coefficient", "friction_traced",
     "mesh_losses", "mesh_losses_traced", "stribeck_curve", "solve_ehl",
     # loaded contact and mesh efficiency
-    "mesh_efficiency", "efficiency_function", "efficiency_warnings", "MeshEfficiency",
+    "mesh_efficiency", "efficiency_function", "efficiency_warnings", "efficiency_guard",
+    "MeshEfficiency",
     "LoadedContact", "check_operating_point", "TORQUE_RANGE_NM", "RPM_RANGE", "COMPLIANCE_MODELS",
     # optimisers and solvers
     "minimize_optax", "minimize_lbfgsb", "least_squares_lm", "OptResult", "LMResult",

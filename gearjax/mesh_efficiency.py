@@ -63,7 +63,8 @@ from gearjax.tribology.lubricant import Oil
 __all__ = ["MeshEfficiency", "mesh_efficiency", "efficiency_function", "mesh_efficiency_traced",
            "efficiency_warnings", "cycle_window", "check_operating_point", "cycle_summary",
            "CycleSummary", "plausibility", "Plausibility", "TORQUE_RANGE_NM", "RPM_RANGE",
-           "MU_MAX", "P_MAX_LIMIT_MPA", "DEFLECTION_MAX_PITCH", "HERTZ_SIZE_MAX", "FILM_MIN_MM"]
+           "MU_MAX", "P_MAX_LIMIT_MPA", "DEFLECTION_MAX_PITCH", "HERTZ_SIZE_MAX", "FILM_MIN_MM",
+           "EfficiencyGuard", "efficiency_guard"]
 
 #: accepted pinion torque (N m) and speed (rpm)
 TORQUE_RANGE_NM = (1e-3, 1e6)
@@ -191,6 +192,47 @@ def cycle_summary(power_loss, power_in, mu, load, u_s, p_max, te_loaded, valid) 
     return CycleSummary(jnp.where(some, mean_eff, nan), jnp.where(den > 0.0, mean_mu, nan),
                         jnp.where(jnp.any(loaded), pm, nan),
                         jnp.where(some, te_hi - te_lo, nan), n_valid)
+
+
+class EfficiencyGuard(NamedTuple):
+    """The efficiency objective of an optimisation on a fixed set of positions
+    (:func:`efficiency_guard`)."""
+
+    mean_efficiency: jax.Array
+    n_lost: jax.Array
+
+
+def efficiency_guard(eff, nominal_valid) -> EfficiencyGuard:
+    """η̄ over a fixed nominal set of positions, with a lost position counted as a total
+    loss, so that an optimiser cannot raise it by invalidating positions (traceable).
+
+    ``nominal_valid`` (M,) bool: the positions valid at the start (``eff0.valid`` of the
+    nominal design), kept fixed during the run -- like the mask of
+    :meth:`gearjax.TCAResult.objectives`.  With ``V0`` that set and ``valid`` the
+    positions valid now::
+
+        eta_guard = 1 - sum_{i in V0} (valid_i ? P_f,i : P_in) / (|V0| P_in)
+        n_lost    = |{i in V0 : not valid_i}|
+
+    On a run that keeps every nominal position valid ``eta_guard`` is the plain η̄ of
+    those positions (:func:`cycle_summary` over V0) and its gradient is the gradient of
+    the modelled losses.  A position that leaves the valid set (off the flank, load
+    balance or friction not converged, implausible) counts as ``P_f = P_in`` (η = 0 there),
+    the worst case, instead of dropping out of the mean: ``eta_guard`` then falls by at
+    least ``(P_in − P_f,i)/(|V0| P_in)`` ≈ 1/|V0|, whereas the plain η̄ over the valid
+    positions rises when the position left was a lossy one.  The step is not
+    differentiable (the masks are constants of the derivative): add the C¹ penalty of
+    ``res.mask_check(on0)`` to push contacts back onto the flank before they leave, and
+    accept an end point only with ``n_lost == 0`` -- otherwise the run is a flagged
+    failure (docs/efficiency.md, "Objectives that cannot be gamed").
+    """
+    v0 = jnp.asarray(nominal_valid, bool)
+    valid = jnp.asarray(eff.valid, bool)
+    pin = jnp.asarray(eff.power_in, float)
+    loss = jnp.where(valid, jnp.where(v0, eff.power_loss, 0.0), jnp.where(v0, pin, 0.0))
+    n0 = jnp.sum(v0)
+    eta = 1.0 - jnp.sum(loss) / (jnp.maximum(n0, 1) * pin)
+    return EfficiencyGuard(jnp.where(n0 > 0, eta, jnp.nan), jnp.sum(v0 & ~valid))
 
 
 class Plausibility(NamedTuple):

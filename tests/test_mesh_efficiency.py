@@ -192,6 +192,46 @@ def test_cycle_summary_over_valid_positions_only():
     np.testing.assert_allclose(g, [-1 / 200.0, 0.0, -1 / 200.0, 0.0], rtol=1e-14)
 
 
+def test_efficiency_guard_cannot_be_raised_by_invalidating_positions(iso_run):
+    """On the 20/40 spur run: invalidating the lossiest valid position raises the plain
+    eta_bar over the valid positions (the gaming the issue names) but lowers the guarded
+    eta, by at least (P_in - P_f)/(|V0| P_in); n_lost counts it.  With every nominal
+    position valid the guard is the plain eta_bar and its gradient that of the losses
+    (-1/(|V0| P_in) per valid position, 0 elsewhere).  Values by hand (NumPy) from the
+    run's arrays.  Planted bugs caught: a lost position dropped from the mean (guard
+    rises), counted at P_f = 0 (guard rises to ~1), a mean over the current valid set
+    instead of the fixed nominal one, n_lost counting positions outside V0."""
+    from gearjax.mesh_efficiency import cycle_summary, efficiency_guard
+    eff, _ = iso_run
+    v0 = np.asarray(eff.valid)
+    P_f, P_in = np.asarray(eff.power_loss, float), float(eff.power_in)
+    assert v0.sum() >= 10
+    g0 = efficiency_guard(eff, v0)
+    assert int(g0.n_lost) == 0
+    np.testing.assert_allclose(float(g0.mean_efficiency), 1 - P_f[v0].sum() / (v0.sum() * P_in),
+                               rtol=1e-14)
+    np.testing.assert_allclose(float(g0.mean_efficiency), float(eff.mean_efficiency), rtol=1e-14)
+    worst = int(np.argmax(np.where(v0, P_f, -np.inf)))
+    gamed_valid = v0.copy()
+    gamed_valid[worst] = False
+    gamed = eff._replace(valid=jnp.asarray(gamed_valid))
+    plain = float(cycle_summary(eff.power_loss, P_in, eff.friction.mu, eff.loaded.load,
+                                eff.u_s, eff.loaded.p_max, eff.loaded.te_loaded, gamed_valid)
+                  .mean_efficiency)
+    g1 = efficiency_guard(gamed, v0)
+    assert plain > float(eff.mean_efficiency)                 # the plain mean is gamed
+    assert int(g1.n_lost) == 1
+    drop = float(g0.mean_efficiency) - float(g1.mean_efficiency)
+    np.testing.assert_allclose(drop, (P_in - P_f[worst]) / (v0.sum() * P_in), rtol=1e-12)
+    # positions outside V0 never count: a position valid now but not at the start
+    extra = v0.copy()
+    extra[worst] = False
+    assert int(efficiency_guard(eff, extra).n_lost) == 0
+    grad = jax.grad(lambda p: efficiency_guard(eff._replace(power_loss=p), v0)
+                    .mean_efficiency)(eff.power_loss)
+    np.testing.assert_allclose(grad, np.where(v0, -1 / (v0.sum() * P_in), 0.0), rtol=1e-14)
+
+
 def test_plausibility_thresholds_on_synthetic_positions():
     """Each check at its documented threshold on a synthetic cycle (one position
     failing one check each).  Planted bugs caught: a check dropped or with a flipped
