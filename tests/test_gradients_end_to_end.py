@@ -129,6 +129,36 @@ def test_bevel_and_hypoid_chain(example):
     # R_x derivatives agree to round-off with 1e-4 steps too)
     jac = _check(f, pair, fields, rel_step=1e-6)
     assert abs(float(jac["pinion.machine.modified_roll_2c"][0])) > 1.0   # TE p-t-p moves
+    _check_mask_gaming_hypoid(f)
+
+
+#: end point of the issue's gaming run on this example (experiments/objective_gaming.py:
+#: 20 Adam steps of learning rate 0.5 mm on the drive pinion's cutter point radius,
+#: minimising mean |SRR| over the nominal mask alone; experiments/results/objective_gaming.json)
+GAMING_POINT_RADIUS = 112.5162183416875
+
+
+def _check_mask_gaming_hypoid(f):
+    """The hypoid gaming run of the issue ends in a flagged failure: mean |SRR| over the
+    9 nominal mask points "falls" 0.634 -> 0.449 while the true on-flank mean rises to
+    0.720 and 2 mask points have left the flank -- ``mask_check`` counts them (against
+    NumPy) and its penalty is positive.  Evaluated by the TCA program compiled above.
+    Planted bugs caught: as in the involute case (a count on the nominal result, a
+    penalty on inside points or of the wrong sign)."""
+    nom = f(f.pair)
+    on = np.asarray(nom.on_flank)
+    assert int(nom.mask_check(on).n_off) == 0 and float(nom.mask_check(on).penalty) == 0.0
+    end = f(gj.with_fields(f.pair, {"pinion.cutter.point_radius":
+                                    jnp.asarray(GAMING_POINT_RADIUS)}))
+    c = end.mask_check(on)
+    assert float(end.objectives(on)[1]) < float(nom.objectives(on)[1])   # the "improvement"
+    of = np.asarray(end.on_flank)
+    srr = np.abs(np.asarray(end.kinematics.srr))
+    assert srr[of].mean() > np.abs(np.asarray(nom.kinematics.srr))[on].mean()   # truly worse
+    assert int(c.n_off) == int(np.sum(on & ~of)) >= 1
+    margin, conv = np.asarray(end.margin), np.asarray(end.path.converged)
+    expect = np.sum(np.where(on & conv, np.maximum(-margin, 0.0) ** 2, 0.0)) + np.sum(on & ~conv)
+    assert float(c.penalty) == pytest.approx(expect, rel=1e-12) and expect > 0.0
 
 
 def test_field_helpers_name_and_replace_leaves():
