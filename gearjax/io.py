@@ -37,6 +37,7 @@ __all__ = ["read_toml", "check_keys", "require_key", "check_number", "check_inte
            "write_csv", "write_xyz", "write_stl_flank",
            "write_stl_tooth", "tooth_mesh", "flank_triangles", "write_flank",
            "register_design_kind", "design_kinds", "design_from_dict", "load_design",
+           "DesignFileMixin",
            "FlankGrid"]
 
 #: packaged examples renamed since (old name -> current name); still accepted
@@ -412,6 +413,19 @@ def read_toml(source) -> dict:
 
 
 # --------------------------------------------------------------------------------------
+class DesignFileMixin:
+    """``name`` and ``to_dict`` of a family's design-file object from its validated
+    ``data`` dict (file units) -- the part every family's file class shares."""
+
+    @property
+    def name(self) -> str:
+        return self.data.get("design", {}).get("name", "")
+
+    def to_dict(self) -> dict:
+        import copy
+        return copy.deepcopy(self.data)
+
+
 # design files of every family: one loader, dispatched on [design] kind
 
 #: kind -> reader(data: dict) -> design; filled by the families when they are imported

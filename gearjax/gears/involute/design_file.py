@@ -37,7 +37,7 @@ from dataclasses import dataclass, field
 from gearjax.errors import check_range
 from gearjax.gears.involute.geometry import InvolutePair
 from gearjax.gears.involute.tca import ADAPTER, InvoluteTCA
-from gearjax.io import (check_integer, check_keys, check_number, check_string,
+from gearjax.io import (DesignFileMixin, check_integer, check_keys, check_number, check_string,
                         register_design_kind, require_key)
 from gearjax.tca_result import register_family
 
@@ -55,19 +55,12 @@ MODIFICATION_KEYS = {"pressure_angle_change_deg": "deg", "profile_crown_per_mm":
 
 
 @dataclass(frozen=True)
-class InvoluteFile:
+class InvoluteFile(DesignFileMixin):
     """A validated involute design file: ``data`` (file units) and ``design`` (the
     :class:`InvoluteTCA` pytree the TCA and the loaded chain run)."""
 
     data: dict = field(compare=True)
     design: InvoluteTCA = field(compare=False)
-
-    @property
-    def name(self) -> str:
-        return self.data.get("design", {}).get("name", "")
-
-    def to_dict(self) -> dict:
-        return copy.deepcopy(self.data)
 
     def defaults_lines(self) -> list:
         """The documented defaults this design relies on (printable lines)."""

@@ -37,7 +37,7 @@ from gearjax.gears.preset_bevel.geometry import (PresetBevelDesign, cone_distanc
                                                  curve_parameter, flank_phase, gear_curve,
                                                  gear_flank_point, pinion_flank_point,
                                                  pitch_angles, preset_kappa)
-from gearjax.io import (FlankGrid, check_integer, check_keys, check_number,  # noqa: F401
+from gearjax.io import (DesignFileMixin, FlankGrid, check_integer, check_keys, check_number,  # noqa: F401
                         register_design_kind, require_key)
 from gearjax.newton import newton_solve
 from gearjax.tca import ARCSEC
@@ -165,20 +165,13 @@ def _grid_jit(fn, data, delta, L, H, T0):
 
 
 @dataclass(frozen=True)
-class PresetBevelFile:
+class PresetBevelFile(DesignFileMixin):
     """A validated preset-TE bevel design file: ``data`` (file units), ``design`` (the
     :class:`PresetBevelDesign` pytree).  Taken by ``gearjax tca``, ``gearjax efficiency``
     (through ``gearjax.run_tca``) and ``gearjax surface``."""
 
     data: dict = field(compare=True)
     design: PresetBevelDesign = field(compare=False)
-
-    @property
-    def name(self) -> str:
-        return self.data.get("design", {}).get("name", "")
-
-    def to_dict(self) -> dict:
-        return copy.deepcopy(self.data)
 
     def defaults_lines(self) -> list:
         """The documented defaults this design relies on (printable lines)."""
