@@ -144,7 +144,7 @@ def test_gradients_against_central_differences(spur, oil_surface, iso_run):
         path = res.path._replace(te=res.path.te + a * (res.path.phi1 - res.path.phi1[mid]))
         kin = res.kinematics._replace(r_x=res.kinematics.r_x * (1.0 + b))
         r = dataclasses.replace(res, path=path, kinematics=kin)
-        eff = mesh_efficiency_traced(r, teeth_of(des, r), T, RPM * np.pi / 30.0,
+        eff = mesh_efficiency_traced(r, teeth_of(des, r), T, RPM,
                                      dataclasses.replace(oil, eta0=eta0),
                                      dataclasses.replace(surf, sigma=sigma),
                                      steps_per_pitch=24, n_pairs=3, compliance="weber")
