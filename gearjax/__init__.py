@@ -84,7 +84,7 @@ from gearjax.tribology import (OILS, FrictionResult, Oil, Surface, friction_coef
 from gearjax.tribology.ehl import solve_ehl  # noqa: E402
 # -- loaded contact and mesh efficiency ---------------------------------------------
 from gearjax.loaded_contact import COMPLIANCE_MODELS, LoadedContact  # noqa: E402
-from gearjax.mesh_efficiency import (DEFAULT_COMPLIANCE, RPM_RANGE, TORQUE_RANGE_NM,  # noqa: E402
+from gearjax.mesh_efficiency import (COMPLIANCE_HELP, DEFAULT_COMPLIANCE, RPM_RANGE, TORQUE_RANGE_NM,  # noqa: E402
                                      MeshEfficiency, check_operating_point,
                                      efficiency_function, efficiency_warnings, mesh_efficiency)
 from gearjax.materials import E_PRIME_RANGE_MPA, Material, pair_material  # noqa: E402
@@ -181,7 +181,7 @@ __all__ = [
     "mesh_losses", "mesh_losses_traced", "stribeck_curve", "solve_ehl",
     # loaded contact and mesh efficiency
     "mesh_efficiency", "efficiency_function", "efficiency_warnings", "MeshEfficiency",
-    "DEFAULT_COMPLIANCE", "Material", "STEEL_MATERIAL", "pair_material", "E_PRIME_RANGE_MPA",
+    "DEFAULT_COMPLIANCE", "COMPLIANCE_HELP", "Material", "STEEL_MATERIAL", "pair_material", "E_PRIME_RANGE_MPA",
     "check_design",
     "LoadedContact", "check_operating_point", "TORQUE_RANGE_NM", "RPM_RANGE", "COMPLIANCE_MODELS",
     # optimisers and solvers

@@ -194,3 +194,24 @@ def test_traced_values_are_not_checked(vh, oil_surface):
     jaxpr = jax.make_jaxpr(lambda e, n: check_efficiency_inputs(
         T, n, oil, surf, e, 0.3, "weber", "roelands", "auto"))(2.26e11, 0.0)
     assert len(jaxpr.eqns) == 0
+
+
+def test_one_compliance_sentence_in_readme_help_and_docstring():
+    """The default compliance model is documented identically (the same sentence) in the
+    README, ``gearjax efficiency --help`` and the docstring of mesh_efficiency, and the
+    defaults agree (before #28: README and Python weber, the command iso6336)."""
+    import os
+
+    from gearjax.cli import build_parser
+    norm = lambda t: " ".join(t.split())           # noqa: E731  (line breaks aside)
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    with open(os.path.join(root, "README.md"), encoding="utf-8") as fh:
+        readme = norm(fh.read())
+    sub = build_parser()._subparsers._group_actions[0].choices["efficiency"]
+    helptext = norm(sub.format_help())
+    sentence = norm(gj.COMPLIANCE_HELP)
+    assert sentence in readme and sentence in helptext
+    assert sentence in norm(gj.mesh_efficiency.__doc__)
+    comp = [a for a in sub._actions if a.dest == "compliance"][0]
+    for fn in (gj.mesh_efficiency, gj.efficiency_function, mesh_efficiency_traced):
+        assert inspect.signature(fn).parameters["compliance"].default == comp.default == "weber"

@@ -117,10 +117,8 @@ def register(sub):
                    help="dE=mm,dP=mm,dG=mm,dSigma=deg (any subset; default all 0)")
     p.add_argument("--compliance", choices=list(gj.COMPLIANCE_MODELS),
                    default=gj.DEFAULT_COMPLIANCE,
-                   help=f"tooth compliance model of the load sharing (default "
-                        f"{gj.DEFAULT_COMPLIANCE}: Weber/Cornell cantilever + Sainsot fillet "
-                        "foundation + Hertz approach; iso6336: the standard's constant single "
-                        "stiffness), as gearjax.mesh_efficiency")
+                   help=f"tooth compliance model of the load sharing, as "
+                        f"gearjax.mesh_efficiency: {gj.COMPLIANCE_HELP}")
     p.add_argument("--positions", type=float, default=None,
                    help=f"positions per mesh cycle (one pinion pitch), integer "
                         f"{POSITIONS_RANGE[0]}..{POSITIONS_RANGE[1]} (default 24 involute, "
