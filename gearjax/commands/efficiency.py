@@ -5,7 +5,11 @@ DESIGN as for ``gearjax tca`` (:mod:`gearjax.commands.designs`): an inline invol
 pair or a hypoid/spiral-bevel design file / ``example:NAME``.  The oil, surface and
 film options are those of ``gearjax friction`` (:func:`gearjax.commands.friction.
 add_lubricant_options`, same ranges).  The pinion torque (N m) and speed (rpm) are
-checked against :data:`gearjax.TORQUE_RANGE_NM` and :data:`gearjax.RPM_RANGE`.
+checked against :data:`gearjax.TORQUE_RANGE_NM` and :data:`gearjax.RPM_RANGE`.  The
+material (:mod:`gearjax.materials`): ``--E-prime-MPa`` if given, else the design's own
+``[material]`` (VH-CATT), else steel; it sets E' and the tooth compliance, and the
+output names its source (``input.material_source``).  ``--compliance`` has the default
+of :func:`gearjax.mesh_efficiency` (:data:`gearjax.DEFAULT_COMPLIANCE`).
 
 Exit status as ``gearjax tca``: 0 with a result (problems of the result -- TCA
 quality flags, positions whose load balance or friction solve did not converge, a
