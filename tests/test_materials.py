@@ -215,3 +215,24 @@ def test_one_compliance_sentence_in_readme_help_and_docstring():
     comp = [a for a in sub._actions if a.dest == "compliance"][0]
     for fn in (gj.mesh_efficiency, gj.efficiency_function, mesh_efficiency_traced):
         assert inspect.signature(fn).parameters["compliance"].default == comp.default == "weber"
+
+
+@pytest.mark.parametrize("field,words", [
+    ("blade_angle", ["pinion.cutter.blade_angle", "20 rad", "0.785398"]),
+    ("shaft_angle", ["shaft_angle", "90 rad", "3.14159"]),
+])
+def test_hand_built_hypoid_pair_checked_before_work(field, words):
+    """A HypoidPair built by hand with degrees in a radian field is refused by
+    run_tca / tca_function in one line, as make_cutter and the design file would."""
+    pair = gj.pair_flanks(gj.load_design("example:spiral_bevel_10x30"), "drive")
+    gj.check_design(pair)                                    # the loader's pair passes
+    if field == "blade_angle":
+        cut = dataclasses.replace(pair.pinion.cutter, blade_angle=jnp.asarray(20.0))
+        bad = dataclasses.replace(pair, pinion=dataclasses.replace(pair.pinion, cutter=cut))
+    else:
+        bad = dataclasses.replace(pair, shaft_angle=jnp.asarray(90.0))
+    for fn in (gj.run_tca, gj.tca_function):
+        with pytest.raises(ValueError) as exc:
+            fn(bad)
+        msg = str(exc.value)
+        assert "\n" not in msg and all(w in msg for w in words), msg
