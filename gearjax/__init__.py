@@ -84,8 +84,8 @@ from gearjax.tribology import (OILS, FrictionResult, Oil, Surface, friction_coef
 from gearjax.tribology.ehl import solve_ehl  # noqa: E402
 # -- loaded contact and mesh efficiency ---------------------------------------------
 from gearjax.loaded_contact import COMPLIANCE_MODELS, LoadedContact  # noqa: E402
-from gearjax.mesh_efficiency import (COMPLIANCE_HELP, DEFAULT_COMPLIANCE, RPM_RANGE, TORQUE_RANGE_NM,  # noqa: E402
-                                     MeshEfficiency, check_operating_point,
+from gearjax.mesh_efficiency import (COMPLIANCE_HELP, DEFAULT_COMPLIANCE,  # noqa: E402
+                                     RPM_RANGE, TORQUE_RANGE_NM, MeshEfficiency, check_operating_point,
                                      efficiency_function, efficiency_warnings, mesh_efficiency)
 from gearjax.materials import E_PRIME_RANGE_MPA, Material, pair_material  # noqa: E402
 from gearjax.materials import STEEL as STEEL_MATERIAL  # noqa: E402
@@ -108,7 +108,8 @@ def run_tca(design, misalignment=None, *, side=None, **options) -> TCAResult:
     Returns a :class:`TCAResult`; ``result.flags()`` gives the contact-quality flags.
     The concrete design is validated first (:func:`check_design`: a field out of
     range, e.g. degrees typed into a radian field, is a one-line ValueError); jitted:
-    a second call with the same shapes and options reuses the compiled program.  For gradients use :func:`tca_function`.
+    a second call with the same shapes and options reuses the compiled program.  For
+    gradients use :func:`tca_function`.
     """
     check_design(design)
     kw = dict(options)
@@ -181,7 +182,8 @@ __all__ = [
     "mesh_losses", "mesh_losses_traced", "stribeck_curve", "solve_ehl",
     # loaded contact and mesh efficiency
     "mesh_efficiency", "efficiency_function", "efficiency_warnings", "MeshEfficiency",
-    "DEFAULT_COMPLIANCE", "COMPLIANCE_HELP", "Material", "STEEL_MATERIAL", "pair_material", "E_PRIME_RANGE_MPA",
+    "DEFAULT_COMPLIANCE", "COMPLIANCE_HELP", "Material", "STEEL_MATERIAL", "pair_material",
+    "E_PRIME_RANGE_MPA",
     "check_design",
     "LoadedContact", "check_operating_point", "TORQUE_RANGE_NM", "RPM_RANGE", "COMPLIANCE_MODELS",
     # optimisers and solvers

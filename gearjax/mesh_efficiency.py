@@ -75,7 +75,8 @@ from gearjax.tribology.friction import FILM_MIN_MM, STEEL_E_PRIME, FrictionResul
 from gearjax.tribology.losses import mesh_losses_traced
 from gearjax.tribology.lubricant import Oil
 
-__all__ = ["MeshEfficiency", "mesh_efficiency", "DEFAULT_COMPLIANCE", "COMPLIANCE_HELP", "check_efficiency_inputs", "efficiency_function", "mesh_efficiency_traced",
+__all__ = ["MeshEfficiency", "mesh_efficiency", "DEFAULT_COMPLIANCE", "COMPLIANCE_HELP",
+           "check_efficiency_inputs", "efficiency_function", "mesh_efficiency_traced",
            "efficiency_warnings", "cycle_window", "check_operating_point", "cycle_summary",
            "CycleSummary", "plausibility", "Plausibility", "TORQUE_RANGE_NM", "RPM_RANGE",
            "MU_MAX", "P_MAX_LIMIT_MPA", "DEFLECTION_MAX_PITCH", "HERTZ_SIZE_MAX", "FILM_MIN_MM"]
@@ -84,7 +85,10 @@ __all__ = ["MeshEfficiency", "mesh_efficiency", "DEFAULT_COMPLIANCE", "COMPLIANC
 DEFAULT_COMPLIANCE = "weber"
 #: the compliance models in one sentence, word for word in the README, ``gearjax
 #: efficiency --help`` and the docstring of :func:`mesh_efficiency` (a test keeps them so)
-COMPLIANCE_HELP = ("weber (the default): Weber/Cornell tooth cantilever + Sainsot fillet foundation + the contact (Hertz approach of a point contact, Weber's line contact); iso6336: the constant single stiffness c' of ISO 6336-1 method B, scaled by E/206000 MPa")
+COMPLIANCE_HELP = ("weber (the default): Weber/Cornell tooth cantilever + Sainsot fillet "
+                   "foundation + the contact (Hertz approach of a point contact, Weber's "
+                   "line contact); iso6336: the constant single stiffness c' of ISO 6336-1 "
+                   "method B, scaled by E/206000 MPa")
 
 #: accepted pinion torque (N m) and speed (rpm)
 TORQUE_RANGE_NM = (1e-3, 1e6)
@@ -523,8 +527,9 @@ def mesh_efficiency(design, torque_Nm, pinion_rpm, oil: Oil, surface: Surface, *
     MPa, nu 0.3: E' = 226 374 MPa) sets E' *and* the tooth compliance
     (:func:`gearjax.materials.pair_material` says which applied).  ``compliance``, the
     same default as the ``gearjax efficiency`` command (:data:`DEFAULT_COMPLIANCE`):
-    weber (the default): Weber/Cornell tooth cantilever + Sainsot fillet foundation + the contact (Hertz approach of a point contact, Weber's line contact); iso6336: the constant single stiffness c' of ISO 6336-1 method B, scaled by E/206000
-    MPa.
+    weber (the default): Weber/Cornell tooth cantilever + Sainsot fillet foundation +
+    the contact (Hertz approach of a point contact, Weber's line contact); iso6336: the
+    constant single stiffness c' of ISO 6336-1 method B, scaled by E/206000 MPa.
 
     Every concrete input is validated before any work, as the command line and the
     design-file loaders do (one-line ValueError naming the parameter, its value and

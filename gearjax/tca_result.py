@@ -65,7 +65,8 @@ from gearjax.surfaces import local_geometry
 from gearjax.tca import (ARCSEC, Assembly, ContactPath, Misalignment, MultiPair, contact_equations,
                          contact_system, gear_mount, relative_curvature)
 
-__all__ = ["SIDES", "check_side", "check_design", "TCAResult", "ContactKinematics", "contact_kinematics",
+__all__ = ["SIDES", "check_side", "check_design",
+           "TCAResult", "ContactKinematics", "contact_kinematics",
            "contact_motion", "strong_float64",
            "register_family", "family_of"]
 

@@ -326,7 +326,8 @@ def run(args) -> int:
            "sigma_um": args.sigma_um, "asperity_density_per_mm2": args.asperity_density_per_mm2,
            "asperity_radius_um": args.asperity_radius_um, "fc": args.fc,
            "E_prime_MPa": Ep, "youngs_modulus_MPa": float(mat.youngs_modulus_MPa),
-           "poisson": float(mat.poisson), "material_source": mat.source, "film": args.film, "viscosity": args.viscosity,
+           "poisson": float(mat.poisson), "material_source": mat.source, "film": args.film,
+           "viscosity": args.viscosity,
            "compliance": args.compliance, "positions": int(opts_all["steps_per_pitch"]),
            "pitches": float(opts_all["half_pitches"]), "pairs": int(opts_all["n_pairs"])}
     out = _output(eff, res, inp, warn_lines, args.plot)
