@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import math
 import time
 
 import jax
@@ -45,7 +44,7 @@ def main():
                    dataclasses.replace(surf, sigma=sigma), mis)
         return eff.mean_efficiency
 
-    a = (x0, gj.Misalignment.zero(), jnp.asarray(200.0), jnp.asarray(1000 * math.pi / 30),
+    a = (x0, gj.Misalignment.zero(), jnp.asarray(200.0), jnp.asarray(1000.0),
          jnp.asarray(oil.eta0), jnp.asarray(surf.sigma))
     rows = []
     for label, fn in (("forward eta_bar", jax.jit(eta)),

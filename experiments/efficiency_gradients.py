@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import math
 import sys
 import time
 from pathlib import Path
@@ -49,7 +48,7 @@ def main():
                    dataclasses.replace(surf, sigma=sigma), mis)
         return eff.mean_efficiency
 
-    args = (x0, mis0, jnp.asarray(TORQUE), jnp.asarray(RPM * math.pi / 30.0),
+    args = (x0, mis0, jnp.asarray(TORQUE), jnp.asarray(float(RPM)),
             jnp.asarray(oil.eta0), jnp.asarray(surf.sigma))
     jf = jax.jit(eta)
     log("compiling the forward model")
@@ -71,7 +70,7 @@ def main():
         rows.append((m, float(getattr(g[1], m)),
                      cd(lambda v: jf(x0, dataclasses.replace(mis0, **{m: v}), *args[2:]),
                         getattr(mis0, m), 1e-6)))
-    for j, n in enumerate(("torque_Nm", "speed_rad_s", "eta0_Pas", "sigma_mm")):
+    for j, n in enumerate(("torque_Nm", "pinion_rpm", "eta0_Pas", "sigma_mm")):
         a = args[2 + j]
 
         def fs(v, j=j):

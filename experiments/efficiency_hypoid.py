@@ -32,7 +32,6 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
-import math
 import sys
 import time
 from pathlib import Path
@@ -90,7 +89,7 @@ def chain(names=None):
 def setup():
     design, f, oil, surf, names, x0 = chain([n for n, _ in VARIABLES])
     scale = jnp.array([s for _, s in VARIABLES])
-    omega = RPM * math.pi / 30.0
+    omega = RPM            # f takes the pinion speed in rpm
 
     def pair_of(u):
         x = x0 + scale * u

@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import math
 import sys
 import time
 from pathlib import Path
@@ -50,7 +49,7 @@ def main(maxiter: int = 40, opt_only: bool = False):
     pair0 = design.pair
     oil = gj.get_oil("mineral_vg100")
     surf = gj.make_surface(SIGMA_UM)
-    w = RPM * math.pi / 30.0
+    w = RPM                # f takes the pinion speed in rpm
     Ep = design.e_prime_MPa()
     f = gj.efficiency_function(pair0, E_prime=Ep)
 

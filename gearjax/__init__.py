@@ -85,9 +85,13 @@ from gearjax.tribology import (OILS, FrictionResult, Oil, Surface, friction_coef
 from gearjax.tribology.ehl import solve_ehl  # noqa: E402
 # -- loaded contact and mesh efficiency ---------------------------------------------
 from gearjax.loaded_contact import COMPLIANCE_MODELS, LoadedContact  # noqa: E402
-from gearjax.mesh_efficiency import (RPM_RANGE, TORQUE_RANGE_NM, MeshEfficiency,  # noqa: E402
-                                     check_operating_point, efficiency_function,
-                                     efficiency_guard, efficiency_warnings, mesh_efficiency)
+from gearjax.mesh_efficiency import (COMPLIANCE_HELP, DEFAULT_COMPLIANCE,  # noqa: E402
+                                     RPM_RANGE, TORQUE_RANGE_NM, MeshEfficiency, check_operating_point,
+                                     efficiency_function, efficiency_guard, efficiency_warnings,
+                                     mesh_efficiency)
+from gearjax.materials import E_PRIME_RANGE_MPA, Material, pair_material  # noqa: E402
+from gearjax.materials import STEEL as STEEL_MATERIAL  # noqa: E402
+from gearjax.tca_result import check_design  # noqa: E402
 
 
 def run_tca(design, misalignment=None, *, side=None, **options) -> TCAResult:
@@ -104,9 +108,12 @@ def run_tca(design, misalignment=None, *, side=None, **options) -> TCAResult:
     :class:`ConvergenceError` when a contact solve fails on the working flank).
 
     Returns a :class:`TCAResult`; ``result.flags()`` gives the contact-quality flags.
-    Validated and jitted; a second call with the same shapes and options reuses the
-    compiled program.  For gradients use :func:`tca_function`.
+    The concrete design is validated first (:func:`check_design`: a field out of
+    range, e.g. degrees typed into a radian field, is a one-line ValueError); jitted:
+    a second call with the same shapes and options reuses the compiled program.  For
+    gradients use :func:`tca_function`.
     """
+    check_design(design)
     kw = dict(options)
     if side is not None:
         kw["side"] = side
@@ -124,6 +131,7 @@ def tca_function(design, *, side=None, **options):
     natural point to differentiate at).  Options as for :func:`run_tca` (no
     ``strict``: check ``result.path.converged`` and ``result.on_flank``).
     """
+    check_design(design)
     kw = dict(options)
     if side is not None:
         kw["side"] = side
@@ -177,6 +185,9 @@ __all__ = [
     # loaded contact and mesh efficiency
     "mesh_efficiency", "efficiency_function", "efficiency_warnings", "efficiency_guard",
     "MeshEfficiency",
+    "DEFAULT_COMPLIANCE", "COMPLIANCE_HELP", "Material", "STEEL_MATERIAL", "pair_material",
+    "E_PRIME_RANGE_MPA",
+    "check_design",
     "LoadedContact", "check_operating_point", "TORQUE_RANGE_NM", "RPM_RANGE", "COMPLIANCE_MODELS",
     # optimisers and solvers
     "minimize_optax", "minimize_lbfgsb", "least_squares_lm", "OptResult", "LMResult",

@@ -119,6 +119,7 @@ def _enable_compilation_cache() -> None:
 
 def main(argv=None) -> int:
     from gearjax import ConvergenceError
+    from gearjax.io import UnconvergedExportError
 
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -133,7 +134,9 @@ def main(argv=None) -> int:
     except ValueError as exc:
         sys.stderr.write(f"gearjax: error: {exc}\n")
         return 2
-    except ConvergenceError as exc:   # a solve failed on valid input: one line, status 3
+    except (ConvergenceError, UnconvergedExportError) as exc:
+        # a solve failed on valid input (or an export would carry such points): one
+        # line, status 3
         msg = str(exc).split("; pass strict=False")[0]
         sys.stderr.write(f"gearjax: error: {msg}\n")
         return 3

@@ -518,9 +518,39 @@ def _np(a):
     return np.asarray(a, dtype=float)
 
 
+class UnconvergedExportError(RuntimeError):
+    """A surface export refused because some grid points are not converged solves
+    (:func:`check_grid_converged`); nothing is written.  The command maps it to one
+    ``gearjax: error:`` line and status 3 (a solve failed on valid input)."""
+
+
+def check_grid_converged(grid, what: str = "flank") -> None:
+    """Refuse to export a grid with any point that is not a converged solve.
+
+    A point is exported only when its ``converged`` flag is set and its position and
+    normal are finite; otherwise :class:`UnconvergedExportError` with one line naming
+    ``what``, the count of bad points out of the total and the largest residual
+    (mm).  Every writer of this module calls it before writing (CSV, XYZ, STL flank,
+    STL tooth), so no format carries a point that is not on the surface."""
+    conv = np.asarray(grid.converged, bool)
+    P, N = _np(grid.points), _np(grid.normals)
+    ok = conv & np.all(np.isfinite(P), axis=-1) & np.all(np.isfinite(N), axis=-1)
+    bad = int(np.sum(~ok))
+    if bad:
+        res = _np(grid.residual)
+        worst = np.nanmax(np.where(ok, -np.inf, np.abs(res)))
+        worst_txt = f"{worst:.3g} mm" if np.isfinite(worst) else "not finite"
+        raise UnconvergedExportError(
+            f"{what}: {bad} of {ok.size} grid points are not converged solves (largest "
+            f"residual {worst_txt}); nothing written -- the grid reaches beyond the flank "
+            "that the solves find (check the blank: addendum, dedendum, face width)")
+
+
 def write_csv(path, grid) -> Path:
     """CSV with one row per grid point: indices, xi, (s, theta, psi), point, normal,
-    residual and converged flag (mm, rad)."""
+    residual and converged flag (mm, rad).  Refused unless every point converged
+    (:func:`check_grid_converged`)."""
+    check_grid_converged(grid)
     P, N, prm = _np(grid.points), _np(grid.normals), _np(grid.params)
     res, conv, xi = _np(grid.residual), np.asarray(grid.converged), _np(grid.xi)
     lines = ["i,j,xi,s_mm,theta_rad,psi_rad,x_mm,y_mm,z_mm,nx,ny,nz,residual_mm,converged"]
@@ -532,7 +562,9 @@ def write_csv(path, grid) -> Path:
 
 
 def write_xyz(path, grid) -> Path:
-    """XYZ point cloud with normals: ``x y z nx ny nz`` per line (mm)."""
+    """XYZ point cloud with normals: ``x y z nx ny nz`` per line (mm).  Refused unless
+    every point converged (:func:`check_grid_converged`)."""
+    check_grid_converged(grid)
     P, N = _np(grid.points).reshape(-1, 3), _np(grid.normals).reshape(-1, 3)
     lines = [" ".join(f"{v:.12g}" for v in (*p, *n)) for p, n in zip(P, N)]
     return atomic_write(path, "\n".join(lines) + "\n")
@@ -577,7 +609,9 @@ def _stl_text(tri, name) -> str:
 
 
 def write_stl_flank(path, grid, name: str = "flank") -> Path:
-    """ASCII STL of one flank (facets oriented out of the material)."""
+    """ASCII STL of one flank (facets oriented out of the material).  Refused unless
+    every point converged (:func:`check_grid_converged`)."""
+    check_grid_converged(grid, name)
     return atomic_write(path, _stl_text(flank_triangles(grid.points, grid.normals), name))
 
 
@@ -626,7 +660,10 @@ def tooth_mesh(convex, concave, teeth: int):
 
 
 def write_stl_tooth(path, convex, concave, teeth: int, name: str = "tooth") -> Path:
-    """ASCII STL of a whole tooth (see :func:`tooth_mesh`)."""
+    """ASCII STL of a whole tooth (see :func:`tooth_mesh`).  Refused unless every point
+    of both flanks converged (:func:`check_grid_converged`)."""
+    check_grid_converged(convex, f"{name}: convex flank")
+    check_grid_converged(concave, f"{name}: concave flank")
     return atomic_write(path, _stl_text(tooth_mesh(convex, concave, teeth), name))
 
 

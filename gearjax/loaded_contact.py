@@ -50,8 +50,9 @@ import numpy as np
 from gearjax.contact import hertz_exact, hertz_line_traced
 from gearjax.newton import newton_solve
 from gearjax.tca import pair_arrays
-from gearjax.tooth_compliance import (contact_compliance, iso6336_single_stiffness,
-                                      tooth_compliance, tooth_geometry)
+from gearjax.tooth_compliance import (E_STEEL, NU_STEEL, contact_compliance,
+                                      iso6336_single_stiffness, tooth_compliance,
+                                      tooth_geometry)
 
 __all__ = ["LoadedContact", "MeshTeeth", "TeethOf", "pair_compliance", "COMPLIANCE_MODELS",
            "hertz_coefficient", "contact_stress", "force_from_approach", "share_torque", "pair_arrays",
@@ -267,9 +268,14 @@ class MeshTeeth(NamedTuple):
 COMPLIANCE_MODELS = ("weber", "iso6336")
 
 
-def pair_compliance(teeth: MeshTeeth, r_x, load_per_width, model: str = "weber"):
+def pair_compliance(teeth: MeshTeeth, r_x, load_per_width, model: str = "weber",
+                    E=E_STEEL, nu=NU_STEEL):
     """Linear compliance ``q`` (mm/N) of tooth pair 0 at every path point (module
     docstring; the Hertz term of a point contact is added by the caller).
+
+    ``E`` (MPa) and ``nu``: Young's modulus and Poisson's ratio of both members (the
+    pair's material, :mod:`gearjax.materials`; default steel, 206 000 MPa and 0.3).
+    Every term is that of linear elasticity, so ``q`` scales as ``1/E`` at fixed ν.
 
     ``"weber"`` (default): both teeth as cantilevers of the virtual spur gears --
     bending, shear and axial compression of the variable section plus the fillet
@@ -281,7 +287,10 @@ def pair_compliance(teeth: MeshTeeth, r_x, load_per_width, model: str = "weber")
 
     ``"iso6336"``: the single stiffness ``c'`` of [ISO6336-1] method B, constant along
     the path: ``q = 1e-3 / (c' width)`` (the 1e-3 converts um to mm); the standard's
-    stiffness includes the flattening of the contact, so no Hertz term is added.
+    stiffness includes the flattening of the contact, so no Hertz term is added.  The
+    standard's c' is that of steel (E_st = 206 000 MPa); another material scales it by
+    ``E/E_st`` ([ISO6336-1], material ratio of a pair of two equal materials; the
+    standard's formula has no ν).
     """
     if model not in COMPLIANCE_MODELS:
         raise ValueError(f"compliance model = {model!r} must be one of {COMPLIANCE_MODELS}")
@@ -290,17 +299,19 @@ def pair_compliance(teeth: MeshTeeth, r_x, load_per_width, model: str = "weber")
         cb3 = jnp.cos(teeth.beta) ** 3      # the standard forms z_n = z / cos^3(beta)
         c1 = iso6336_single_stiffness(z[0] * cb3, z[1] * cb3, x[0], x[1], teeth.beta,
                                       alpha_n=0.5 * (al[0] + al[1])).c_prime
-        return 1e-3 / (c1 * teeth.width)
+        return 1e-3 / (c1 * (E / E_STEEL) * teeth.width)
 
     def tooth(i):
         g = tooth_geometry(z[i], teeth.module, al[i], x[i], teeth.ha[i], teeth.hf[i])
         r = jnp.clip(teeth.r_load[i], g.r_form, g.r_a)
         return jax.vmap(lambda ri: tooth_compliance(ri, z[i], teeth.module, al[i], x[i],
-                                                    teeth.ha[i], teeth.hf[i]))(r)
+                                                    teeth.ha[i], teeth.hf[i], E=E,
+                                                    nu=nu))(r)
 
     t1, t2 = tooth(0), tooth(1)
     q = (t1.total + t2.total) / teeth.width
     if teeth.line_length is not None:
-        qc = contact_compliance(load_per_width, r_x, t1.half_thickness, t2.half_thickness)
+        qc = contact_compliance(load_per_width, r_x, t1.half_thickness, t2.half_thickness,
+                                E, nu)
         q = q + qc / teeth.line_length
     return q

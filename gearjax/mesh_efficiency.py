@@ -34,8 +34,22 @@ equivalent ellipse whose major semi-axis is ``L/2``:
 ``eta_m(phi) = 1 - P_f/P_in``, ``eta_bar = 1 - mean(P_f)/P_in`` over the cycle
 (positions equally spaced in time) [VH-CATT].
 
-Units: torque N m at the boundary (N mm inside), speed rpm at the boundary (rad/s
-inside), loads N, speeds mm/s, radii mm, power W.
+**Material.**  The reduced modulus E′ of the Hertz contact, film and asperities and
+the Young's modulus and Poisson's ratio of the tooth compliance are those of one
+material (:mod:`gearjax.materials`): an explicit ``E_prime`` (MPa), else the design's
+own material (a VH-CATT file's ``[material]``), else steel (E 206 000 MPa, ν 0.3,
+E′ = 226 374 MPa); with an explicit E′ the compliance uses E = E′ (1 − ν²).
+
+**Compliance.**  One default everywhere (Python, the ``gearjax efficiency`` command,
+the docs): :data:`DEFAULT_COMPLIANCE` = ``"weber"`` (Weber/Cornell cantilever +
+Sainsot foundation + the contact: Hertz approach of a point contact, Weber's line
+contact); ``"iso6336"``: ISO 6336-1's constant single stiffness
+(:func:`gearjax.loaded_contact.pair_compliance`).
+
+Units: torque N m, pinion speed **rpm** in every public function (the keyword is
+``pinion_rpm``: :func:`mesh_efficiency`, the ``f`` of :func:`efficiency_function`,
+:func:`mesh_efficiency_traced`; rad/s only inside), loads N, speeds mm/s, radii mm,
+power W, moduli MPa.
 References (docs/references.md): [VH-CATT]; [Litvin2004]; [HamrockBrewe1983];
 [ISO6336-1]; [Ohlendorf1958].
 """
@@ -51,20 +65,31 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax.errors import check_range
+from gearjax.errors import check_range, is_traced
 from gearjax.loaded_contact import (COMPLIANCE_MODELS, LoadedContact, MeshTeeth, contact_stress,
                                     hertz_coefficient,
                                     lever_arms, pair_arrays, pair_compliance, share_torque)
 from gearjax.tca_result import TCAResult, family_of
+from gearjax.tooth_compliance import NU_STEEL
 from gearjax.tribology.friction import FILM_MIN_MM, STEEL_E_PRIME, FrictionResult, Surface
 from gearjax.tribology.losses import mesh_losses_traced
 from gearjax.tribology.lubricant import Oil
 
-__all__ = ["MeshEfficiency", "mesh_efficiency", "efficiency_function", "mesh_efficiency_traced",
+__all__ = ["MeshEfficiency", "mesh_efficiency", "DEFAULT_COMPLIANCE", "COMPLIANCE_HELP",
+           "check_efficiency_inputs", "efficiency_function", "mesh_efficiency_traced",
            "efficiency_warnings", "cycle_window", "check_operating_point", "cycle_summary",
            "CycleSummary", "plausibility", "Plausibility", "TORQUE_RANGE_NM", "RPM_RANGE",
            "MU_MAX", "P_MAX_LIMIT_MPA", "DEFLECTION_MAX_PITCH", "HERTZ_SIZE_MAX", "FILM_MIN_MM",
            "EfficiencyGuard", "efficiency_guard"]
+
+#: the default tooth compliance model of every route (Python and the command line)
+DEFAULT_COMPLIANCE = "weber"
+#: the compliance models in one sentence, word for word in the README, ``gearjax
+#: efficiency --help`` and the docstring of :func:`mesh_efficiency` (a test keeps them so)
+COMPLIANCE_HELP = ("weber (the default): Weber/Cornell tooth cantilever + Sainsot fillet "
+                   "foundation + the contact (Hertz approach of a point contact, Weber's "
+                   "line contact); iso6336: the constant single stiffness c' of ISO 6336-1 "
+                   "method B, scaled by E/206000 MPa")
 
 #: accepted pinion torque (N m) and speed (rpm)
 TORQUE_RANGE_NM = (1e-3, 1e6)
@@ -296,11 +321,61 @@ def cycle_window(n_grid: int, steps_per_pitch: int) -> np.ndarray:
     return np.arange(steps_per_pitch) + (mid - steps_per_pitch // 2)
 
 
-def check_operating_point(torque_Nm, rpm) -> tuple[float, float]:
-    """Validate the operating point (concrete): torque (N m) and speed (rpm) in range."""
-    T = check_range("torque", torque_Nm, *TORQUE_RANGE_NM, unit="N m")
-    n = check_range("speed", rpm, *RPM_RANGE, unit="rpm")
+def check_operating_point(torque_Nm, pinion_rpm) -> tuple[float, float]:
+    """Validate the operating point (concrete): torque (N m) and pinion speed (rpm) in
+    :data:`TORQUE_RANGE_NM` and :data:`RPM_RANGE` (one-line ValueError naming the
+    parameter, its value and the range; traced values pass unchecked)."""
+    T = check_range("torque_Nm", torque_Nm, *TORQUE_RANGE_NM, unit="N m")
+    n = check_range("pinion_rpm", pinion_rpm, *RPM_RANGE, unit="rpm")
     return T, n
+
+
+#: ranges of an Oil's and a Surface's fields in library units (those of make_oil and
+#: make_surface: eta0 Pa s, tau0 MPa, rho0 kg/m^3, z; sigma and beta mm, density 1/mm^2,
+#: v_slip mm/s): (low, high, low bound excluded, unit)
+_OIL_RANGES = {"eta0": (math.exp(-9.67), 100.0, True, "Pa s"), "z": (0.0, 3.0, True, ""),
+               "tau0": (0.0, 100.0, True, "MPa"), "rho0": (0.0, 2e4, True, "kg/m^3")}
+_SURFACE_RANGES = {"sigma": (0.0, 0.01, True, "mm"), "density": (0.0, 1e6, True, "1/mm^2"),
+                   "beta": (0.0, 1.0, True, "mm"), "f_c": (0.0, 1.0, False, ""),
+                   "v_slip": (0.0, 1000.0, True, "mm/s"),
+                   "asperity_film_factor": (0.5, 1.0, False, "")}
+
+
+def _check_fields(what, obj, ranges):
+    """The scalar fields of an Oil / Surface in their ranges (concrete values only:
+    traced fields and batches -- arrays with dimensions -- are not checked here)."""
+    for name, (lo, hi, lo_open, unit) in ranges.items():
+        v = getattr(obj, name)
+        if is_traced(v) or np.ndim(v):
+            continue
+        check_range(f"{what}.{name}", v, lo, hi, lo_open=lo_open, unit=unit)
+
+
+def check_efficiency_inputs(torque_Nm, pinion_rpm, oil, surface, E_prime, poisson,
+                            compliance, viscosity_model, film_method):
+    """Validate the concrete operating inputs of :func:`mesh_efficiency` /
+    :func:`efficiency_function` before any work, as the command line does: torque and
+    speed (:func:`check_operating_point`), E′ in (0, 1e7] MPa (E′ typed in Pa is
+    refused), ν in [0, 0.5], the oil and surface fields in the ranges of
+    :func:`gearjax.tribology.make_oil` / :func:`~gearjax.tribology.make_surface`, and
+    the model names.  Traced values are not checked.  One-line ValueError."""
+    from gearjax.materials import POISSON_RANGE, check_e_prime
+
+    check_operating_point(torque_Nm, pinion_rpm)
+    check_e_prime(E_prime)
+    check_range("poisson", poisson, *POISSON_RANGE)
+    _check_fields("oil", oil, _OIL_RANGES)
+    _check_fields("surface", surface, _SURFACE_RANGES)
+    _check_models(compliance, viscosity_model, film_method)
+
+
+def _check_models(compliance, viscosity_model, film_method):
+    """The model names (one-line ValueError listing the allowed ones)."""
+    for name, v, allowed in (("compliance", compliance, COMPLIANCE_MODELS),
+                             ("viscosity_model", viscosity_model, ("roelands", "barus")),
+                             ("film_method", film_method, ("auto", "point", "line"))):
+        if v not in allowed:
+            raise ValueError(f"{name} = {v!r} must be one of {tuple(allowed)}")
 
 
 def _equivalent_ry(F, r_x, L, E_prime):
@@ -310,9 +385,10 @@ def _equivalent_ry(F, r_x, L, E_prime):
     return r_x * (k / 1.0339) ** (1.0 / 0.636)
 
 
-def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, speed_rad_s, oil: Oil,
+def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, pinion_rpm, oil: Oil,
                            surface: Surface, *, steps_per_pitch: int, n_pairs: int,
-                           E_prime=STEEL_E_PRIME, compliance: str = "weber",
+                           E_prime=STEEL_E_PRIME, poisson=NU_STEEL,
+                           compliance: str = DEFAULT_COMPLIANCE,
                            viscosity_model: str = "roelands",
                            film_method: str = "auto") -> MeshEfficiency:
     """Loaded contact, friction and efficiency of the pair over one mesh cycle
@@ -320,7 +396,10 @@ def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, speed_ra
 
     ``res`` : the TCA result with kinematics; ``teeth`` : the family's
     :class:`~gearjax.loaded_contact.MeshTeeth` for ``res``; ``steps_per_pitch`` and
-    ``n_pairs`` : those of the TCA.  Torque on the pinion (N m), pinion speed (rad/s).
+    ``n_pairs`` : those of the TCA.  Torque on the pinion (N m), pinion speed (rpm;
+    ``omega1 = pinion_rpm pi/30`` rad/s inside).  ``E_prime`` (MPa) and ``poisson``:
+    the material (module docstring); the tooth compliance takes
+    ``E = E_prime (1 - poisson^2)`` and ``poisson``.
     """
     path, kin = res.path, res.kinematics
     n = path.phi1.shape[0]
@@ -343,7 +422,8 @@ def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, speed_ra
     # nominal load per unit length of a line contact (one pair carrying the torque):
     # it enters Weber's contact compliance only through a logarithm
     w_nom = T1 / (jnp.where(on, l1_0, 1.0) * teeth.width)
-    q0 = pair_compliance(teeth, r_x0, w_nom, compliance)
+    E_young = E_prime * (1.0 - poisson ** 2)
+    q0 = pair_compliance(teeth, r_x0, w_nom, compliance, E=E_young, nu=poisson)
     if line or compliance == "iso6336":
         c0 = jnp.zeros_like(q0)
     else:
@@ -360,7 +440,7 @@ def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, speed_ra
     te_loaded = env - sgn * y
 
     # kinematics of every pair at every position (speeds per rad/s -> mm/s)
-    omega = jnp.asarray(speed_rad_s, float)
+    omega = jnp.asarray(pinion_rpm, float) * (math.pi / 30.0)
     th_e = pairs(jnp.where(on, kin.entrainment_angle, 0.0), 0.0)
     ue_t = pairs(jnp.where(on, kin.u_e, 1.0), 1.0) * omega
     us_t = pairs(jnp.where(on, kin.u_s, 0.0), 0.0) * omega
@@ -418,17 +498,35 @@ def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, speed_ra
                           edge_loaded, degenerate, sm.n_valid, sm.te_loaded_ptp)
 
 
-def efficiency_function(design, *, side=None, compliance: str = "weber", E_prime=STEEL_E_PRIME,
-                        viscosity_model: str = "roelands", film_method: str = "auto",
-                        **tca_options):
-    """A pure, traceable ``f(pair, torque_Nm, speed_rad_s, oil, surface, mis=None) ->
+def efficiency_function(design, *, side=None, compliance: str = DEFAULT_COMPLIANCE,
+                        E_prime=None, viscosity_model: str = "roelands",
+                        film_method: str = "auto", **tca_options):
+    """A pure, traceable ``f(pair, torque_Nm, pinion_rpm, oil, surface, mis=None) ->
     (MeshEfficiency, TCAResult)`` of ``design`` for ``jax.grad``/``jit``/``vmap``.
 
-    The concrete set-up (reference guess, sense of rotation, contact mode) is done
-    once here, as for :func:`gearjax.tca_function`; ``f.pair`` is the design's pair
-    pytree (the natural point to differentiate at).  ``tca_options`` as for
-    :func:`gearjax.run_tca` (``steps_per_pitch``, ``half_pitches``, ``n_pairs``, ...).
+    Torque on the pinion in N m, **pinion speed in rpm** (as :func:`mesh_efficiency`
+    and the ``--rpm`` flag; before issue #28 ``f`` took rad/s).  The concrete set-up
+    (reference guess, sense of rotation, contact mode) is done once here, as for
+    :func:`gearjax.tca_function`; ``f.pair`` is the design's pair pytree (the natural
+    point to differentiate at).  The material (module docstring) is resolved here,
+    once, by :func:`gearjax.materials.pair_material`: ``E_prime`` (MPa) if given, else
+    the design's material, else steel; ``f.material`` is the
+    :class:`~gearjax.materials.Material` used.  ``compliance`` defaults to
+    :data:`DEFAULT_COMPLIANCE` (as :func:`mesh_efficiency` and the command).
+    ``tca_options`` as for :func:`gearjax.run_tca` (``steps_per_pitch``,
+    ``half_pitches``, ``n_pairs``, ...).
+
+    Concrete inputs are validated as by :func:`mesh_efficiency` (the design and the
+    options here; ``pair``, torque, speed, oil and surface on every call of ``f`` with
+    concrete values); traced values (under ``jit``/``grad``/``vmap``) are not.
     """
+    from gearjax.materials import pair_material
+    from gearjax.tca_result import check_design
+
+    mat = pair_material(design, E_prime)
+    Ep, nu = float(mat.e_prime_MPa), float(mat.poisson)
+    _check_models(compliance, viscosity_model, film_method)
+    check_design(design)
     ad = family_of(design)
     opts = {**ad.defaults, **tca_options}
     opts.pop("kinematics", None)
@@ -439,25 +537,47 @@ def efficiency_function(design, *, side=None, compliance: str = "weber", E_prime
     f_tca = ad.traced(run_design, **kw, **opts)
     spp, K = int(opts["steps_per_pitch"]), int(opts["n_pairs"])
 
-    def f(pair, torque_Nm, speed_rad_s, oil, surface, mis=None):
+    def f(pair, torque_Nm, pinion_rpm, oil, surface, mis=None):
+        check_efficiency_inputs(torque_Nm, pinion_rpm, oil, surface, Ep, nu, compliance,
+                                viscosity_model, film_method)
+        check_design(pair)
         res = f_tca(pair, mis)
-        eff = mesh_efficiency_traced(res, teeth_of(pair, res), torque_Nm, speed_rad_s, oil,
-                                     surface, steps_per_pitch=spp, n_pairs=K, E_prime=E_prime,
-                                     compliance=compliance, viscosity_model=viscosity_model,
-                                     film_method=film_method)
+        eff = mesh_efficiency_traced(res, teeth_of(pair, res), torque_Nm, pinion_rpm, oil,
+                                     surface, steps_per_pitch=spp, n_pairs=K, E_prime=Ep,
+                                     poisson=nu, compliance=compliance,
+                                     viscosity_model=viscosity_model, film_method=film_method)
         return eff, res
 
     f.pair = pair0
-    f.options = dict(opts, side=side, compliance=compliance)
+    f.material = mat
+    f.options = dict(opts, side=side, compliance=compliance, E_prime_MPa=Ep, poisson=nu,
+                     material_source=mat.source)
     return f
 
 
-def mesh_efficiency(design, torque_Nm, rpm, oil: Oil, surface: Surface, *, misalignment=None,
-                    side=None, compliance: str = "weber", E_prime=STEEL_E_PRIME,
-                    viscosity_model: str = "roelands", film_method: str = "auto",
+def mesh_efficiency(design, torque_Nm, pinion_rpm, oil: Oil, surface: Surface, *,
+                    misalignment=None, side=None, compliance: str = DEFAULT_COMPLIANCE,
+                    E_prime=None, viscosity_model: str = "roelands", film_method: str = "auto",
                     strict: bool = True, **tca_options):
     """Loaded contact, friction along the path and mesh efficiency of ``design`` at
-    pinion torque ``torque_Nm`` (N m) and speed ``rpm`` (validated; module docstring).
+    pinion torque ``torque_Nm`` (N m) and pinion speed ``pinion_rpm`` (rpm) (module
+    docstring).
+
+    Material: ``E_prime`` (MPa, reduced modulus ``E' = 2/((1-nu1^2)/E1 + (1-nu2^2)/E2)``)
+    overrides the design's material; by default (None) the design's own material
+    (a VH-CATT file's ``[material]``) or, for families without one, steel (E 206 000
+    MPa, nu 0.3: E' = 226 374 MPa) sets E' *and* the tooth compliance
+    (:func:`gearjax.materials.pair_material` says which applied).  ``compliance``, the
+    same default as the ``gearjax efficiency`` command (:data:`DEFAULT_COMPLIANCE`):
+    weber (the default): Weber/Cornell tooth cantilever + Sainsot fillet foundation +
+    the contact (Hertz approach of a point contact, Weber's line contact); iso6336: the
+    constant single stiffness c' of ISO 6336-1 method B, scaled by E/206000 MPa.
+
+    Every concrete input is validated before any work, as the command line and the
+    design-file loaders do (one-line ValueError naming the parameter, its value and
+    the allowed range): the design's fields (:func:`gearjax.tca_result.check_design`:
+    e.g. degrees typed into a radian field), torque, speed, E' (MPa: E' in Pa is
+    refused), the oil and surface fields, the model names.
 
     Runs :func:`gearjax.run_tca` (its compiled program is shared with every other
     TCA of the same options) and then one jitted program for the loads, friction
@@ -465,9 +585,15 @@ def mesh_efficiency(design, torque_Nm, rpm, oil: Oil, surface: Surface, *, misal
     :func:`efficiency_warnings`.  ``strict``: raise ConvergenceError when the TCA
     fails on the working flank (as :func:`gearjax.run_tca`).
     """
-    T, n = check_operating_point(torque_Nm, rpm)
-    if compliance not in COMPLIANCE_MODELS:
-        raise ValueError(f"compliance = {compliance!r} must be one of {COMPLIANCE_MODELS}")
+    from gearjax.materials import pair_material
+    from gearjax.tca_result import check_design
+
+    mat = pair_material(design, E_prime)
+    Ep, nu = float(mat.e_prime_MPa), float(mat.poisson)
+    check_efficiency_inputs(torque_Nm, pinion_rpm, oil, surface, Ep, nu, compliance,
+                            viscosity_model, film_method)
+    T, n = float(torque_Nm), float(pinion_rpm)
+    check_design(design)
     ad = family_of(design)
     opts = {**ad.defaults, **tca_options}
     opts.pop("kinematics", None)
@@ -475,8 +601,8 @@ def mesh_efficiency(design, torque_Nm, rpm, oil: Oil, surface: Surface, *, misal
     teeth_of, pair, run_design = ad.mesh(design, **kw, **opts)
     res = ad.run(run_design, misalignment, **kw, **opts, kinematics=True, strict=strict)
     oil = dataclasses.replace(oil, name="")
-    eff = _post_jit(res, pair, jnp.asarray(T, float), jnp.asarray(n * math.pi / 30.0, float), oil,
-                    surface, jnp.asarray(E_prime, float), teeth_of=teeth_of,
+    eff = _post_jit(res, pair, jnp.asarray(T, float), jnp.asarray(n, float), oil,
+                    surface, jnp.asarray(Ep, float), jnp.asarray(nu, float), teeth_of=teeth_of,
                     steps_per_pitch=int(opts["steps_per_pitch"]), n_pairs=int(opts["n_pairs"]),
                     compliance=compliance, viscosity_model=viscosity_model,
                     film_method=film_method)
@@ -485,14 +611,12 @@ def mesh_efficiency(design, torque_Nm, rpm, oil: Oil, surface: Surface, *, misal
 
 @functools.partial(jax.jit, static_argnames=("teeth_of", "steps_per_pitch", "n_pairs", "compliance",
                                              "viscosity_model", "film_method"))
-def _post_jit(res, pair, T, w, oil, surface, E_prime, *, teeth_of, steps_per_pitch, n_pairs,
-              compliance, viscosity_model, film_method):
-    return mesh_efficiency_traced(res, teeth_of(pair, res), T, w, oil, surface,
+def _post_jit(res, pair, T, n, oil, surface, E_prime, poisson, *, teeth_of, steps_per_pitch,
+              n_pairs, compliance, viscosity_model, film_method):
+    return mesh_efficiency_traced(res, teeth_of(pair, res), T, n, oil, surface,
                                   steps_per_pitch=steps_per_pitch, n_pairs=n_pairs,
-                                  E_prime=E_prime, compliance=compliance,
+                                  E_prime=E_prime, poisson=poisson, compliance=compliance,
                                   viscosity_model=viscosity_model, film_method=film_method)
-
-
 
 
 def efficiency_warnings(eff: MeshEfficiency, res: TCAResult, *, film_method: str = "auto",

@@ -65,7 +65,8 @@ from gearjax.surfaces import local_geometry
 from gearjax.tca import (ARCSEC, Assembly, ContactPath, Misalignment, MultiPair, contact_equations,
                          contact_system, gear_mount, relative_curvature)
 
-__all__ = ["SIDES", "check_side", "TCAResult", "ContactKinematics", "contact_kinematics",
+__all__ = ["SIDES", "check_side", "check_design",
+           "TCAResult", "ContactKinematics", "contact_kinematics",
            "contact_motion", "strong_float64",
            "register_family", "family_of"]
 
@@ -470,6 +471,18 @@ def register_family(design_type: type, adapter) -> None:
     and ``sensitivity(design, mis, *, side, **options) -> (values, table)``.
     """
     _FAMILIES[design_type] = adapter
+
+
+def check_design(design) -> None:
+    """Validate a concrete design before any work, as the family's design-file loader
+    and validated constructor do (one-line ``ValueError`` naming the field, its value
+    and the allowed range, in the internal units mm and rad: e.g. a pressure angle of
+    20 typed into the radian field).  The family's adapter provides
+    ``check(design)``; traced fields (under ``jit``/``grad``/``vmap``) and batched
+    fields are skipped.  A family without ``check`` is not checked here."""
+    chk = getattr(family_of(design), "check", None)
+    if chk is not None:
+        chk(design)
 
 
 def family_of(design):

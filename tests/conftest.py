@@ -92,7 +92,7 @@ SLOWEST_FIRST = (
     "test_formate_pair.py", "test_tca.py", "test_cutter_radius_optimize.py",
     "test_involute.py", "test_ehl.py", "test_kinematics.py", "test_notebooks.py",
     "test_hypoid_surface.py", "test_tca_result.py",
-    "test_vh_catt.py",
+    "test_vh_catt.py", "test_materials.py",
 )
 
 

@@ -11,7 +11,8 @@ import gearjax
 
 PKG = Path(gearjax.__file__).resolve().parent
 BACKBONE = {"frames", "newton", "surfaces", "kinematics", "tca", "edge_contact", "tca_result", "contact",
-            "tooth_compliance", "loaded_contact", "optimize", "io", "errors", "progress", "fields"}
+            "tooth_compliance", "loaded_contact", "optimize", "io", "errors", "progress", "fields",
+            "materials"}
 
 
 def _imports(path: Path):

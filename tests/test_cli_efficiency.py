@@ -147,11 +147,15 @@ def test_table_from_the_same_result(run, capsys):
     _print_table(out, args)
     lines = capsys.readouterr().out.splitlines()
     assert lines[0].startswith("# mesh efficiency involute:")
-    assert lines[1].split()[:5] == ["phi1[deg]", "n", "s[-1]", "s[+0]", "s[+1]"]
-    rows = lines[2:2 + 8]
+    # the material and compliance used, and where the material came from (an involute
+    # pair has no material: the documented steel default, said so)
+    assert lines[1].startswith("# material: E' = 226374 MPa (E = 206000 MPa, nu = 0.3; "
+                               "default steel") and lines[1].endswith("compliance weber")
+    assert lines[2].split()[:5] == ["phi1[deg]", "n", "s[-1]", "s[+0]", "s[+1]"]
+    rows = lines[3:3 + 8]
     assert all(r.split()[-1] == "ok" for r in rows)
     assert float(rows[0].split()[0]) == pytest.approx(out["phi1_deg"][0], abs=1e-4)
-    summary = "\n".join(lines[10:])
+    summary = "\n".join(lines[11:])
     for label in ("eta_bar", "mean mu", "max p_max", "P_in", "loaded TE p-t-p"):
         assert label in summary
     assert f"{100 * out['mean_efficiency']:.4f} %" in summary

@@ -157,3 +157,36 @@ def test_atomic_write_keeps_old_file_on_failure(tmp_path, monkeypatch, gear_grid
         write_csv(p, gear_grids["convex"])
     assert p.read_text() == "old content\n"
     assert sorted(os.listdir(tmp_path)) == ["keep.csv"]   # no temp file left behind
+
+
+@pytest.mark.parametrize("bad", ["converged", "nan_point", "nan_normal"])
+def test_every_format_refuses_a_grid_with_a_point_not_converged(tmp_path, design, gear_grids,
+                                                                bad):
+    """#28 item 4: one point that is not a converged solve (flag False, or a point or a
+    normal not finite) refuses the export in every format, and nothing is written
+    (an existing file keeps its content)."""
+    g = gear_grids["convex"]
+    P, N = np.array(g.points), np.array(g.normals)
+    conv = np.array(g.converged, bool)
+    if bad == "converged":
+        conv[1, 2] = False
+    elif bad == "nan_point":
+        P[1, 2, 0] = np.nan
+    else:
+        N[1, 2, 2] = np.inf
+    broken = g._replace(points=P, normals=N, converged=conv)
+    teeth = design.member_blank("gear").teeth
+    writers = {"f.csv": lambda p: write_csv(p, broken), "f.xyz": lambda p: write_xyz(p, broken),
+               "f.stl": lambda p: write_stl_flank(p, broken),
+               "t1.stl": lambda p: write_stl_tooth(p, broken, gear_grids["concave"], teeth),
+               "t2.stl": lambda p: write_stl_tooth(p, gear_grids["concave"], broken, teeth),
+               "g.xyz": lambda p: io.write_flank(p, broken)}
+    for name, write in writers.items():
+        p = tmp_path / name
+        p.write_text("old\n")
+        with pytest.raises(io.UnconvergedExportError,
+                           match=r"1 of 12 grid points are not converged solves"):
+            write(p)
+        assert p.read_text() == "old\n"
+    # the intact grid is written (the check refuses only what is wrong)
+    assert write_xyz(tmp_path / "ok.xyz", g).exists()

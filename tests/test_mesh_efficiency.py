@@ -124,6 +124,33 @@ def test_weber_mean_mesh_stiffness_against_iso6336(spur, weber_run):
     assert y[n == 2].max() < y[n == 1].min()
 
 
+def test_line_contact_material_scaling(spur, oil_surface, iso_run, weber_run):
+    """E' doubled (``E_prime=``; an involute pair has no material table, the default is
+    steel): at single-contact positions the load is statics only, the line-contact Hertz
+    pressure p_max = sqrt(w E' / (2 pi R)) grows by sqrt(2) exactly, and the ISO 6336
+    stiffness scales with E (c' E/E_st), so the fall-back halves exactly; with the
+    Weber/Sainsot teeth it nearly halves (the contact term's logarithm of the Hertz
+    half-width changes with E)."""
+    from gearjax.tribology import STEEL_E_PRIME
+    for base, comp in ((iso_run, "iso6336"), (weber_run, "weber")):
+        e1 = base[0]
+        e2, _ = mesh_efficiency(spur[1], TORQUE, RPM, *oil_surface, compliance=comp,
+                                E_prime=2.0 * STEEL_E_PRIME)
+        n1, n2 = np.asarray(e1.loaded.n_loaded), np.asarray(e2.loaded.n_loaded)
+        single = (n1 == 1) & (n2 == 1)
+        assert single.sum() >= 4
+        F1, F2 = (np.asarray(e.loaded.load).sum(axis=0)[single] for e in (e1, e2))
+        np.testing.assert_allclose(F2, F1, rtol=1e-10)
+        p1, p2 = (np.asarray(e.loaded.p_max).max(axis=0)[single] for e in (e1, e2))
+        np.testing.assert_allclose(p2 / p1, np.sqrt(2.0), rtol=1e-10)
+        y1, y2 = (np.asarray(e.loaded.deflection)[single] for e in (e1, e2))
+        if comp == "iso6336":
+            np.testing.assert_allclose(y2 / y1, 0.5, rtol=1e-9)
+        else:
+            assert np.all(np.abs(y2 / y1 - 0.5) < 0.03), y2 / y1
+        assert float(e2.te_loaded_ptp) != float(e1.te_loaded_ptp)
+
+
 def test_gradients_against_central_differences(spur, oil_surface, iso_run):
     """d eta_bar through the loads, kinematics and friction: with respect to torque,
     roughness, viscosity and two perturbations of the TCA result (on the unloaded TE,
@@ -144,7 +171,7 @@ def test_gradients_against_central_differences(spur, oil_surface, iso_run):
         path = res.path._replace(te=res.path.te + a * (res.path.phi1 - res.path.phi1[mid]))
         kin = res.kinematics._replace(r_x=res.kinematics.r_x * (1.0 + b))
         r = dataclasses.replace(res, path=path, kinematics=kin)
-        eff = mesh_efficiency_traced(r, teeth_of(des, r), T, RPM * np.pi / 30.0,
+        eff = mesh_efficiency_traced(r, teeth_of(des, r), T, RPM,
                                      dataclasses.replace(oil, eta0=eta0),
                                      dataclasses.replace(surf, sigma=sigma),
                                      steps_per_pitch=24, n_pairs=3, compliance="weber")
@@ -152,6 +179,9 @@ def test_gradients_against_central_differences(spur, oil_surface, iso_run):
 
     x0 = jnp.array([TORQUE, float(surf.sigma), float(oil.eta0), 0.0, 0.0])
     jeta = jax.jit(eta)
+    # the traced route takes the speed in rpm, as mesh_efficiency (one convention)
+    eff_w = mesh_efficiency(des, TORQUE, RPM, oil, surf, compliance="weber")[0]
+    assert float(jeta(x0)) == pytest.approx(float(eff_w.mean_efficiency), rel=1e-12)
     g = jax.jit(jax.grad(eta))(x0)
     assert np.all(np.isfinite(g))
     for i in range(5):

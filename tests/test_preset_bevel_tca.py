@@ -6,6 +6,7 @@ and the misalignment are data; the grid options are those of ``gearjax tca --pos
 import dataclasses
 import json
 import math
+import re
 
 import jax
 import jax.numpy as jnp
@@ -259,3 +260,23 @@ def test_te_gradient_wrt_kappa_and_rho1_matches_central_differences(des, surface
         assert np.all(np.abs(fd) > 0.0)
         ad = np.asarray(surface_only(des, dtheta=np.eye(2)[j])[1])
         np.testing.assert_allclose(ad, fd, rtol=1e-5)
+
+
+def test_cli_surface_refuses_points_beyond_the_flank(tmp_path, capsys):
+    """#28 item 4: addendum = dedendum = 21 mm puts grid rows beyond the flank that the
+    solves reach (before: 58 of 205 points not converged written with status 0, STL and
+    XYZ without any flag).  Every format is refused with one line, status 3, nothing
+    written."""
+    src = gj.example_path("preset_te_bevel_10x30").read_text()
+    bad = tmp_path / "deep.toml"
+    bad.write_text(src.replace("addendum_mm = 4.5", "addendum_mm = 21.0")
+                   .replace("dedendum_mm = 4.5", "dedendum_mm = 21.0"))
+    for out, extra in (("f.xyz", []), ("f.csv", []), ("f.stl", []), ("t.stl", ["--tooth"])):
+        capsys.readouterr()
+        rc = main(["surface", str(bad), "--member", "pinion", "--flank", "concave",
+                   "--grid", "41x5", "--out", str(tmp_path / out), *extra])
+        err = capsys.readouterr().err.strip().splitlines()
+        assert rc == 3 and len(err) == 1, err
+        assert re.search(r"gearjax: error: .*: \d+ of \d+ grid points are not converged "
+                         r"solves .*nothing written", err[0]), err
+        assert not (tmp_path / out).exists()

@@ -125,3 +125,19 @@ def test_involute_design_file_defaults_are_listed():
     assert "pair.helix_angle_deg = 0" in lines
     assert not any(k.startswith("pair.profile_shift") for k in lines)
     assert math.isclose(float(gj.load_design("example:khk_spur_12x24").design.face_width), 20.0)
+
+
+def test_involute_design_file_material_sets_e_prime():
+    """An involute file's optional [material] is the design's material (E' and the tooth
+    compliance, gearjax.materials); without it the documented steel default applies."""
+    from gearjax.materials import SOURCE_DEFAULT, SOURCE_DESIGN
+    f = gj.load_design("example:khk_spur_12x24")
+    assert f.material() is None and gj.pair_material(f).source == SOURCE_DEFAULT
+    data = f.to_dict()
+    data["material"] = {"youngs_modulus_GPa": 110.0, "poisson": 0.34}
+    m = gj.pair_material(gj.design_from_dict(data))
+    assert m.source == SOURCE_DESIGN and m.youngs_modulus_MPa == 110000.0
+    assert m.e_prime_MPa == pytest.approx(110000.0 / (1 - 0.34 ** 2), rel=1e-14)
+    data["material"] = {"youngs_modulus_GPa": 1.1e5, "poisson": 0.34}      # typed in MPa
+    with pytest.raises(ValueError, match=r"\[material\] youngs_modulus_GPa"):
+        gj.design_from_dict(data)

@@ -5,7 +5,11 @@ DESIGN as for ``gearjax tca`` (:mod:`gearjax.commands.designs`): an inline invol
 pair or a hypoid/spiral-bevel design file / ``example:NAME``.  The oil, surface and
 film options are those of ``gearjax friction`` (:func:`gearjax.commands.friction.
 add_lubricant_options`, same ranges).  The pinion torque (N m) and speed (rpm) are
-checked against :data:`gearjax.TORQUE_RANGE_NM` and :data:`gearjax.RPM_RANGE`.
+checked against :data:`gearjax.TORQUE_RANGE_NM` and :data:`gearjax.RPM_RANGE`.  The
+material (:mod:`gearjax.materials`): ``--E-prime-MPa`` if given, else the design's own
+``[material]`` (VH-CATT), else steel; it sets E' and the tooth compliance, and the
+output names its source (``input.material_source``).  ``--compliance`` has the default
+of :func:`gearjax.mesh_efficiency` (:data:`gearjax.DEFAULT_COMPLIANCE`).
 
 Exit status as ``gearjax tca``: 0 with a result (problems of the result -- TCA
 quality flags, positions whose load balance or friction solve did not converge, a
@@ -34,7 +38,12 @@ EFFICIENCY_KEYS_DOC = """JSON keys (K tooth pairs, M positions over one mesh cyc
   input                 the options as given (design, side, misalign, torque_Nm, rpm,
                         oil, sigma_um, asperity options, fc, film, viscosity,
                         compliance, positions, pitches, pairs) plus the oil's
-                        eta0_Pas, alpha_per_GPa, tau0_MPa and E_prime_MPa
+                        eta0_Pas, alpha_per_GPa, tau0_MPa and the material used:
+                        E_prime_MPa (reduced modulus E' = E/(1-nu^2)),
+                        youngs_modulus_MPa and poisson (E, nu of the tooth
+                        compliance), material_source ("--E-prime-MPa" when the flag
+                        is given, "design [material]" from the design file, else
+                        "default steel (...)": the design has no material)
   phi1_deg              (M,) pinion angle of each position (deg; reference in the middle)
   pairs                 (K,) tooth-pair index k of the rows below (pair k = pair 0
                         shifted by k pinion pitches)
@@ -102,12 +111,18 @@ def register(sub):
     lo, hi = gj.RPM_RANGE
     p.add_argument("--rpm", type=float, required=True,
                    help=f"pinion speed (rpm, in [{lo:g}, {hi:g}])")
-    add_lubricant_options(p)
+    add_lubricant_options(p, e_prime_help=(
+        "reduced modulus E' = 2/((1-v1^2)/E1+(1-v2^2)/E2) (MPa, in (0, 1e7]): overrides the "
+        "design's material for the Hertz contact, film and tooth compliance (E = E'(1-nu^2), "
+        "nu of the design or 0.3); default: the design's [material] table (VH-CATT), else "
+        "steel E' = 226374 (E 206000, nu 0.3); the JSON's input.material_source says which"))
     p.add_argument("--side", choices=["drive", "coast"], default="drive")
     p.add_argument("--misalign", default="",
                    help="dE=mm,dP=mm,dG=mm,dSigma=deg (any subset; default all 0)")
-    p.add_argument("--compliance", choices=list(gj.COMPLIANCE_MODELS), default="iso6336",
-                   help="tooth compliance model of the load sharing (default iso6336)")
+    p.add_argument("--compliance", choices=list(gj.COMPLIANCE_MODELS),
+                   default=gj.DEFAULT_COMPLIANCE,
+                   help=f"tooth compliance model of the load sharing, as "
+                        f"gearjax.mesh_efficiency: {gj.COMPLIANCE_HELP}")
     p.add_argument("--positions", type=float, default=None,
                    help=f"positions per mesh cycle (one pinion pitch), integer "
                         f"{POSITIONS_RANGE[0]}..{POSITIONS_RANGE[1]} (default 24 involute, "
@@ -231,6 +246,10 @@ def _print_table(out, args):
     print(f"# mesh efficiency {args.design} ({args.side}); T1 = {args.torque_Nm:g} N m, "
           f"n1 = {args.rpm:g} rpm, oil {args.oil or 'custom'}, sigma = {args.sigma_um:g} um; "
           f"misalign {out['input']['misalign'] or 'none'}")
+    inp = out["input"]
+    print(f"# material: E' = {inp['E_prime_MPa']:.0f} MPa (E = {inp['youngs_modulus_MPa']:.0f} "
+          f"MPa, nu = {inp['poisson']:g}; {inp['material_source']}); compliance "
+          f"{inp['compliance']}")
     head = " ".join(f"{f's[{k:+d}]':>7s}" for k in pairs)
     print(f"{'phi1[deg]':>10s} {'n':>2s} {head} {'pmax[MPa]':>9s} {'lam_min':>8s} {'mu':>8s} "
           f"{'P_f[W]':>10s} {'eta_m':>8s} flag")
@@ -272,16 +291,20 @@ def run(args) -> int:
         check_output_path(args.plot, "--plot", PLOT_SUFFIXES)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        oil, surf, Ep = lubricant_from_args(args)
+        oil, surf, _ = lubricant_from_args(args)   # E': the material below
     design = (involute_design(args.design)[1] if is_involute(args.design)
               else gj.load_design(args.design))
     opts_all = {**gj.family_of(design).defaults, **opts}
+    # the material: --E-prime-MPa (validated above) > the design's [material] > steel;
+    # mesh_efficiency resolves it the same way from the same E_prime argument
+    mat = gj.pair_material(design, args.E_prime_MPa, override_source="--E-prime-MPa")
+    Ep = float(mat.e_prime_MPa)
 
     with Progress(1, "efficiency") as bar, bar.phase(
             f"{args.side} side: TCA, load sharing, friction ({opts_all['steps_per_pitch']} "
             "positions)"):
         eff, res = gj.mesh_efficiency(design, T, n, oil, surf, misalignment=mis, side=args.side,
-                                      compliance=args.compliance, E_prime=Ep,
+                                      compliance=args.compliance, E_prime=args.E_prime_MPa,
                                       viscosity_model=args.viscosity, film_method=args.film,
                                       **opts)
         bar.update()
@@ -302,7 +325,9 @@ def run(args) -> int:
            "alpha_per_GPa": float(oil.alpha) * 1e3, "tau0_MPa": float(oil.tau0),
            "sigma_um": args.sigma_um, "asperity_density_per_mm2": args.asperity_density_per_mm2,
            "asperity_radius_um": args.asperity_radius_um, "fc": args.fc,
-           "E_prime_MPa": float(Ep), "film": args.film, "viscosity": args.viscosity,
+           "E_prime_MPa": Ep, "youngs_modulus_MPa": float(mat.youngs_modulus_MPa),
+           "poisson": float(mat.poisson), "material_source": mat.source, "film": args.film,
+           "viscosity": args.viscosity,
            "compliance": args.compliance, "positions": int(opts_all["steps_per_pitch"]),
            "pitches": float(opts_all["half_pitches"]), "pairs": int(opts_all["n_pairs"])}
     out = _output(eff, res, inp, warn_lines, args.plot)

@@ -79,11 +79,17 @@ def _add_common(p):
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
 
 
-def add_lubricant_options(p):
+#: help of --E-prime-MPa in the friction and stribeck commands
+E_PRIME_HELP = ("reduced modulus E' = 2/((1-v1^2)/E1+(1-v2^2)/E2) (MPa, in (0, 1e7]; "
+                "default steel 226374)")
+
+
+def add_lubricant_options(p, e_prime_help: str = E_PRIME_HELP):
     """The oil (--oil NAME, or --eta0 with --alpha-per-GPa/--tau0-MPa), surface
     (--sigma-um, asperity options, --fc), --E-prime-MPa, --film and --viscosity
     options shared by the friction, stribeck and efficiency commands
-    (read back by :func:`lubricant_from_args`)."""
+    (read back by :func:`lubricant_from_args`); ``e_prime_help`` the help of
+    --E-prime-MPa (its default differs between commands)."""
     g = p.add_mutually_exclusive_group(required=True)
     g.add_argument("--oil", help="example oil: mineral_vg100 | mineral_vg220 | pao_vg100 "
                                  "(gearjax.OILS)")
@@ -100,9 +106,7 @@ def add_lubricant_options(p):
                    help="asperity tip radius (um, in (0, 1000], default 10)")
     p.add_argument("--fc", type=float, default=0.1,
                    help="boundary friction coefficient (in [0, 1], default 0.1)")
-    p.add_argument("--E-prime-MPa", type=float, default=None,
-                   help="reduced modulus E' = 2/((1-v1^2)/E1+(1-v2^2)/E2) (MPa, in (0, 1e7]; "
-                        "default steel 226374)")
+    p.add_argument("--E-prime-MPa", type=float, default=None, help=e_prime_help)
     p.add_argument("--film", choices=["auto", "point", "line"], default="auto",
                    help="film formula (default auto: Hamrock-Dowson blended into line contact)")
     p.add_argument("--viscosity", choices=["roelands", "barus"], default="roelands")

@@ -1,6 +1,13 @@
-"""``gearjax surface DESIGN``: a flank grid of a hypoid / spiral-bevel member, written
-to CSV, XYZ (points and normals) or STL (the algorithm of [HFT-hypoid], docs/references.md; see
-:mod:`gearjax.gears.hypoid.flank`)."""
+"""``gearjax surface DESIGN``: a flank grid of a member of any family with a surface
+export (hypoid / spiral bevel, preset-TE bevel, VH-CATT), written to CSV, XYZ (points and
+normals) or STL (the hypoid grid by the algorithm of [HFT-hypoid], docs/references.md;
+see :mod:`gearjax.gears.hypoid.flank`).
+
+Every exported point is a converged solve: a grid with any point whose solve did not
+converge (or whose point or normal is not finite) is refused in every format, CSV, XYZ
+and STL, with one ``gearjax: error:`` line naming the flank, the number of such points
+and the largest residual, status 3, and nothing is written
+(:func:`gearjax.io.check_grid_converged`; an existing file is left unchanged)."""
 
 from __future__ import annotations
 
@@ -52,6 +59,7 @@ def run(args) -> int:
     if args.plot is not None and not hypoid:
         raise ValueError(f"--plot: the axial-plane figure is drawn for hypoid and spiral-bevel "
                          f"designs only, not for [design] kind = {design.data['design']['kind']!r}")
+    from gearjax.io import check_grid_converged
     flanks = ["convex", "concave"] if args.tooth else [args.flank]
     grids = {}
     with Progress(len(flanks), f"surface {args.member}") as bar:
@@ -60,6 +68,8 @@ def run(args) -> int:
                 grids[f] = (flank_surface(design.flank(args.member, f), n_xi, n_s) if hypoid
                             else design.surface_grid(args.member, f, n_xi, n_s))
             bar.update()
+    for f, g in grids.items():      # before any file is written (plot included)
+        check_grid_converged(g, f"{design.name} {args.member} {f} flank")
     if args.tooth:
         teeth = (design.member_blank(args.member).teeth if hypoid
                  else int(design.teeth(args.member)))

@@ -111,6 +111,39 @@ def _f(v):
     return float64_array(float(v))
 
 
+def check_pair_fields(pair: HypoidPair) -> None:
+    """Range check of a concrete pair's fields in the internal units (mm, rad), the
+    ranges of :func:`gearjax.gears.hypoid.cutter.make_cutter` and
+    :meth:`~gearjax.gears.hypoid.machine.MachineSettings.create` (one-line ValueError
+    naming the field, its value and the range: a blade angle of 20 -- degrees typed
+    into the radian field -- is refused), plus the mounting: shaft angle in (0, pi)
+    rad, offset >= 0 mm.  Traced or batched fields skip it (the design file is
+    validated by its loader)."""
+    from gearjax.errors import check_range, is_traced
+    if any(is_traced(v) or np.ndim(v) for v in jax.tree_util.tree_leaves(pair)):
+        return
+    for member in ("pinion", "gear"):
+        c, m = getattr(pair, member).cutter, getattr(pair, member).machine
+        check_range(f"{member}.cutter.point_radius", c.point_radius, 0.0, 1e4, lo_open=True,
+                    unit="mm")
+        check_range(f"{member}.cutter.blade_angle", c.blade_angle, 0.0, math.pi / 4,
+                    lo_open=True, hi_open=True, unit="rad")
+        check_range(f"{member}.cutter.edge_radius", c.edge_radius, 0.0, None, unit="mm")
+        check_range(f"{member}.machine.radial_distance", m.radial_distance, 0.0, None,
+                    lo_open=True, unit="mm")
+        check_range(f"{member}.machine.tilt", m.tilt, 0.0, math.pi / 2, hi_open=True,
+                    unit="rad")
+        for name in ("cradle_angle", "swivel", "machine_root_angle"):
+            check_range(f"{member}.machine.{name}", getattr(m, name), -2.0 * math.pi,
+                        2.0 * math.pi, unit="rad")
+        if m.generated:
+            check_range(f"{member}.machine.ratio_of_roll", m.ratio_of_roll, 0.0, None,
+                        lo_open=True)
+    check_range("shaft_angle", pair.shaft_angle, 0.0, math.pi, lo_open=True, hi_open=True,
+                unit="rad")
+    check_range("offset", pair.offset, 0.0, None, unit="mm")
+
+
 def pair_flanks(design, side: str = "drive", *, hand: int = 1) -> HypoidPair:
     """The :class:`HypoidPair` of ``side`` ("drive"/"coast") of a loaded design
     (:class:`gearjax.gears.hypoid.design_file.HypoidDesign`).  Mounting data from the design's blank: shaft

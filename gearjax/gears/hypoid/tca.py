@@ -457,6 +457,16 @@ class _Adapter:
         side = side or "drive"                  # a design file: side picks the flanks
         return prepare(pair_flanks(design, side)), side
 
+    def check(self, design):
+        """A hand-built :class:`HypoidPair` (or a prepared one) in the ranges of the
+        cutter and machine constructors, in mm and rad
+        (:func:`~gearjax.gears.hypoid.pair.check_pair_fields`;
+        :func:`gearjax.tca_result.check_design`); a design file is validated by its
+        loader."""
+        from gearjax.gears.hypoid.pair import check_pair_fields
+        if isinstance(design, (Prepared, HypoidPair)):
+            check_pair_fields(design.pair if isinstance(design, Prepared) else design)
+
     def run(self, design, mis=None, *, side=None, steps_per_pitch=16, half_pitches=2.0,
             n_pairs=5, line_contact=False, approach=DEFAULT_APPROACH, kinematics=True,
             strict=True):

@@ -16,6 +16,9 @@ units: mm and degrees.  Tables and keys:
   Basic rack: addendum 1.0 m_n, dedendum 1.25 m_n (tip circles r + m_n (1 + x); no tip
   shortening), zero-backlash operating centre distance a_w from
   ``inv α_wt = 2 tan α_n (x1 + x2)/(z1 + z2) + inv α_t`` (ISO 21771).
+* ``[material]`` (optional table; both keys required when it is given):
+  ``youngs_modulus_GPa`` (50..500), ``poisson`` (0..0.5) of both members -- E′ and the
+  tooth compliance of the loaded contact (:mod:`gearjax.materials`); without it steel.
 * ``[modification]`` (optional table, every key optional, default 0): the pinion rack's
   ``pressure_angle_change_deg`` (-5..5), ``profile_crown_per_mm`` and
   ``lead_crown_per_mm`` (0..0.1) of :class:`gearjax.gears.involute.tca.InvoluteTCA`.
@@ -71,6 +74,15 @@ class InvoluteFile(DesignFileMixin):
         out += [f"modification.{k} = 0" for k in MODIFICATION_KEYS if k not in mod]
         return out
 
+    def material(self):
+        """The file's ``[material]`` (:class:`gearjax.materials.Material`), or None (the
+        documented steel default applies)."""
+        from gearjax.materials import SOURCE_DESIGN, Material
+        m = self.data.get("material")
+        if m is None:
+            return None
+        return Material(float(m["youngs_modulus_GPa"]) * 1e3, float(m["poisson"]), SOURCE_DESIGN)
+
     def teeth(self, member: str) -> int:
         if member not in ("pinion", "gear"):
             raise ValueError(f"member = {member!r} must be 'pinion' or 'gear'")
@@ -84,7 +96,7 @@ class InvoluteFile(DesignFileMixin):
 def read_involute(data: dict) -> InvoluteFile:
     """Validate a parsed ``involute`` design file (module docstring) and build the pair."""
     data = copy.deepcopy(data)
-    check_keys("", data, {"design", "pair", "modification"})
+    check_keys("", data, {"design", "pair", "modification", "material"})
     des = data["design"]
     check_keys("design", des, {"kind", "name", "description", "source"})
     check_string("design", "kind", require_key("design", des, "kind"), (KIND,))
@@ -109,6 +121,18 @@ def read_involute(data: dict) -> InvoluteFile:
     check_keys("modification", mod, set(MODIFICATION_KEYS))
     m = {k: check_number("modification", k, mod[k], u) if k in mod else 0.0
          for k, u in MODIFICATION_KEYS.items()}
+    if "material" in data:
+        mat = data["material"]
+        if not isinstance(mat, dict):
+            raise ValueError("[material] must be a table")
+        check_keys("material", mat, {"youngs_modulus_GPa", "poisson"})
+        for k, (lo, hi, unit) in (("youngs_modulus_GPa", (50.0, 500.0, "GPa")),
+                                  ("poisson", (0.0, 0.5, ""))):
+            val = check_number("material", k, require_key("material", mat, k), unit)
+            try:
+                check_range(k, val, lo, hi, unit=unit)
+            except ValueError as exc:
+                raise ValueError(f"[material] {exc}") from None
     try:
         pair = InvolutePair.create(v["z1"], v["z2"], v["normal_module_mm"],
                                    v["normal_pressure_angle_deg"], v["helix_angle_deg"],
@@ -145,6 +169,9 @@ class _FileAdapter:
 
     def mesh(self, f, **kw):
         return ADAPTER.mesh(self._design(f), **kw)
+
+    def check(self, f):
+        return ADAPTER.check(self._design(f))
 
     def sensitivity(self, f, *a, **kw):
         return ADAPTER.sensitivity(self._design(f), *a, **kw)

@@ -181,7 +181,7 @@ def _check_tooth_form(pair: InvolutePair) -> None:
                          "(no path of contact); reduce the profile shifts")
 
 
-def _check_pair_fields(pair: InvolutePair) -> None:
+def check_pair_fields(pair: InvolutePair) -> None:
     """Range check of a pair's fields (internal units mm, rad); traced fields skip it."""
     vals = (pair.module, pair.pressure_angle, pair.helix, pair.x1, pair.x2)
     if any(is_traced(v) for v in vals) or any(np.ndim(v) for v in vals):
@@ -221,7 +221,7 @@ def pair_geometry(pair: InvolutePair) -> dict:
     :meth:`InvolutePair.create`, in mm and rad), so a pair built directly with
     out-of-range numbers gets a ``ValueError`` instead of NaN geometry.
     """
-    _check_pair_fields(pair)
+    check_pair_fields(pair)
     m_t, alpha_t, r1, rb1 = _gear_basics(pair.module, pair.pressure_angle, pair.helix, pair.z1)
     _, _, r2, rb2 = _gear_basics(pair.module, pair.pressure_angle, pair.helix, pair.z2)
     target = _inv(alpha_t) + 2 * jnp.tan(pair.pressure_angle) * (pair.x1 + pair.x2) / (pair.z1 + pair.z2)

@@ -40,6 +40,7 @@ Units: mm, rad.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 from functools import partial
 from typing import NamedTuple
@@ -622,6 +623,20 @@ class _Adapter:
                            half_pitches=float(half_pitches), line_contact=lc,
                            n_pairs=int(n_pairs), kinematics=bool(kinematics))
         return f
+
+    def check(self, des):
+        """The concrete design's fields in the ranges of :meth:`InvolutePair.create` and
+        :meth:`InvoluteTCA.create`, in mm and rad (:func:`gearjax.tca_result.
+        check_design`); traced or batched fields skip it."""
+        from gearjax.gears.involute.geometry import check_pair_fields
+        check_pair_fields(des.pair)
+        vals = (des.face_width, des.dalpha, des.profile_crown, des.lead_crown)
+        if any(is_traced(v) or np.ndim(v) for v in vals):
+            return
+        check_range("face_width", des.face_width, 0.0, 1000.0, lo_open=True, unit="mm")
+        check_range("dalpha", des.dalpha, -math.radians(5.0), math.radians(5.0), unit="rad")
+        check_range("profile_crown", des.profile_crown, 0.0, 0.1, unit="1/mm")
+        check_range("lead_crown", des.lead_crown, 0.0, 0.1, unit="1/mm")
 
     def mesh(self, des, *, side="drive", line_contact=None, **_):
         """``(teeth_of, pair, design)`` of the loaded-contact models (concrete set-up):

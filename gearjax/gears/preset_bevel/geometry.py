@@ -62,12 +62,14 @@ Units: mm, rad.  Reference: [Preset-TE-bevel] (docs/references.md).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 
+from gearjax.errors import check_int, check_range, is_traced
 from gearjax.fields import float64_array
 
 __all__ = ["PresetBevelDesign", "pitch_angles", "spiral_rate", "cone_distances",
@@ -304,3 +306,32 @@ def gear_flank(des: PresetBevelDesign, pinion_flank_name="concave", phase=None):
     ph = 0.0 if phase is None else phase
     return jax.tree_util.Partial(gear_flank_point,
                                  curve_data(des, "gear", pinion_flank_name, ph, modified=False))
+
+
+def check_design_fields(des: PresetBevelDesign) -> None:
+    """Range check of a concrete design's fields in the internal units (mm, rad), the
+    ranges of the design file (``validate_fields`` of the design-file module): one-line
+    ValueError naming the field, its value and the range (e.g. a spiral angle of 35
+    -- degrees typed into the radian field -- is refused).  Traced or batched fields
+    skip it."""
+    names = ("beta", "alpha_n", "shaft_angle", "module_t", "face_width", "R0", "kappa",
+             "rho1", "rho2", "addendum", "dedendum")
+    vals = [getattr(des, n) for n in names]
+    if any(is_traced(v) or np.ndim(v) for v in vals):
+        return
+    check_int("z1", des.z1, 3, 200)
+    check_int("z2", des.z2, des.z1, 400)
+    check_range("beta", des.beta, math.radians(5.0), math.radians(60.0), unit="rad")
+    check_range("alpha_n", des.alpha_n, math.radians(5.0), math.radians(35.0), unit="rad")
+    S = check_range("shaft_angle", des.shaft_angle, math.radians(30.0), math.radians(150.0),
+                    unit="rad")
+    mt = check_range("module_t", des.module_t, 0.1, 100.0, unit="mm")
+    d1 = math.atan2(math.sin(S), des.z2 / des.z1 + math.cos(S))
+    Ao = mt * des.z1 / (2.0 * math.sin(d1))
+    check_range("face_width", des.face_width, 0.0, 0.5 * Ao, lo_open=True, unit="mm")
+    check_range("R0", des.R0, 0.0, None, lo_open=True, unit="mm")
+    check_range("kappa", des.kappa, 0.0, 1.0, unit="rad")
+    for n in ("rho1", "rho2"):
+        check_range(n, getattr(des, n), 0.5, 5000.0, unit="mm")
+    for n in ("addendum", "dedendum"):
+        check_range(n, getattr(des, n), 0.05 * mt, 3.0 * mt, unit="mm")

@@ -199,6 +199,14 @@ class _Adapter:
         # a design-file object carries the pytree as ``.design``
         return getattr(design, "design", design)
 
+    def check(self, design):
+        """The concrete design's fields in the ranges of the design file
+        (:func:`~gearjax.gears.preset_bevel.design_file.validate_fields`), in mm and rad:
+        one-line ValueError naming the field (:func:`gearjax.tca_result.check_design`);
+        traced or batched fields skip it."""
+        from gearjax.gears.preset_bevel.geometry import check_design_fields
+        check_design_fields(self._design(design))
+
     def run(self, design, mis=None, *, side=None, steps_per_pitch=24, half_pitches=1.0,
             n_pairs=3, approach=DEFAULT_APPROACH, kinematics=True, strict=True, **_):
         return preset_tca(self._design(design), mis, side=side or "drive",

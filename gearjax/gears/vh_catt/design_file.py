@@ -12,10 +12,12 @@ File units: mm, degrees, GPa.  Tables and keys (all required unless marked):
     radius R_T of the head that cuts the pinion / the gear;
   - ``blade_offset_mm`` (0..5 m): the mismatch e (blades moved apart by e each side,
     trace radii R_T -+ (w/2 + e); 0 = the plain dual-blade head).
-* ``[material]`` ``youngs_modulus_GPa`` (50..500), ``poisson`` (0..0.5): both members
-  (E' = E/(1 - nu^2), the plane-strain modulus of two equal bodies, for the loaded
-  contact: :meth:`VHCattDesign.e_prime_MPa`; the ``gearjax efficiency`` command takes
-  its ``--E-prime`` option, default steel on steel).
+* ``[material]`` ``youngs_modulus_GPa`` (50..500), ``poisson`` (0..0.5): both members.
+  It sets the loaded contact's reduced modulus E' = E/(1 - nu^2) (Hertz, film,
+  asperities) and the tooth compliance (E, nu) of :func:`gearjax.mesh_efficiency`,
+  :func:`gearjax.efficiency_function` and ``gearjax efficiency``
+  (:meth:`VHCattDesign.material`, :mod:`gearjax.materials`); an explicit E'
+  (``E_prime=`` / ``--E-prime-MPa``) overrides it, with the file's nu.
 
 Every number must be a finite TOML number (tooth numbers TOML integers); unknown
 keys and missing keys raise ``ValueError`` naming the table and the key.  No
@@ -73,9 +75,19 @@ class VHCattDesign:
         """No defaults: every key of the schema is required."""
         return []
 
-    def e_prime_MPa(self) -> float:
+    def material(self):
+        """The ``[material]`` table as a :class:`gearjax.materials.Material` (E in MPa,
+        ν; both members): it sets E′ = E/(1 − ν²) and the tooth compliance of
+        :func:`gearjax.mesh_efficiency` and ``gearjax efficiency`` unless E′ is given
+        explicitly (:func:`gearjax.materials.pair_material`)."""
+        from gearjax.materials import SOURCE_DESIGN, Material
         m = self.data["material"]
-        return float(m["youngs_modulus_GPa"]) * 1e3 / (1.0 - float(m["poisson"]) ** 2)
+        return Material(float(m["youngs_modulus_GPa"]) * 1e3, float(m["poisson"]),
+                        SOURCE_DESIGN)
+
+    def e_prime_MPa(self) -> float:
+        """E′ = E/(1 − ν²) of the ``[material]`` table (MPa)."""
+        return float(self.material().e_prime_MPa)
 
     def teeth(self, member: str) -> int:
         return self.pair.teeth(member)

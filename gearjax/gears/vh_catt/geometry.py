@@ -485,6 +485,27 @@ def _form_arrays(pair: VHCattPair) -> dict:
     return out
 
 
+def check_pair_fields(pair: VHCattPair) -> None:
+    """Range check of a concrete pair's fields in the internal units (mm, rad) with the
+    ranges of :meth:`VHCattPair.create` and the design file (one-line ValueError naming
+    the field, its value and the range: a pressure angle of 20 -- degrees typed into
+    the radian field -- is refused).  Traced or batched fields skip it."""
+    vals = (pair.module, pair.pressure_angle, pair.cutter_radius1, pair.cutter_radius2,
+            pair.blade_offset, pair.face_width)
+    if any(is_traced(v) or np.ndim(v) for v in vals):
+        return
+    check_int("z1", pair.z1, lo=8, hi=MAX_TEETH)
+    check_int("z2", pair.z2, lo=8, hi=MAX_TEETH)
+    m = check_range("module", pair.module, *MODULE_RANGE_MM, unit="mm")
+    check_range("pressure_angle", pair.pressure_angle, math.radians(10.0), math.radians(30.0),
+                unit="rad")
+    rt = [check_range(name, getattr(pair, name), *CUTTER_RADIUS_RANGE_MM, unit="mm")
+          for name in ("cutter_radius1", "cutter_radius2")]
+    check_range("blade_offset", pair.blade_offset, 0.0, 5.0 * m, unit="mm")
+    check_range("face_width", pair.face_width, 0.0, min(20.0 * m, min(rt)), lo_open=True,
+                unit="mm")
+
+
 def tooth_form(pair: VHCattPair) -> dict:
     """Undercut and pointing checks of both members (concrete; numbers in mm).
 

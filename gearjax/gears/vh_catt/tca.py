@@ -264,6 +264,12 @@ class _Adapter:
         f.pair = pair_of(des)
         return f
 
+    def check(self, des):
+        """The concrete pair's fields in range (:func:`~gearjax.gears.vh_catt.geometry.
+        check_pair_fields`; :func:`gearjax.tca_result.check_design`)."""
+        from gearjax.gears.vh_catt.geometry import check_pair_fields
+        check_pair_fields(pair_of(des))
+
     def outline(self, des, side="drive"):
         """Pinion flank limits for the TCA figure (concrete floats, mm): face_half,
         root_radius (form circle of the straight blade), tip_radius."""
