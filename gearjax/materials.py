@@ -19,9 +19,11 @@ Where the material comes from (:func:`pair_material`), first match wins:
 1. an explicit E′ (``E_prime=`` in Python, ``--E-prime-MPa`` on the command line):
    E′ as given, ν of the design's material (0.3 when it has none), E = E′ (1 − ν²);
 2. the design's own material (a design object with a ``material()`` method returning
-   a :class:`Material`, e.g. a VH-CATT design file);
-3. the documented default, steel on steel (:data:`STEEL`), for families whose design
-   files carry no material (involute, hypoid / spiral bevel, preset-TE bevel).
+   a :class:`Material`: a VH-CATT design file, an involute design file with its
+   optional ``[material]``);
+3. the documented default, steel on steel (:data:`STEEL`), for designs that carry no
+   material (inline involute pairs and involute files without ``[material]``,
+   hypoid / spiral bevel, preset-TE bevel).
 
 :class:`Material` carries the source, which the ``gearjax efficiency`` output reports
 (``input.material_source``).  Units: MPa.  References (docs/references.md):
