@@ -601,18 +601,24 @@ def mesh_efficiency(design, torque_Nm, pinion_rpm, oil: Oil, surface: Surface, *
     teeth_of, pair, run_design = ad.mesh(design, **kw, **opts)
     res = ad.run(run_design, misalignment, **kw, **opts, kinematics=True, strict=strict)
     oil = dataclasses.replace(oil, name="")
-    eff = _post_jit(res, pair, jnp.asarray(T, float), jnp.asarray(n, float), oil,
+    # a family whose pair has static fields that only enter arithmetic (the tooth
+    # numbers of an involute pair) passes them traced: one program for every pair
+    split = getattr(ad, "split_pair", None)
+    blank, extra, join = ((*split(pair), ad.join_pair) if split is not None
+                          else (pair, None, None))
+    eff = _post_jit(res, blank, extra, jnp.asarray(T, float), jnp.asarray(n, float), oil,
                     surface, jnp.asarray(Ep, float), jnp.asarray(nu, float), teeth_of=teeth_of,
-                    steps_per_pitch=int(opts["steps_per_pitch"]), n_pairs=int(opts["n_pairs"]),
-                    compliance=compliance, viscosity_model=viscosity_model,
-                    film_method=film_method)
+                    join=join, steps_per_pitch=int(opts["steps_per_pitch"]),
+                    n_pairs=int(opts["n_pairs"]), compliance=compliance,
+                    viscosity_model=viscosity_model, film_method=film_method)
     return eff, res
 
 
-@functools.partial(jax.jit, static_argnames=("teeth_of", "steps_per_pitch", "n_pairs", "compliance",
-                                             "viscosity_model", "film_method"))
-def _post_jit(res, pair, T, n, oil, surface, E_prime, poisson, *, teeth_of, steps_per_pitch,
-              n_pairs, compliance, viscosity_model, film_method):
+@functools.partial(jax.jit, static_argnames=("teeth_of", "join", "steps_per_pitch", "n_pairs",
+                                             "compliance", "viscosity_model", "film_method"))
+def _post_jit(res, pair, extra, T, n, oil, surface, E_prime, poisson, *, teeth_of, join,
+              steps_per_pitch, n_pairs, compliance, viscosity_model, film_method):
+    pair = pair if join is None else join(pair, extra)
     return mesh_efficiency_traced(res, teeth_of(pair, res), T, n, oil, surface,
                                   steps_per_pitch=steps_per_pitch, n_pairs=n_pairs,
                                   E_prime=E_prime, poisson=poisson, compliance=compliance,

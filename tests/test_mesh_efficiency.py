@@ -52,6 +52,34 @@ def weber_run(spur, oil_surface):
     return mesh_efficiency(spur[1], TORQUE, RPM, *oil_surface, compliance="weber")
 
 
+def test_one_loaded_program_for_every_tooth_pair(spur, oil_surface, weber_run):
+    """The loaded chain's jitted program takes the tooth numbers traced: a second pair
+    (another tooth count, shift, module) with the same options reuses the program the
+    20/40 run compiled, and its result is that pair's (eta_bar differs, all positions of
+    a conjugate pair valid).  Planted bug caught: tooth numbers static again (one
+    program per pair: the suite and every sweep pay a compilation per design)."""
+    from gearjax.mesh_efficiency import _post_jit
+    n0 = _post_jit._cache_size()
+    other = gj.InvoluteTCA.create(gj.InvolutePair.create(12, 24, 3.0, 20.0, 0.0, 0.6, 0.36), 20.0)
+    eff, _ = mesh_efficiency(other, TORQUE, RPM, *oil_surface, compliance="weber")
+    assert _post_jit._cache_size() == n0
+    assert int(eff.n_valid) == eff.valid.shape[0]
+    assert float(eff.mean_efficiency) != pytest.approx(float(weber_run[0].mean_efficiency),
+                                                      rel=1e-6)
+    # the same pair through its own fresh program (the static route) gives the same result
+    # the same pair through a program of its own with the tooth numbers as Python ints
+    # (the static route the traced one replaced)
+    ad = gj.family_of(other)
+    opts = dict(ad.defaults)
+    teeth_of, pair, run_des = ad.mesh(other, **opts)
+    res = ad.run(run_des, None, **opts, kinematics=True)
+    ref = jax.jit(lambda r: mesh_efficiency_traced(
+        r, teeth_of(pair, r), TORQUE, RPM, *oil_surface, steps_per_pitch=opts["steps_per_pitch"],
+        n_pairs=opts["n_pairs"], compliance="weber"))(res)
+    np.testing.assert_allclose(np.asarray(eff.power_loss), np.asarray(ref.power_loss),
+                               rtol=1e-9)
+
+
 def test_textbook_load_sharing_and_balance(spur, iso_run):
     eff, res = iso_run
     geo = pair_geometry(spur[0])

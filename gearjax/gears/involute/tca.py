@@ -578,6 +578,10 @@ class _Adapter:
 
     family = "involute"
     defaults = dict(steps_per_pitch=24, half_pitches=1.25, n_pairs=3)
+    # the loaded chain's jitted program takes the pair without its (static) tooth
+    # numbers and the numbers as a traced array: one program for every pair
+    split_pair = staticmethod(split_teeth)
+    join_pair = staticmethod(join_teeth)
 
     @staticmethod
     def _options(des, line_contact):
