@@ -101,27 +101,23 @@ __all__ = ["EDGE_NAMES", "FACE_END_KINDS", "TIP_KINDS", "CORNER_KINDS", "EDGE_LE
 
 #: names of the edges, in the order of :attr:`EdgeContact.kind`: the four face ends,
 #: the tip edges of pinion and gear, then the corners (appended: the indices before
-#: keep their meaning): a member's tip edge ending at its own toe/heel ("pinion
-#: tip/toe corner"), and a member's tip edge crossing the mating member's face end
-#: ("pinion tip x gear toe": the point of the tip edge that meets the mating flank on
-#: the mating face end, where the own corner lies just beyond the mating face)
+#: keep their meaning): the toe/heel end of a member's tip edge where it touches the
+#: mating flank -- the member's own corner, or, where that lies beyond the mating
+#: member's face, the point where the tip edge crosses the mating face end
 EDGE_NAMES = ("pinion toe", "pinion heel", "gear toe", "gear heel", "pinion tip", "gear tip",
               "pinion tip/toe corner", "pinion tip/heel corner",
-              "gear tip/toe corner", "gear tip/heel corner",
-              "pinion tip x gear toe", "pinion tip x gear heel",
-              "gear tip x pinion toe", "gear tip x pinion heel")
+              "gear tip/toe corner", "gear tip/heel corner")
 #: indices into :data:`EDGE_NAMES` of the face ends (toe/heel), of the tip edges and of
 #: the corners (tip edge x face end; a corner contact is a tip contact)
 FACE_END_KINDS = (0, 1, 2, 3)
 TIP_KINDS = (4, 5)
-CORNER_KINDS = tuple(range(6, 14))
+CORNER_KINDS = (6, 7, 8, 9)
 #: per candidate: the edge (or tip) belongs to the pinion; its face end e (-1 toe,
-#: +1 heel, 0 none); a tip edge; a corner; the corner's face end on the tip's own member
-_PINION = np.array([1.0, 1.0, 0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0])
-_END = np.array([-1.0, 1.0, -1.0, 1.0, 0.0, 0.0] + [-1.0, 1.0] * 4)
-_TIP = np.array([0.0] * 4 + [1.0] * 10)
-_CORNER = np.array([0.0] * 6 + [1.0] * 8)
-_OWN = np.array([0.0] * 6 + [1.0] * 4 + [0.0] * 4)
+#: +1 heel, 0 none); a tip edge; a corner
+_PINION = np.array([1.0, 1.0, 0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0, 0.0])
+_END = np.array([-1.0, 1.0, -1.0, 1.0, 0.0, 0.0, -1.0, 1.0, -1.0, 1.0])
+_TIP = np.array([0.0] * 4 + [1.0] * 6)
+_CORNER = np.array([0.0] * 6 + [1.0] * 4)
 
 #: rad: an edge contact replaces the surface contact only when it is this far ahead
 EDGE_LEAD = 1e-9
@@ -151,14 +147,15 @@ def edge_contact_system(r1: Callable, r2: Callable, asm, mis, g1: Callable, g2: 
                         line_contact: bool = False, v1_fixed=0.0):
     """The edge-contact system ``F(z, theta)`` of the module docstring.
 
-    ``theta = (phi1, s, g0, pinion, e, tip, g0b, corner, own)``: pinion angle, homotopy
+    ``theta = (phi1, s, g0, pinion, e, tip, g0b, corner)``: pinion angle, homotopy
     level, the edge function at the start point, 1.0 for an edge of the pinion (0.0: of
     the gear), face end ``e`` and 1.0 for the tip edge (then ``t_k(q)`` replaces
     ``g_k(q, e)``; ``t1``, ``t2`` default to the face ends); for a corner (``corner``
-    1.0, with ``tip``) the tangency is replaced by the face-end equation
-    ``g_m(q_m, e) - s g0b = 0`` of the tip's own member (``own`` 1.0, m = k) or of the
-    mating member (m = j, the tip edge crossing the mating face end), ``g0b`` its value
-    at the start point.  With ``line_contact`` the tip-edge candidates (not the
+    1.0, with ``tip``) the tangency is replaced by the end equation
+    ``G_e - s g0b = 0``, ``G_e = e max(e g_1(q_1, e), e g_2(q_2, e))`` (zero where the
+    common point reaches the first of the two face ends ``e`` -- the tip's own corner,
+    or the mating face end where the tip edge crosses it first), ``g0b`` its value at
+    the start point.  With ``line_contact`` the tip-edge candidates (not the
     corners) take the line-contact treatment: the edge tangency is replaced by
     ``v1 = v1_fixed`` (one face-width section, that of the surface path).  The unknown
     ``z`` is packed as in :func:`gearjax.tca.contact_system` (point contact).  Returns
@@ -181,7 +178,7 @@ def edge_contact_system(r1: Callable, r2: Callable, asm, mis, g1: Callable, g2: 
         return jnp.dot(n_other, t) / jnp.where(nt > 0.0, nt, 1.0)
 
     def F(z, theta):
-        ph1, s, g0, pinion, e, tip, g0b, corner, own = theta
+        ph1, s, g0, pinion, e, tip, g0b, corner = theta
         x, psi1, psi2 = cs.split(z)
         uv1, uv2, ph2 = cs.unpack(x)
         q1, m1, f1 = flank_at(r1, uv1, psi1)
@@ -200,14 +197,21 @@ def edge_contact_system(r1: Callable, r2: Callable, asm, mis, g1: Callable, g2: 
             # a tip edge parallel to the mating generatrix (spur) touches along a
             # line: fix the face-width section instead of the (degenerate) tangency
             tang = jnp.where((tip > 0.5) & ~is_corner, uv1[1] - v1_fixed, tang)
-        # a corner: the tip edge meets a face end (of its own member or the mating one)
-        end_on_pinion = is1 == (own > 0.5)
-        g_end = jnp.where(end_on_pinion, g1(q1, e), g2(q2, e))
-        tang = jnp.where(is_corner, g_end - s * g0b, tang)
+        # a corner: the tip edge meets the first face end e (own or mating member)
+        tang = jnp.where(is_corner, corner_end(g1, g2, q1, q2, e) - s * g0b, tang)
         mesh = [jnp.reshape(f, (1,)) for f in (f1, f2) if f is not None]
         return jnp.concatenate([p1 - p2, jnp.stack([on_edge, tang])] + mesh)
 
     return F, cs
+
+
+def corner_end(g1: Callable, g2: Callable, q1, q2, e):
+    """``G_e = e max(e g_1(q_1, e), e g_2(q_2, e))`` (mm): the face-end function of a
+    corner at end ``e`` (module docstring, "Corners"); zero where the common point
+    (body points ``q1``, ``q2``) lies on the face end ``e`` of one member and inside
+    the other's, negative beyond one of them on that end (``g_k`` grows into the face
+    from ``e = -1``, out of it at ``e = +1``)."""
+    return e * jnp.maximum(e * g1(q1, e), e * g2(q2, e))
 
 
 def _continue(F, z0, thetas, fresh, n_homotopy, tol, max_steps):
@@ -252,9 +256,8 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
     ``(face1, rest1, face2, rest2)``, tip and root together.  ``g1, g2`` : face-end
     functions of pinion and gear (module docstring).  ``tips = (t1, t2)`` : tip-edge
     functions ``t_k(q)`` (mm, zero on the tip surface, > 0 below it) of pinion and
-    gear, or ``None`` (face ends only).  ``corners`` (with ``tips``): also the eight
-    corner candidates (tip edge x own face end, tip edge x mating face end; module
-    docstring, "Corners").  ``drive`` : True on the drive side (may be traced).
+    gear, or ``None`` (face ends only).  ``corners`` (with ``tips``): also the four
+    corner candidates (each tip edge at each end; module docstring, "Corners").  ``drive`` : True on the drive side (may be traced).
     ``steps_per_pitch`` : grid steps per angular pitch (the neighbouring tooth pairs
     are pair 0 shifted by that many steps).
     ``line_contact`` : ``path`` was solved in line-contact mode (one face-width section):
@@ -269,7 +272,7 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
     n = path.phi1.shape[0]
     mid = n // 2
     t1, t2 = (None, None) if tips is None else tips
-    nc = 4 if tips is None else (14 if corners else 6)
+    nc = 4 if tips is None else (10 if corners else 6)
     v1_fixed = jax.lax.stop_gradient(path.uv1[mid, 1])
     F, cs = edge_contact_system(r1, r2, asm, mis, g1, g2, t1, t2, line_contact=line_contact,
                                 v1_fixed=v1_fixed)
@@ -286,13 +289,11 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
     def edge_values(g, t, q, e, tip):
         return jax.vmap(lambda qq: start_value(g, t, qq, e, tip))(q)
 
-    def end_values(pinion, e, own):
-        # the face-end function of the corner's face end (own member or mating member)
-        on1 = (pinion > 0.5) == (own > 0.5)
-        return jnp.where(on1, jax.vmap(lambda q: g1(q, e))(path.p1_body),
-                         jax.vmap(lambda q: g2(q, e))(path.p2_body))
+    def end_values(e):
+        # the corner's end function along the path
+        return jax.vmap(lambda a, b: corner_end(g1, g2, a, b, e))(path.p1_body, path.p2_body)
 
-    def one_edge(pinion, e, tip, corner, own):
+    def one_edge(pinion, e, tip, corner):
         # the start: the surface contact at the reference (face ends) or, for a tip
         # edge, at the converged grid point where the surface contact is nearest that
         # tip (the homotopy is then short and starts on the branch the corner takes
@@ -303,7 +304,7 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
         near = jnp.argmin(jnp.where(path.converged, jnp.abs(gv), jnp.inf))
         i0 = jnp.where((tip > 0.5) & jnp.any(path.converged), near, mid)
         g0 = gv[i0]
-        g0b = jax.lax.stop_gradient(end_values(pinion, e, own))[i0]
+        g0b = jax.lax.stop_gradient(end_values(e))[i0]
         x0 = jnp.concatenate([path.uv1[i0], path.uv2[i0], path.phi2[i0][None]])
         psi0 = [None if p is None else p[i0] for p in (path.psi1, path.psi2)]
         z0 = jax.lax.stop_gradient(cs.join(x0, *psi0))
@@ -320,7 +321,7 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
         pad = jnp.stack([fwd > n - 1, bwd < 0])
         fresh = jnp.concatenate([jnp.zeros((2, k), bool),
                                  pad | (steps == 0)[None, :]], axis=1)
-        const = [v + 0.0 * levels for v in (g0, pinion, e, tip, g0b, corner, own)]
+        const = [v + 0.0 * levels for v in (g0, pinion, e, tip, g0b, corner)]
 
         def run(ph, fr):
                 return _continue(F, z0, (ph, levels, *const), fr, k, tol, max_steps)
@@ -336,9 +337,9 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
 
         return whole(sols.x), whole(sols.converged) & ok_ref, whole(sols.residual)
 
-    pin_np, tip_np, corner_np, own_np = _PINION[:nc], _TIP[:nc], _CORNER[:nc], _OWN[:nc]
+    pin_np, tip_np, corner_np = _PINION[:nc], _TIP[:nc], _CORNER[:nc]
     Z, conv, res = jax.vmap(one_edge)(*(jnp.asarray(a) for a in
-                                        (pin_np, _END[:nc], tip_np, corner_np, own_np)))
+                                        (pin_np, _END[:nc], tip_np, corner_np)))
 
     def post(z, ph1):
         x, psi1, psi2 = cs.split(z)
@@ -363,17 +364,18 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
         face1, tip1, root1, face2, tip2, root2 = parts
     pin = pin_np[:, None] > 0.5
     is_tip = tip_np[:, None] > 0.5
-    own_corner = (corner_np * own_np)[:, None] > 0.5
-    cross = (corner_np * (1.0 - own_np))[:, None] > 0.5
+    is_corner = corner_np[:, None] > 0.5
     # the edge point inside the other boundaries of its own flank (a face end: tip and
-    # root; a tip edge: face width and root; an own corner: root -- its tip and face end
-    # are its equations) and the mating point inside its flank (a crossing corner lies
-    # on the mating face end by its equations: tip and root of the mating flank)
+    # root; a tip edge: face width and root; a corner: root -- its tip and the first
+    # face end are its equations) and the mating point inside its flank (a corner: tip
+    # and root; the face widths of both members are held by the corner's end equation,
+    # which puts the point on one face end and inside the other: with equal face widths
+    # it lies on both, where a face margin would be a rounding error either way)
     own_root = jnp.where(pin, root1, root2)
     own = jnp.where(is_tip, jnp.where(pin, face1, face2), jnp.where(pin, tip1, tip2))
-    own = jnp.where(own_corner, jnp.inf, own)
-    mate = jnp.where(pin, jnp.minimum(jnp.where(cross, jnp.inf, face2), jnp.minimum(tip2, root2)),
-                     jnp.minimum(jnp.where(cross, jnp.inf, face1), jnp.minimum(tip1, root1)))
+    own = jnp.where(is_corner, jnp.inf, own)
+    mate = jnp.where(pin, jnp.minimum(jnp.where(is_corner, jnp.inf, face2), jnp.minimum(tip2, root2)),
+                     jnp.minimum(jnp.where(is_corner, jnp.inf, face1), jnp.minimum(tip1, root1)))
     other = jnp.minimum(jnp.minimum(own, own_root), mate)
     valid = conv & (other >= 0.0)
     # TE from the reference contact of the path (not from the path's own value at each

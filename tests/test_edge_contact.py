@@ -395,8 +395,9 @@ def _rot_y(t):
 
 def _tip_corners(cf, ph1, dg, dP, b, tip):
     """{name: (phi2, valid)} of the tip-edge end candidates of pair 0 at pinion angle
-    ``ph1``, named as in EDGE_NAMES; plus the tip edge in the pinion's section z = 0
-    ("section")."""
+    ``ph1``: the own corners ("gear tip/toe corner", ...), the crossings of the mating
+    face ends ("gear tip x pinion toe", ...; EDGE_NAMES calls both the toe/heel corner
+    of the tip edge), and the tip edge in the pinion's section z = 0 ("section")."""
     from scipy.optimize import brentq
     g1, g2 = cf.g
     c = np.array([0.0, cf.a, 0.0])
@@ -466,6 +467,15 @@ def _tip_corners(cf, ph1, dg, dP, b, tip):
     return out
 
 
+def _corner_name(name):
+    """EDGE_NAMES' name of a candidate of _tip_corners (a crossing of the mating face end
+    is the tip edge's corner at that end)."""
+    if " x " not in name:
+        return name
+    tip, end = name.split(" x ")
+    return f"{tip}/{end.split()[1]} corner"
+
+
 @pytest.mark.parametrize("da,tip,dg_deg,dP,where", [
     (1.0, "gear tip", 0.1, 0.0, "gear tip/heel corner"),
     (1.0, "gear tip", -0.1, 0.0, "gear tip/toe corner"),
@@ -482,7 +492,7 @@ def test_tip_corner_under_a_shaft_angle_error_matches_the_closed_form(traced, mi
     gear angle) against the closed form above, at every grid point where the tip
     carries the load.  With the pinion shifted axially by dP = -1 mm the gear's
     leading corner lies beyond the pinion's face: the tip edge touches where it crosses
-    the pinion's heel.  The lead over the tip's point in the mid-face section (the
+    the pinion's heel (reported as the gear tip's heel corner, at the pinion's heel).  The lead over the tip's point in the mid-face section (the
     contact reported before corners were solved) is close to the line-of-action
     estimate (b/2) dg cos(alpha)/r_b2 = 67.5 arcsec (measured 66.0-69.0: the normal at a
     tip corner is not the line of action), far above the tolerance."""
@@ -498,7 +508,7 @@ def test_tip_corner_under_a_shaft_angle_error_matches_the_closed_form(traced, mi
     names = [EDGE_NAMES[k] for k in kind]
     at_tip = [j for j in np.nonzero(carried)[0] if names[j].startswith(tip)]
     assert len(at_tip) >= 3, [names[j] for j in np.nonzero(carried)[0]]
-    assert {names[j] for j in at_tip} == {where}
+    assert {names[j] for j in at_tip} == {_corner_name(where)}
     phi1, phi2 = np.asarray(path.phi1), np.asarray(path.phi2)
     lead_first_order = 0.5 * B * dg * np.cos(np.radians(20.0)) / RB2
     errs = []
@@ -508,9 +518,113 @@ def test_tip_corner_under_a_shaft_angle_error_matches_the_closed_form(traced, mi
         # drive: the gear is turned furthest back (largest TE = smallest phi2 here:
         # TE = -(phi2 - phi2_ref) + ...) by the leading candidate
         lead = min(valid, key=valid.get)
-        assert names[j] == lead, (j, names[j], valid)
+        assert lead == where and names[j] == _corner_name(lead), (j, names[j], valid)
         errs.append(abs(phi2[j] - valid[lead]) / ARCSEC)
         # ahead of the tip edge's point in the mid-face section (the old result)
         ahead = (cands["section"][0] - valid[lead])
         assert 0.9 * abs(lead_first_order) < ahead < 1.1 * abs(lead_first_order)
     assert max(errs) < 1e-6, errs
+    # on the face end of the member that bounds it (the tip's own, or the mating one)
+    on_pinion = where.startswith("pinion") == (" x " not in where)
+    e = 1.0 if where.endswith("heel") or "heel corner" in where else -1.0
+    body = np.asarray(path.axial1 if on_pinion else path.axial2)[at_tip]
+    np.testing.assert_allclose(body, e * 0.5 * B, atol=1e-9)
+
+
+# -- VH-CATT tip edges -------------------------------------------------------------------
+
+def _vh_gear_corner(pair, cf, ph1, e):
+    """Gear angle (rad) at which the gear's tip corner at face end ``e`` touches the
+    pinion flank of the mismatched VH-CATT pair below, and the pinion point's radius
+    and section -- from the closed-form envelope of each member
+    (:func:`~gearjax.gears.vh_catt.geometry.envelope_point_np`, Willis' condition on
+    the rack, NumPy) and scalar root finding (SciPy): the gear corner is the flank
+    point of radius r_a2 in the section z = e b/2; turned by phi2 about the gear
+    centre, it must lie on the pinion flank in its section: the pinion point of the
+    same radius in that section (root in u) has the same polar angle (root in phi2)."""
+    from scipy.optimize import brentq
+    from gearjax.gears.vh_catt import geometry as G
+    pin = pair["pinion"]
+    k1 = G.tool_data(pin.module, pin.pressure_angle, pin.cutter_radius("pinion"), 17,
+                     G.HANDS["pinion"], -1.0, pin.blade_offset, xp=np)   # drive flanks
+    gp = pair["gear"]
+    k2 = G.tool_data(gp.module, gp.pressure_angle, gp.cutter_radius("gear"), 23,
+                     G.HANDS["gear"], -1.0, gp.blade_offset, xp=np)
+    z = e * 0.5 * float(gp.face_width)
+
+    def radius_u(k, R, zz):
+        # bracketed about the middle section's blade coordinate of that radius (rack
+        # geometry), on the working branch
+        ca, sa = float(k.cos_a), float(k.sin_a)
+        u0 = (np.sqrt(max(R ** 2 - (k.r * ca) ** 2, 0.0)) - k.r * sa) * sa / ca
+        f = lambda u: np.hypot(*G.envelope_point_np(k, u, zz)[0][:2]) - R
+        return brentq(f, u0 - 1.0, u0 + 1.0, xtol=1e-14, rtol=1e-15)
+
+    q2 = G.envelope_point_np(k2, radius_u(k2, cf.g[1]["ra"], z), z)[0]
+
+    def mismatch(ph2):
+        c, s_ = np.cos(ph2), np.sin(ph2)
+        W = np.array([c * q2[0] - s_ * q2[1], cf.a + s_ * q2[0] + c * q2[1]])
+        R = np.hypot(*W)
+        q1 = G.envelope_point_np(k1, radius_u(k1, R, z), z)[0]
+        return np.angle(np.exp(1j * (np.arctan2(W[1], W[0]) - ph1
+                                     - np.arctan2(q1[1], q1[0])))), R
+
+    ph2_0 = cf.candidates(ph1)["gear tip"]
+    ph2 = brentq(lambda p: mismatch(p)[0], ph2_0 - 1.5e-3, ph2_0 + 1.5e-3, xtol=1e-15, rtol=1e-15)
+    return ph2, mismatch(ph2)[1]
+
+
+def test_vh_catt_tip_contact_matches_closed_forms():
+    """VH-CATT: the pinion of the seed's pair (17/23, m = 4 mm, alpha = 20 deg, b = 28 mm,
+    R_T = 400 mm, blade offset 3 mm) cut with a blade angle 1 deg larger -- a deliberate
+    base-pitch mismatch (the pinion's base pitch is the smaller): premature contact of
+    the incoming pair at the gear tip.  Both members are symmetric about the middle
+    section, an exact involute pair (the rack-line envelope, tests/test_vh_catt.py), so
+    the tip edge's point there is a candidate whose gear angle the plane closed form
+    gives (_ClosedFormSpur, x = 0, centre distance r1 + r2); the other sections are not
+    involutes, and at the first grid points the gear's tip edge touches first at its
+    corners (toe and heel, equal by the symmetry): their gear angle from the closed-form
+    envelopes (_vh_gear_corner).  At each grid point where the gear tip carries the
+    load, the TCA's contact is the leading one of these candidates, at its gear angle."""
+    from dataclasses import replace
+    from gearjax.gears.vh_catt.tca import vh_flanks, vh_tca_traced
+    pair = gj.load_design("example:vh_catt_17x23").pair
+    pin = replace(pair, pressure_angle=pair.pressure_angle + np.radians(1.0))
+    run = jax.jit(lambda p, q, m: vh_tca_traced(p, m, -1.0, pinion=q))
+    path, margin, multi = run(pair, pin, _mis(0.0))
+    mid = path.phi1.shape[0] // 2
+    cf = _ClosedFormSpur(17, 23, 4.0, 20.0, 1.0, 80.0, (1.0, 1.0))
+    sig = []
+    r1, r2 = vh_flanks(pair, -1.0, pin)
+    for i, (r, uv) in enumerate(((r1, path.uv1[mid]), (r2, path.uv2[mid]))):
+        q = np.asarray(r(uv))
+        assert abs(q[2]) < 1e-9                              # the middle section
+        sig.append((np.arctan2(q[1], q[0]) - 0.5 * np.pi) / cf.psi(i, np.hypot(q[0], q[1])))
+    np.testing.assert_allclose(np.abs(sig), 1.0, atol=1e-9)   # the closed-form flanks
+    cf.sig = tuple(np.sign(sig))
+    kind = np.asarray(path.edge_kind)
+    carried = (np.asarray(margin) >= 0.0) & (kind >= 0)
+    names = [EDGE_NAMES[k] for k in kind]
+    assert {names[j] for j in np.nonzero(carried)[0]} <= {"gear tip", "gear tip/toe corner",
+                                                        "gear tip/heel corner"}
+    assert carried.sum() >= 3
+    phi1, phi2 = np.asarray(path.phi1), np.asarray(path.phi2)
+    pn = jax.tree_util.tree_map(np.asarray, {"pinion": pin, "gear": pair})
+    errs, seen = [], set()
+    for j in np.nonzero(carried)[0]:
+        cands = {"gear tip": cf.candidates(phi1[j]).get("gear tip")}
+        for e, name in ((-1.0, "gear tip/toe corner"), (1.0, "gear tip/heel corner")):
+            ph2, R = _vh_gear_corner(pn, cf, phi1[j], e)
+            if cf.g[0]["rF"] <= R <= cf.g[0]["ra"]:          # on the pinion flank
+                cands[name] = ph2
+        cands = {k: v for k, v in cands.items() if v is not None}
+        best = min(cands.values())       # drive: TE = -(phi2 - phi2_ref) + ...: max TE
+        lead = {k for k, v in cands.items() if v - best < 1e-6 * ARCSEC}
+        assert names[j] in lead, (j, names[j], cands)
+        errs.append(abs(phi2[j] - cands[names[j]]) / ARCSEC)
+        seen.add(names[j].split("/")[0])
+        if names[j] == "gear tip":
+            assert abs(float(path.axial2[j])) < 1e-9
+    assert max(errs) < 1e-6, errs
+    np.testing.assert_allclose(np.asarray(path.radial2)[carried], cf.g[1]["ra"], atol=1e-9)
