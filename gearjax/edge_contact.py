@@ -39,7 +39,7 @@ edge contact with respect to every design field follow).
 **Which contact is made.**  The teeth are rigid: at a pinion angle the gear
 turns until the first pair of points touches.  The candidates are the surface
 contact (valid where it lies inside both flanks) and the edge contacts -- four face
-ends, two tips -- (valid where the edge point lies inside the other boundaries of its
+ends, two tips, four corners -- (valid where the edge point lies inside the other boundaries of its
 flank -- tip or face width, root -- and the point of flank ``j`` inside flank ``j``).  The contact made
 is the candidate furthest ahead in the sense of the load, ``max s TE`` with
 ``s = +1`` on the drive side and ``-1`` on the coast side -- the rule of the TE
@@ -78,8 +78,32 @@ boundaries are not edges: a generated flank joins its fillet with a common tange
 plane; a tip candidate whose mating point lies below the mating root boundary is
 not valid (tip/fillet interference, the fillet is not modelled), and a contact path
 that reaches a root boundary leaves the flank (``margin < 0``), which the contact
-ratio, the TE envelope and the quality flags report.  Corner contact (tip edge x
-face end) is not solved.
+ratio, the TE envelope and the quality flags report.
+
+**Corners** (with ``tips`` and ``corners``).  Where the TE at which a tip-edge point
+touches grows along the face (a shaft-angle error tilts the tip edge against the mating
+flank; the flanks of a localised pair diverge differently at the tip), ``max f`` over
+the tip edge lies at one of its ends: the corner where the tip surface meets a face
+end.  Its contact with flank ``j`` replaces the tangency of the tip-edge system by the
+end equation::
+
+    r1f - r2f = 0,   t_k(q_k) = 0,   G_e(q_1, q_2) = 0,   (+ meshing equations)
+    G_e = e max(e g_1(q_1, e), e g_2(q_2, e))
+
+(3 + 1 + 1 equations, the size of the edge system): ``G_e = 0`` puts the common point
+on the first face end ``e`` of the two members -- the tip's own corner, or, where that
+corner lies beyond the mating member's face (face widths or axial positions differ,
+the mating face end is crossed first), the point where the tip edge crosses the mating
+face end.  (``max`` is not smooth where both face ends are reached at once -- equal
+face widths, aligned -- and both branches then give the same point.)  Four more
+candidates (two tips x two ends, :data:`CORNER_KINDS`) in the same ``vmap``, started like
+the tip edges (homotopy ``t_k = s t_k(q_0)``, ``G_e = s G_e(q_0)`` from the surface
+contact nearest the tip) and valid where the point lies above both root boundaries and
+inside the mating tip; the selection rule is unchanged (a corner with the TE of the
+tip-edge candidate -- a spur pair in line contact, aligned -- loses the tie to the tip
+edge, which comes first).  In line-contact mode the tip edges are solved in the
+section of the path, the corners are not: under a shaft-angle error the corner that
+leads is found, ahead of that section by about ``(b/2) dSigma cos(alpha)/r_b2``.
 
 Units: mm, rad.
 """
@@ -125,7 +149,8 @@ EDGE_LEAD = 1e-9
 
 class EdgeContact(NamedTuple):
     """The edge contacts beside a surface contact path (arrays over the grid; ``K`` = 4
-    face ends, 6 with the tip edges, in the order of :data:`EDGE_NAMES`).
+    face ends, 6 with the tip edges, 10 with the corners, in the order of
+    :data:`EDGE_NAMES`).
 
     kind : (N,) int, -1 where the contact is the surface contact, else the index into
         :data:`EDGE_NAMES` of the edge carrying the contact.
@@ -214,28 +239,53 @@ def corner_end(g1: Callable, g2: Callable, q1, q2, e):
     return e * jnp.maximum(e * g1(q1, e), e * g2(q2, e))
 
 
-def _continue(F, z0, thetas, fresh, n_homotopy, tol, max_steps):
+#: failed angle steps in a row after which a corner candidate's continuation stops
+CORNER_GIVE_UP = 2
+
+
+def _give_up_system(F):
+    """``G(z, (theta, keep, dead)) = z - keep`` where ``dead``, else ``F(z, theta)``
+    (a pure function of its arguments: the implicit derivative of
+    :func:`gearjax.newton.newton_solve` sees every traced value in ``theta``)."""
+    def G(z, th):
+        th_, keep, dead = th
+        return jnp.where(dead, z - keep, F(z, th_))
+    return G
+
+
+def _continue(F, z0, thetas, fresh, n_homotopy, tol, max_steps, give_up=False):
     """Solve ``F(z, theta_i) = 0`` along the scanned ``thetas`` (lax.scan), each solve
     from the linear predictor of the two previous solutions (uniform steps of the
     homotopy level, then of the angle) -- a constant predictor where ``fresh`` (the
     first angle step after the ``n_homotopy`` homotopy steps).  A failed step keeps the
     previous solution.  Where the homotopy has not reached its end (its last solve
-    failed) the angle steps are marked not converged."""
+    failed) the angle steps are marked not converged.
+
+    With ``give_up`` (traced bool; the corners) the continuation stops after the
+    homotopy failed or :data:`CORNER_GIVE_UP` angle steps failed in a row: the
+    remaining steps are marked not converged and solve the trivial ``z - z_prev = 0``
+    instead (one Newton step), so that a lost candidate does not keep the candidates
+    solved beside it in the same ``vmap`` iterating to ``max_steps`` (their Newton
+    loops run as long as the slowest)."""
 
     def step(carry, inp):
-        x_prev, x_prev2, ok_h = carry
+        x_prev, x_prev2, ok_h, fails = carry
         theta, new, i = inp
         linear = jax.lax.stop_gradient(2.0 * x_prev - x_prev2)
         pred = jnp.where(new, x_prev, linear)
-        sol = newton_solve(F, pred, theta, tol=tol, max_steps=max_steps,
-                           natural_monotonicity=True)
-        ok = sol.converged
+        dead = give_up & ((fails >= CORNER_GIVE_UP) | ((i >= n_homotopy) & ~ok_h))
+
+        sol = newton_solve(_give_up_system(F), pred, (theta, jax.lax.stop_gradient(pred), dead),
+                           tol=tol, max_steps=max_steps, natural_monotonicity=True)
+        ok = sol.converged & ~dead
         ok_h = jnp.where(i == n_homotopy - 1, ok, ok_h)
         sol = sol._replace(converged=ok & ((i < n_homotopy) | ok_h))
-        return (jnp.where(ok, sol.x, x_prev), x_prev, ok_h), sol
+        fails = jnp.where(i >= n_homotopy, jnp.where(ok, 0, fails + 1), 0)
+        return (jnp.where(ok, sol.x, x_prev), x_prev, ok_h, fails), sol
 
     idx = jnp.arange(fresh.shape[0])
-    _, sols = jax.lax.scan(step, (z0, z0, jnp.asarray(True)), (thetas, fresh, idx))
+    _, sols = jax.lax.scan(step, (z0, z0, jnp.asarray(True), jnp.asarray(0)),
+                           (thetas, fresh, idx))
     return sols
 
 
@@ -324,7 +374,8 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
         const = [v + 0.0 * levels for v in (g0, pinion, e, tip, g0b, corner)]
 
         def run(ph, fr):
-                return _continue(F, z0, (ph, levels, *const), fr, k, tol, max_steps)
+                return _continue(F, z0, (ph, levels, *const), fr, k, tol, max_steps,
+                             give_up=corner > 0.5)
 
         sols = jax.vmap(run)(phis, fresh)
         ok_ref = sols.converged[0, k - 1] & sols.converged[1, k - 1]

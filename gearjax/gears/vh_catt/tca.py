@@ -21,7 +21,11 @@ move the contact off the middle section, where the sections are not involutes.
 Flank boundaries: tip circles ``r + m``, form circles of the straight blades
 (:func:`gearjax.gears.vh_catt.geometry.pair_geometry`; those of the middle section,
 which the other sections follow to within the trace's small tangential extent) and
-the face ends ``|z| <= b/2`` (with edge contact, :mod:`gearjax.edge_contact`).
+the face ends ``|z| <= b/2``.  Edge contact (:mod:`gearjax.edge_contact`): the face
+ends, the tip edges on the addendum cylinders ``t_k = r_ak - |q_xy|`` and the corners
+where they meet (premature/prolonged contact of a mismatched pair; the corners lead
+where the TE along a tip edge is lowest in the middle section, as found for a pinion
+with a blade angle 1 deg off, tests/test_edge_contact.py).
 
 Units: mm, rad.  References: [VH-CATT]; [Litvin2004] ch. 9.
 """
