@@ -239,8 +239,59 @@ def corner_end(g1: Callable, g2: Callable, q1, q2, e):
     return e * jnp.maximum(e * g1(q1, e), e * g2(q2, e))
 
 
+#: mm: face-width margin a corner's point may miss by (it lies on a face end by its
+#: equations, solved to 1e-11)
+CORNER_TOL = 1e-8
+
 #: failed angle steps in a row after which a corner candidate's continuation stops
 CORNER_GIVE_UP = 2
+
+
+#: rad/mm: a corner counts where the TE along its tip edge into the face falls (in
+#: the sense of the load) or stays level within this
+CORNER_SLOPE_TOL = 1e-12
+
+
+def _corner_slope(cs, r1, r2, R, c, mis, asm, g1, g2, t1, t2, z, ph1, pinion, e):
+    """``dTE/d(eps)`` (rad/mm, (2,)) at a corner solution ``z`` of the tip edge of the
+    pinion (``pinion`` 1.0) or gear at end ``e``: the TE at which the flank point ``eps``
+    mm from the corner along the tip edge into the face, and down the profile from the
+    tip (in the flank's tangent plane), would touch the mating flank (first order; the
+    mating flank fixed, the gear turned).  With the tip-edge tangent ``u_k = m_k x grad
+    t_k`` (body frame, oriented into the face: ``e grad g_k . u_k < 0``), the mating
+    normal ``n_j`` and the velocity ``w = a_2 x (p - c)`` of the common point ``p`` per
+    unit gear angle: ``dphi2/deps = (n_2 . R_1 u_1)/(n_2 . w)`` for a pinion corner,
+    ``-(n_1 . R_2 u_2)/(n_1 . w)`` for a gear corner; ``dTE = ratio_sign dphi2``
+    (orientation-free: ``n_j`` enters above and below)."""
+    x, psi1, psi2 = cs.split(z)
+    uv1, uv2, ph2 = cs.unpack(x)
+    q1, m1, _ = flank_at(r1, uv1, psi1)
+    q2, m2, _ = flank_at(r2, uv2, psi2)
+    R1 = matrix_z(ph1)
+    R2 = R @ matrix_z(ph2)
+
+    def directions(m, t, g, q):
+        # along the tip edge into the face, and down the profile (in the flank's
+        # tangent plane, across the tip edge, below the tip: t grows)
+        gt = jax.grad(t)(q)
+        u = jnp.cross(m, gt)
+        u = u / jnp.maximum(jnp.linalg.norm(u), 1e-300)
+        u = jnp.where(e * jnp.dot(jax.grad(lambda qq: g(qq, e))(q), u) > 0.0, -u, u)
+        v = jnp.cross(m, u)
+        v = jnp.where(jnp.dot(gt, v) < 0.0, -v, v)
+        return u, v
+
+    p = R1 @ q1 + mis.dP * jnp.array([0.0, 0.0, 1.0])
+    w = jnp.cross(R[:, 2], p - c)
+    n1, n2 = R1 @ m1, R2 @ m2
+
+    def dte(d1, d2):
+        d_pin = jnp.dot(n2, R1 @ d1) / jnp.dot(n2, w)
+        d_gear = -jnp.dot(n1, R2 @ d2) / jnp.dot(n1, w)
+        return asm.ratio_sign * jnp.where(pinion > 0.5, d_pin, d_gear)
+
+    (u1, v1), (u2, v2) = directions(m1, t1, g1, q1), directions(m2, t2, g2, q2)
+    return jnp.stack([dte(u1, u2), dte(v1, v2)])
 
 
 def _give_up_system(F):
@@ -404,6 +455,13 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
     (ph2, uv1, uv2, q1, q2, n1, n2, psi1, psi2) = jax.vmap(
         lambda zz: jax.vmap(post)(zz, path.phi1))(Z)
     parts = jax.vmap(margin_parts)(q1, q2, uv1, uv2)
+    if nc > 6:
+        slope = jax.vmap(lambda zz, pk, ek: jax.vmap(
+            lambda z1, p1: _corner_slope(cs, r1, r2, R, c, mis, asm, g1, g2, t1, t2, z1, p1,
+                                         pk, ek))(zz, path.phi1))(
+            Z, jnp.asarray(_PINION[:nc]), jnp.asarray(_END[:nc]))
+    else:
+        slope = jnp.zeros(Z.shape[:2] + (2,))
     if len(parts) == 4:
         # face ends only: (face1, rest1, face2, rest2), tip and root margins together
         if tips is not None:
@@ -417,18 +475,23 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
     is_tip = tip_np[:, None] > 0.5
     is_corner = corner_np[:, None] > 0.5
     # the edge point inside the other boundaries of its own flank (a face end: tip and
-    # root; a tip edge: face width and root; a corner: root -- its tip and the first
-    # face end are its equations) and the mating point inside its flank (a corner: tip
-    # and root; the face widths of both members are held by the corner's end equation,
-    # which puts the point on one face end and inside the other: with equal face widths
-    # it lies on both, where a face margin would be a rounding error either way)
+    # root; a tip edge: face width and root; a corner: face width and root, its tip is
+    # its equation) and the mating point inside its flank.  A corner lies on a face end
+    # of one member by its end equation, and with equal face widths on both: its face
+    # margins are zero to the solver's tolerance and count with CORNER_TOL (both ends
+    # are checked: the end equation bounds the point at end e only)
+    slack = jnp.where(is_corner, CORNER_TOL, 0.0)
     own_root = jnp.where(pin, root1, root2)
-    own = jnp.where(is_tip, jnp.where(pin, face1, face2), jnp.where(pin, tip1, tip2))
-    own = jnp.where(is_corner, jnp.inf, own)
-    mate = jnp.where(pin, jnp.minimum(jnp.where(is_corner, jnp.inf, face2), jnp.minimum(tip2, root2)),
-                     jnp.minimum(jnp.where(is_corner, jnp.inf, face1), jnp.minimum(tip1, root1)))
+    own = jnp.where(is_tip, jnp.where(pin, face1, face2), jnp.where(pin, tip1, tip2)) + slack
+    mate = jnp.where(pin, jnp.minimum(face2 + slack, jnp.minimum(tip2, root2)),
+                     jnp.minimum(face1 + slack, jnp.minimum(tip1, root1)))
     other = jnp.minimum(jnp.minimum(own, own_root), mate)
-    valid = conv & (other >= 0.0)
+    # a corner leads only where the tip edge runs from it into the face behind it in
+    # the sense of the load (module docstring, "Corners"): else the tip edge's interior
+    # would pass through the mating flank (a corner point on the flank from inside)
+    sgn_load = jnp.where(drive, 1.0, -1.0)
+    ahead = ~is_corner | (jnp.max(sgn_load * slope, axis=-1) <= CORNER_SLOPE_TOL)
+    valid = conv & (other >= 0.0) & ahead
     # TE from the reference contact of the path (not from the path's own value at each
     # angle: where the surface solve failed that may be NaN, and an edge contact there
     # is still a contact)

@@ -164,13 +164,14 @@ def _face_ends(pair: VHCattPair, pinion: VHCattPair | None = None):
 
 def vh_tca_traced(pair: VHCattPair, mis: Misalignment, code, *, steps_per_pitch: int = 24,
                   half_pitches: float = 1.25, n_pairs: int = 3, approach=DEFAULT_APPROACH,
-                  face_ends: bool = True, tip_edges: bool = True,
+                  face_ends: bool = True, tip_edges: bool = True, corners: bool = True,
                   pinion: VHCattPair | None = None):
     """Traceable point-contact TCA: ``(path, margin, multi)`` on the uniform grid of
     pinion angles ``phi1_ref + k 2 pi/(z1 steps_per_pitch)``, ``|k| <=
     round(half_pitches steps_per_pitch)``; with ``face_ends`` the edge contacts at the
-    face ends are solved too, with ``tip_edges`` also those of the tip edges and the
-    corners (tip edge x face end) (:func:`gearjax.edge_contact.face_end_contact`).
+    face ends are solved too, with ``tip_edges`` also those of the tip edges and, with
+    ``corners``, of the corners (tip edge x face end)
+    (:func:`gearjax.edge_contact.face_end_contact`).
     ``pinion`` : cut the pinion as the pinion of this pair instead (same tooth numbers
     and module; e.g. another blade angle: a deliberate base-pitch mismatch, whose tip
     contacts the tests check); its own tip and form circles bound its flank."""
@@ -185,7 +186,7 @@ def vh_tca_traced(pair: VHCattPair, mis: Misalignment, code, *, steps_per_pitch:
         path, margin, _ = face_end_contact(r1, r2, asm, mis, path, margin, parts, g1, g2,
                                            drive=code < 0, line_contact=False,
                                            steps_per_pitch=steps_per_pitch,
-                                           tips=tips if tip_edges else None)
+                                           tips=tips if tip_edges else None, corners=corners)
     multi = multi_pair(path, margin, steps_per_pitch, pair.z1, drive=(code < 0),
                        n_pairs=n_pairs)
     return path, margin, multi
