@@ -98,8 +98,16 @@ face end.  (``max`` is not smooth where both face ends are reached at once -- eq
 face widths, aligned -- and both branches then give the same point.)  Four more
 candidates (two tips x two ends, :data:`CORNER_KINDS`) in the same ``vmap``, started like
 the tip edges (homotopy ``t_k = s t_k(q_0)``, ``G_e = s G_e(q_0)`` from the surface
-contact nearest the tip) and valid where the point lies above both root boundaries and
-inside the mating tip; the selection rule is unchanged (a corner with the TE of the
+contact nearest the tip) and valid where the point lies above both root boundaries,
+inside the mating tip and inside both face widths (to ``CORNER_TOL`` = 1e-8 mm: it lies
+on a face end by its equations), and where it is a local maximum of the TE over the
+tip's flank (in the sense of the load): the TE at which the flank point ``eps`` from the
+corner touches falls along the tip edge into the face and down the profile from the
+tip (first-order slopes, :func:`_corner_slope`; without this a far branch -- the corner
+on the mating flank from inside the mating tooth, thousands of arcsec "ahead" -- was
+taken on a localised spiral-bevel pair).  A corner continuation that fails two grid
+steps in a row gives up (``CORNER_GIVE_UP``: its Newton loops would hold the others of
+the same ``vmap``).  The selection rule is unchanged (a corner with the TE of the
 tip-edge candidate -- a spur pair in line contact, aligned -- loses the tie to the tip
 edge, which comes first).  In line-contact mode the tip edges are solved in the
 section of the path, the corners are not: under a shaft-angle error the corner that
