@@ -39,7 +39,7 @@ edge contact with respect to every design field follow).
 **Which contact is made.**  The teeth are rigid: at a pinion angle the gear
 turns until the first pair of points touches.  The candidates are the surface
 contact (valid where it lies inside both flanks) and the edge contacts -- four face
-ends, two tips -- (valid where the edge point lies inside the other boundaries of its
+ends, two tips, four corners -- (valid where the edge point lies inside the other boundaries of its
 flank -- tip or face width, root -- and the point of flank ``j`` inside flank ``j``).  The contact made
 is the candidate furthest ahead in the sense of the load, ``max s TE`` with
 ``s = +1`` on the drive side and ``-1`` on the coast side -- the rule of the TE
@@ -78,8 +78,40 @@ boundaries are not edges: a generated flank joins its fillet with a common tange
 plane; a tip candidate whose mating point lies below the mating root boundary is
 not valid (tip/fillet interference, the fillet is not modelled), and a contact path
 that reaches a root boundary leaves the flank (``margin < 0``), which the contact
-ratio, the TE envelope and the quality flags report.  Corner contact (tip edge x
-face end) is not solved.
+ratio, the TE envelope and the quality flags report.
+
+**Corners** (with ``tips`` and ``corners``).  Where the TE at which a tip-edge point
+touches grows along the face (a shaft-angle error tilts the tip edge against the mating
+flank; the flanks of a localised pair diverge differently at the tip), ``max f`` over
+the tip edge lies at one of its ends: the corner where the tip surface meets a face
+end.  Its contact with flank ``j`` replaces the tangency of the tip-edge system by the
+end equation::
+
+    r1f - r2f = 0,   t_k(q_k) = 0,   G_e(q_1, q_2) = 0,   (+ meshing equations)
+    G_e = e max(e g_1(q_1, e), e g_2(q_2, e))
+
+(3 + 1 + 1 equations, the size of the edge system): ``G_e = 0`` puts the common point
+on the first face end ``e`` of the two members -- the tip's own corner, or, where that
+corner lies beyond the mating member's face (face widths or axial positions differ,
+the mating face end is crossed first), the point where the tip edge crosses the mating
+face end.  (``max`` is not smooth where both face ends are reached at once -- equal
+face widths, aligned -- and both branches then give the same point.)  Four more
+candidates (two tips x two ends, :data:`CORNER_KINDS`) in the same ``vmap``, started like
+the tip edges (homotopy ``t_k = s t_k(q_0)``, ``G_e = s G_e(q_0)`` from the surface
+contact nearest the tip) and valid where the point lies above both root boundaries,
+inside the mating tip and inside both face widths (to ``CORNER_TOL`` = 1e-8 mm: it lies
+on a face end by its equations), and where it is a local maximum of the TE over the
+tip's flank (in the sense of the load): the TE at which the flank point ``eps`` from the
+corner touches falls along the tip edge into the face and down the profile from the
+tip (first-order slopes, :func:`_corner_slope`; without this a far branch -- the corner
+on the mating flank from inside the mating tooth, thousands of arcsec "ahead" -- was
+taken on a localised spiral-bevel pair).  A corner continuation that fails two grid
+steps in a row gives up (``CORNER_GIVE_UP``: its Newton loops would hold the others of
+the same ``vmap``).  The selection rule is unchanged (a corner with the TE of the
+tip-edge candidate -- a spur pair in line contact, aligned -- loses the tie to the tip
+edge, which comes first).  In line-contact mode the tip edges are solved in the
+section of the path, the corners are not: under a shaft-angle error the corner that
+leads is found, ahead of that section by about ``(b/2) dSigma cos(alpha)/r_b2``.
 
 Units: mm, rad.
 """
@@ -96,18 +128,28 @@ from gearjax.frames import matrix_z
 from gearjax.newton import newton_solve
 from gearjax.tca import ContactPath, contact_system, flank_at, gear_mount
 
-__all__ = ["EDGE_NAMES", "FACE_END_KINDS", "TIP_KINDS", "EDGE_LEAD", "EdgeContact", "edge_contact_system", "face_end_contact"]
+__all__ = ["EDGE_NAMES", "FACE_END_KINDS", "TIP_KINDS", "CORNER_KINDS", "EDGE_LEAD",
+           "EdgeContact", "edge_contact_system", "face_end_contact"]
 
 #: names of the edges, in the order of :attr:`EdgeContact.kind`: the four face ends,
-#: then the tip edges of pinion and gear (appended: the face-end indices 0-3 keep
-#: their meaning)
-EDGE_NAMES = ("pinion toe", "pinion heel", "gear toe", "gear heel", "pinion tip", "gear tip")
-#: indices into :data:`EDGE_NAMES` of the face ends (toe/heel) and of the tip edges
+#: the tip edges of pinion and gear, then the corners (appended: the indices before
+#: keep their meaning): the toe/heel end of a member's tip edge where it touches the
+#: mating flank -- the member's own corner, or, where that lies beyond the mating
+#: member's face, the point where the tip edge crosses the mating face end
+EDGE_NAMES = ("pinion toe", "pinion heel", "gear toe", "gear heel", "pinion tip", "gear tip",
+              "pinion tip/toe corner", "pinion tip/heel corner",
+              "gear tip/toe corner", "gear tip/heel corner")
+#: indices into :data:`EDGE_NAMES` of the face ends (toe/heel), of the tip edges and of
+#: the corners (tip edge x face end; a corner contact is a tip contact)
 FACE_END_KINDS = (0, 1, 2, 3)
 TIP_KINDS = (4, 5)
-_PINION = np.array([1.0, 1.0, 0.0, 0.0, 1.0, 0.0])
-_END = np.array([-1.0, 1.0, -1.0, 1.0, 0.0, 0.0])
-_TIP = np.array([0.0, 0.0, 0.0, 0.0, 1.0, 1.0])
+CORNER_KINDS = (6, 7, 8, 9)
+#: per candidate: the edge (or tip) belongs to the pinion; its face end e (-1 toe,
+#: +1 heel, 0 none); a tip edge; a corner
+_PINION = np.array([1.0, 1.0, 0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0, 0.0])
+_END = np.array([-1.0, 1.0, -1.0, 1.0, 0.0, 0.0, -1.0, 1.0, -1.0, 1.0])
+_TIP = np.array([0.0] * 4 + [1.0] * 6)
+_CORNER = np.array([0.0] * 6 + [1.0] * 4)
 
 #: rad: an edge contact replaces the surface contact only when it is this far ahead
 EDGE_LEAD = 1e-9
@@ -115,7 +157,8 @@ EDGE_LEAD = 1e-9
 
 class EdgeContact(NamedTuple):
     """The edge contacts beside a surface contact path (arrays over the grid; ``K`` = 4
-    face ends, 6 with the tip edges, in the order of :data:`EDGE_NAMES`).
+    face ends, 6 with the tip edges, 10 with the corners, in the order of
+    :data:`EDGE_NAMES`).
 
     kind : (N,) int, -1 where the contact is the surface contact, else the index into
         :data:`EDGE_NAMES` of the edge carrying the contact.
@@ -137,14 +180,19 @@ def edge_contact_system(r1: Callable, r2: Callable, asm, mis, g1: Callable, g2: 
                         line_contact: bool = False, v1_fixed=0.0):
     """The edge-contact system ``F(z, theta)`` of the module docstring.
 
-    ``theta = (phi1, s, g0, pinion, e, tip)``: pinion angle, homotopy level, the edge
-    function at the start point, 1.0 for an edge of the pinion (0.0: of the gear), face
-    end ``e`` and 1.0 for the tip edge (then ``t_k(q)`` replaces ``g_k(q, e)``; ``t1``,
-    ``t2`` default to the face ends).  With ``line_contact`` the tip-edge candidates
-    take the line-contact treatment: the edge tangency is replaced by ``v1 = v1_fixed``
-    (one face-width section, that of the surface path).  The unknown ``z`` is packed as
-    in :func:`gearjax.tca.contact_system` (point contact).  Returns ``(F, cs)`` with
-    ``cs`` that :class:`~gearjax.tca.ContactSystem`.
+    ``theta = (phi1, s, g0, pinion, e, tip, g0b, corner)``: pinion angle, homotopy
+    level, the edge function at the start point, 1.0 for an edge of the pinion (0.0: of
+    the gear), face end ``e`` and 1.0 for the tip edge (then ``t_k(q)`` replaces
+    ``g_k(q, e)``; ``t1``, ``t2`` default to the face ends); for a corner (``corner``
+    1.0, with ``tip``) the tangency is replaced by the end equation
+    ``G_e - s g0b = 0``, ``G_e = e max(e g_1(q_1, e), e g_2(q_2, e))`` (zero where the
+    common point reaches the first of the two face ends ``e`` -- the tip's own corner,
+    or the mating face end where the tip edge crosses it first), ``g0b`` its value at
+    the start point.  With ``line_contact`` the tip-edge candidates (not the
+    corners) take the line-contact treatment: the edge tangency is replaced by
+    ``v1 = v1_fixed`` (one face-width section, that of the surface path).  The unknown
+    ``z`` is packed as in :func:`gearjax.tca.contact_system` (point contact).  Returns
+    ``(F, cs)`` with ``cs`` that :class:`~gearjax.tca.ContactSystem`.
     """
     R, c = gear_mount(asm, mis)
     cs = contact_system(r1, r2, asm, mis, False)
@@ -163,7 +211,7 @@ def edge_contact_system(r1: Callable, r2: Callable, asm, mis, g1: Callable, g2: 
         return jnp.dot(n_other, t) / jnp.where(nt > 0.0, nt, 1.0)
 
     def F(z, theta):
-        ph1, s, g0, pinion, e, tip = theta
+        ph1, s, g0, pinion, e, tip, g0b, corner = theta
         x, psi1, psi2 = cs.split(z)
         uv1, uv2, ph2 = cs.unpack(x)
         q1, m1, f1 = flank_at(r1, uv1, psi1)
@@ -177,45 +225,134 @@ def edge_contact_system(r1: Callable, r2: Callable, asm, mis, g1: Callable, g2: 
         is1 = pinion > 0.5
         on_edge = jnp.where(is1, ga, gb) - s * g0
         tang = jnp.where(is1, tangency(R2 @ m2, R1, m1, da), tangency(R1 @ m1, R2, m2, db))
+        is_corner = corner > 0.5
         if line_contact:
             # a tip edge parallel to the mating generatrix (spur) touches along a
             # line: fix the face-width section instead of the (degenerate) tangency
-            tang = jnp.where(tip > 0.5, uv1[1] - v1_fixed, tang)
+            tang = jnp.where((tip > 0.5) & ~is_corner, uv1[1] - v1_fixed, tang)
+        # a corner: the tip edge meets the first face end e (own or mating member)
+        tang = jnp.where(is_corner, corner_end(g1, g2, q1, q2, e) - s * g0b, tang)
         mesh = [jnp.reshape(f, (1,)) for f in (f1, f2) if f is not None]
         return jnp.concatenate([p1 - p2, jnp.stack([on_edge, tang])] + mesh)
 
     return F, cs
 
 
-def _continue(F, z0, thetas, fresh, n_homotopy, tol, max_steps):
+def corner_end(g1: Callable, g2: Callable, q1, q2, e):
+    """``G_e = e max(e g_1(q_1, e), e g_2(q_2, e))`` (mm): the face-end function of a
+    corner at end ``e`` (module docstring, "Corners"); zero where the common point
+    (body points ``q1``, ``q2``) lies on the face end ``e`` of one member and inside
+    the other's, negative beyond one of them on that end (``g_k`` grows into the face
+    from ``e = -1``, out of it at ``e = +1``)."""
+    return e * jnp.maximum(e * g1(q1, e), e * g2(q2, e))
+
+
+#: mm: face-width margin a corner's point may miss by (it lies on a face end by its
+#: equations, solved to 1e-11)
+CORNER_TOL = 1e-8
+
+#: failed angle steps in a row after which a corner candidate's continuation stops
+CORNER_GIVE_UP = 2
+
+
+#: rad/mm: a corner counts where the TE along its tip edge into the face falls (in
+#: the sense of the load) or stays level within this
+CORNER_SLOPE_TOL = 1e-12
+
+
+def _corner_slope(cs, r1, r2, R, c, mis, asm, g1, g2, t1, t2, z, ph1, pinion, e):
+    """``dTE/d(eps)`` (rad/mm, (2,)) at a corner solution ``z`` of the tip edge of the
+    pinion (``pinion`` 1.0) or gear at end ``e``: the TE at which the flank point ``eps``
+    mm from the corner along the tip edge into the face, and down the profile from the
+    tip (in the flank's tangent plane), would touch the mating flank (first order; the
+    mating flank fixed, the gear turned).  With the tip-edge tangent ``u_k = m_k x grad
+    t_k`` (body frame, oriented into the face: ``e grad g_k . u_k < 0``), the mating
+    normal ``n_j`` and the velocity ``w = a_2 x (p - c)`` of the common point ``p`` per
+    unit gear angle: ``dphi2/deps = (n_2 . R_1 u_1)/(n_2 . w)`` for a pinion corner,
+    ``-(n_1 . R_2 u_2)/(n_1 . w)`` for a gear corner; ``dTE = ratio_sign dphi2``
+    (orientation-free: ``n_j`` enters above and below)."""
+    x, psi1, psi2 = cs.split(z)
+    uv1, uv2, ph2 = cs.unpack(x)
+    q1, m1, _ = flank_at(r1, uv1, psi1)
+    q2, m2, _ = flank_at(r2, uv2, psi2)
+    R1 = matrix_z(ph1)
+    R2 = R @ matrix_z(ph2)
+
+    def directions(m, t, g, q):
+        # along the tip edge into the face, and down the profile (in the flank's
+        # tangent plane, across the tip edge, below the tip: t grows)
+        gt = jax.grad(t)(q)
+        u = jnp.cross(m, gt)
+        u = u / jnp.maximum(jnp.linalg.norm(u), 1e-300)
+        u = jnp.where(e * jnp.dot(jax.grad(lambda qq: g(qq, e))(q), u) > 0.0, -u, u)
+        v = jnp.cross(m, u)
+        v = jnp.where(jnp.dot(gt, v) < 0.0, -v, v)
+        return u, v
+
+    p = R1 @ q1 + mis.dP * jnp.array([0.0, 0.0, 1.0])
+    w = jnp.cross(R[:, 2], p - c)
+    n1, n2 = R1 @ m1, R2 @ m2
+
+    def dte(d1, d2):
+        d_pin = jnp.dot(n2, R1 @ d1) / jnp.dot(n2, w)
+        d_gear = -jnp.dot(n1, R2 @ d2) / jnp.dot(n1, w)
+        return asm.ratio_sign * jnp.where(pinion > 0.5, d_pin, d_gear)
+
+    (u1, v1), (u2, v2) = directions(m1, t1, g1, q1), directions(m2, t2, g2, q2)
+    return jnp.stack([dte(u1, u2), dte(v1, v2)])
+
+
+def _give_up_system(F):
+    """``G(z, (theta, keep, dead)) = z - keep`` where ``dead``, else ``F(z, theta)``
+    (a pure function of its arguments: the implicit derivative of
+    :func:`gearjax.newton.newton_solve` sees every traced value in ``theta``)."""
+    def G(z, th):
+        th_, keep, dead = th
+        return jnp.where(dead, z - keep, F(z, th_))
+    return G
+
+
+def _continue(F, z0, thetas, fresh, n_homotopy, tol, max_steps, give_up=False):
     """Solve ``F(z, theta_i) = 0`` along the scanned ``thetas`` (lax.scan), each solve
     from the linear predictor of the two previous solutions (uniform steps of the
     homotopy level, then of the angle) -- a constant predictor where ``fresh`` (the
     first angle step after the ``n_homotopy`` homotopy steps).  A failed step keeps the
     previous solution.  Where the homotopy has not reached its end (its last solve
-    failed) the angle steps are marked not converged."""
+    failed) the angle steps are marked not converged.
+
+    With ``give_up`` (traced bool; the corners) the continuation stops after the
+    homotopy failed or :data:`CORNER_GIVE_UP` angle steps failed in a row: the
+    remaining steps are marked not converged and solve the trivial ``z - z_prev = 0``
+    instead (one Newton step), so that a lost candidate does not keep the candidates
+    solved beside it in the same ``vmap`` iterating to ``max_steps`` (their Newton
+    loops run as long as the slowest)."""
 
     def step(carry, inp):
-        x_prev, x_prev2, ok_h = carry
+        x_prev, x_prev2, ok_h, fails = carry
         theta, new, i = inp
         linear = jax.lax.stop_gradient(2.0 * x_prev - x_prev2)
         pred = jnp.where(new, x_prev, linear)
-        sol = newton_solve(F, pred, theta, tol=tol, max_steps=max_steps,
-                           natural_monotonicity=True)
-        ok = sol.converged
+        dead = give_up & ((fails >= CORNER_GIVE_UP) | ((i >= n_homotopy) & ~ok_h))
+
+        sol = newton_solve(_give_up_system(F), pred, (theta, jax.lax.stop_gradient(pred), dead),
+                           tol=tol, max_steps=max_steps, natural_monotonicity=True)
+        ok = sol.converged & ~dead
         ok_h = jnp.where(i == n_homotopy - 1, ok, ok_h)
         sol = sol._replace(converged=ok & ((i < n_homotopy) | ok_h))
-        return (jnp.where(ok, sol.x, x_prev), x_prev, ok_h), sol
+        fails = jnp.where(i >= n_homotopy, jnp.where(ok, 0, fails + 1), 0)
+        return (jnp.where(ok, sol.x, x_prev), x_prev, ok_h, fails), sol
 
     idx = jnp.arange(fresh.shape[0])
-    _, sols = jax.lax.scan(step, (z0, z0, jnp.asarray(True)), (thetas, fresh, idx))
+    _, sols = jax.lax.scan(step, (z0, z0, jnp.asarray(True), jnp.asarray(0)),
+                           (thetas, fresh, idx))
     return sols
 
 
 def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, margin,
                      margin_parts: Callable, g1: Callable, g2: Callable, *, drive,
                      steps_per_pitch: int, line_contact: bool = False, tips=None,
-                     tol: float = 1e-11, max_steps: int = 30, n_homotopy: int = 8):
+                     corners: bool = True, tol: float = 1e-11, max_steps: int = 30,
+                     n_homotopy: int = 8):
     """Edge contacts (face ends, and tip edges with ``tips``) beside ``path`` and the
     contact actually made (traceable).
 
@@ -228,7 +365,8 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
     ``(face1, rest1, face2, rest2)``, tip and root together.  ``g1, g2`` : face-end
     functions of pinion and gear (module docstring).  ``tips = (t1, t2)`` : tip-edge
     functions ``t_k(q)`` (mm, zero on the tip surface, > 0 below it) of pinion and
-    gear, or ``None`` (face ends only).  ``drive`` : True on the drive side (may be traced).
+    gear, or ``None`` (face ends only).  ``corners`` (with ``tips``): also the four
+    corner candidates (each tip edge at each end; module docstring, "Corners").  ``drive`` : True on the drive side (may be traced).
     ``steps_per_pitch`` : grid steps per angular pitch (the neighbouring tooth pairs
     are pair 0 shifted by that many steps).
     ``line_contact`` : ``path`` was solved in line-contact mode (one face-width section):
@@ -243,7 +381,7 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
     n = path.phi1.shape[0]
     mid = n // 2
     t1, t2 = (None, None) if tips is None else tips
-    nc = 4 if tips is None else 6
+    nc = 4 if tips is None else (10 if corners else 6)
     v1_fixed = jax.lax.stop_gradient(path.uv1[mid, 1])
     F, cs = edge_contact_system(r1, r2, asm, mis, g1, g2, t1, t2, line_contact=line_contact,
                                 v1_fixed=v1_fixed)
@@ -260,7 +398,11 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
     def edge_values(g, t, q, e, tip):
         return jax.vmap(lambda qq: start_value(g, t, qq, e, tip))(q)
 
-    def one_edge(pinion, e, tip):
+    def end_values(e):
+        # the corner's end function along the path
+        return jax.vmap(lambda a, b: corner_end(g1, g2, a, b, e))(path.p1_body, path.p2_body)
+
+    def one_edge(pinion, e, tip, corner):
         # the start: the surface contact at the reference (face ends) or, for a tip
         # edge, at the converged grid point where the surface contact is nearest that
         # tip (the homotopy is then short and starts on the branch the corner takes
@@ -271,6 +413,7 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
         near = jnp.argmin(jnp.where(path.converged, jnp.abs(gv), jnp.inf))
         i0 = jnp.where((tip > 0.5) & jnp.any(path.converged), near, mid)
         g0 = gv[i0]
+        g0b = jax.lax.stop_gradient(end_values(e))[i0]
         x0 = jnp.concatenate([path.uv1[i0], path.uv2[i0], path.phi2[i0][None]])
         psi0 = [None if p is None else p[i0] for p in (path.psi1, path.psi2)]
         z0 = jax.lax.stop_gradient(cs.join(x0, *psi0))
@@ -287,10 +430,11 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
         pad = jnp.stack([fwd > n - 1, bwd < 0])
         fresh = jnp.concatenate([jnp.zeros((2, k), bool),
                                  pad | (steps == 0)[None, :]], axis=1)
-        const = [v + 0.0 * levels for v in (g0, pinion, e, tip)]
+        const = [v + 0.0 * levels for v in (g0, pinion, e, tip, g0b, corner)]
 
         def run(ph, fr):
-            return _continue(F, z0, (ph, levels, *const), fr, k, tol, max_steps)
+                return _continue(F, z0, (ph, levels, *const), fr, k, tol, max_steps,
+                             give_up=corner > 0.5)
 
         sols = jax.vmap(run)(phis, fresh)
         ok_ref = sols.converged[0, k - 1] & sols.converged[1, k - 1]
@@ -303,9 +447,9 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
 
         return whole(sols.x), whole(sols.converged) & ok_ref, whole(sols.residual)
 
-    pin_np, tip_np = _PINION[:nc], _TIP[:nc]
-    Z, conv, res = jax.vmap(one_edge)(jnp.asarray(pin_np), jnp.asarray(_END[:nc]),
-                                      jnp.asarray(tip_np))
+    pin_np, tip_np, corner_np = _PINION[:nc], _TIP[:nc], _CORNER[:nc]
+    Z, conv, res = jax.vmap(one_edge)(*(jnp.asarray(a) for a in
+                                        (pin_np, _END[:nc], tip_np, corner_np)))
 
     def post(z, ph1):
         x, psi1, psi2 = cs.split(z)
@@ -319,6 +463,13 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
     (ph2, uv1, uv2, q1, q2, n1, n2, psi1, psi2) = jax.vmap(
         lambda zz: jax.vmap(post)(zz, path.phi1))(Z)
     parts = jax.vmap(margin_parts)(q1, q2, uv1, uv2)
+    if nc > 6:
+        slope = jax.vmap(lambda zz, pk, ek: jax.vmap(
+            lambda z1, p1: _corner_slope(cs, r1, r2, R, c, mis, asm, g1, g2, t1, t2, z1, p1,
+                                         pk, ek))(zz, path.phi1))(
+            Z, jnp.asarray(_PINION[:nc]), jnp.asarray(_END[:nc]))
+    else:
+        slope = jnp.zeros(Z.shape[:2] + (2,))
     if len(parts) == 4:
         # face ends only: (face1, rest1, face2, rest2), tip and root margins together
         if tips is not None:
@@ -330,14 +481,25 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
         face1, tip1, root1, face2, tip2, root2 = parts
     pin = pin_np[:, None] > 0.5
     is_tip = tip_np[:, None] > 0.5
+    is_corner = corner_np[:, None] > 0.5
     # the edge point inside the other boundaries of its own flank (a face end: tip and
-    # root; a tip edge: face width and root) and the mating point inside its flank
+    # root; a tip edge: face width and root; a corner: face width and root, its tip is
+    # its equation) and the mating point inside its flank.  A corner lies on a face end
+    # of one member by its end equation, and with equal face widths on both: its face
+    # margins are zero to the solver's tolerance and count with CORNER_TOL (both ends
+    # are checked: the end equation bounds the point at end e only)
+    slack = jnp.where(is_corner, CORNER_TOL, 0.0)
     own_root = jnp.where(pin, root1, root2)
-    own = jnp.where(is_tip, jnp.where(pin, face1, face2), jnp.where(pin, tip1, tip2))
-    mate = jnp.where(pin, jnp.minimum(face2, jnp.minimum(tip2, root2)),
-                     jnp.minimum(face1, jnp.minimum(tip1, root1)))
+    own = jnp.where(is_tip, jnp.where(pin, face1, face2), jnp.where(pin, tip1, tip2)) + slack
+    mate = jnp.where(pin, jnp.minimum(face2 + slack, jnp.minimum(tip2, root2)),
+                     jnp.minimum(face1 + slack, jnp.minimum(tip1, root1)))
     other = jnp.minimum(jnp.minimum(own, own_root), mate)
-    valid = conv & (other >= 0.0)
+    # a corner leads only where the tip edge runs from it into the face behind it in
+    # the sense of the load (module docstring, "Corners"): else the tip edge's interior
+    # would pass through the mating flank (a corner point on the flank from inside)
+    sgn_load = jnp.where(drive, 1.0, -1.0)
+    ahead = ~is_corner | (jnp.max(sgn_load * slope, axis=-1) <= CORNER_SLOPE_TOL)
+    valid = conv & (other >= 0.0) & ahead
     # TE from the reference contact of the path (not from the path's own value at each
     # angle: where the surface solve failed that may be NaN, and an edge contact there
     # is still a contact)

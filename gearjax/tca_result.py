@@ -58,7 +58,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax.edge_contact import EDGE_NAMES, FACE_END_KINDS, TIP_KINDS
+from gearjax.edge_contact import CORNER_KINDS, EDGE_NAMES, FACE_END_KINDS, TIP_KINDS
 from gearjax.fields import strong_float64
 from gearjax.frames import matrix_z
 from gearjax.surfaces import local_geometry
@@ -360,7 +360,10 @@ class TCAResult:
         tip_contact : pair 0 carries the load at the tip edge of pinion or gear
             (corner contact off the line of action: premature contact at the start
             of mesh or prolonged contact at its end, e.g. under a base-pitch
-            mismatch).  Also raises ``edge_contact``.
+            mismatch), or at a corner where the tip edge meets a face end (a tip
+            contact under a misalignment that tilts the tip edge against the mating
+            flank: ``path.edge_kind`` in :data:`~gearjax.edge_contact.CORNER_KINDS`).
+            Also raises ``edge_contact``.
         low_contact_ratio : contact ratio below 1 (or not found): gaps in the
             envelope, the motion is not transmitted continuously.
         large_te : the TE envelope's peak-to-peak exceeds :data:`LARGE_TE_ARCSEC`
@@ -425,8 +428,8 @@ class TCAResult:
         return [n for n in self.edges_loaded() if EDGE_NAMES.index(n) in FACE_END_KINDS]
 
     def tips_loaded(self) -> list[str]:
-        """The tip edges among :meth:`edges_loaded`."""
-        return [n for n in self.edges_loaded() if EDGE_NAMES.index(n) in TIP_KINDS]
+        """The tip edges and the corners (tip edge x face end) among :meth:`edges_loaded`."""
+        return [n for n in self.edges_loaded() if EDGE_NAMES.index(n) in TIP_KINDS + CORNER_KINDS]
 
     def warnings(self) -> list[str]:
         """Human-readable warnings for the flags that are raised (empty if none)."""

@@ -370,3 +370,261 @@ def test_hypoid_tip_edge_function_is_the_face_cone():
     f1, tip1, root1, *_ = parts(q[None] - jnp.array([[d, 0.0, 0.0]]), q[None])
     assert float(tip1[0]) == pytest.approx(d * cos_g, rel=1e-12)
     assert float(f1[0]) > 0 and float(root1[0]) > 0
+
+
+# -- corners: tip edge x face end under a shaft-angle error ----------------------------
+#
+# Closed form (independent of the TCA): the pinion is aligned (world = body frame turned
+# by phi1 about z, shifted by dP along z), the gear is turned by phi2 about its body z
+# and then by dg about the centre line y (right-handed rotation R_y(dg)), its centre at
+# (0, a, 0).  A spur tooth's tip edge is the straight line of its flank at radius r_a,
+# parallel to its body axis; the transverse flanks are the plane involutes of
+# _ClosedFormSpur.  The gear's tip edge touches the pinion flank at a world point W on
+# the pinion's involute: one scalar equation in phi2 (brentq), with W at the gear's
+# face end (the gear's own corner, body z = e b/2) or at the pinion's face end (world
+# z = e b/2 + dP, where the tip edge crosses it); the pinion's tip edge touches the
+# gear flank at a gear body point read off directly (explicit in phi2).  Exact in dg
+# (no small-angle terms neglected).  The rigid teeth touch at the candidate furthest
+# ahead: where the TE of the tip-edge point grows along the face (to first order
+# linearly, d TE/dz = +-dg cos(alpha)/r_b2), at one end of the tip edge.
+
+def _rot_y(t):
+    c, s = np.cos(t), np.sin(t)
+    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+
+
+def _tip_corners(cf, ph1, dg, dP, b, tip):
+    """{name: (phi2, valid)} of the tip-edge end candidates of pair 0 at pinion angle
+    ``ph1``: the own corners ("gear tip/toe corner", ...), the crossings of the mating
+    face ends ("gear tip x pinion toe", ...; EDGE_NAMES calls both the toe/heel corner
+    of the tip edge), and the tip edge in the pinion's section z = 0 ("section")."""
+    from scipy.optimize import brentq
+    g1, g2 = cf.g
+    c = np.array([0.0, cf.a, 0.0])
+    Ry = _rot_y(dg)
+    out = {}
+    if tip == "gear tip":
+        th = 0.5 * np.pi + cf.sig[1] * cf.psi(1, g2["ra"])
+        e2 = np.array([np.cos(th), np.sin(th)]) * g2["ra"]
+
+        def world(ph2, zb):
+            cz, sz = np.cos(ph2), np.sin(ph2)
+            return c + Ry @ np.array([cz * e2[0] - sz * e2[1], sz * e2[0] + cz * e2[1], zb])
+
+        def on_pinion(W):
+            R = np.hypot(W[0], W[1])
+            if R <= g1["rb"]:
+                return np.nan, R
+            return (np.angle(np.exp(1j * (np.arctan2(W[1], W[0]) - ph1 - 0.5 * np.pi
+                                          - cf.sig[0] * cf.psi(0, R)))), R)
+
+        def zb_at(ph2, zw):
+            # gear body z of the tip-edge point at world z zw: with x' the body x of
+            # R_z(phi2) q, W_z = -sin(dg) x' + cos(dg) zb, and W_x = cos(dg) x' at zb = 0
+            xp = (world(ph2, 0.0)[0] - c[0]) / np.cos(dg)
+            return (zw + np.sin(dg) * xp) / np.cos(dg)
+
+        ph2_0 = cf.candidates(ph1).get("gear tip")
+        if ph2_0 is None:
+            return out
+        cases = {"gear tip/toe corner": ("own", -1), "gear tip/heel corner": ("own", 1),
+                 "gear tip x pinion toe": ("cross", -1), "gear tip x pinion heel": ("cross", 1),
+                 "section": ("cross", 0)}
+        for name, (how, e) in cases.items():
+            def zb(ph2):
+                return e * 0.5 * b if how == "own" else zb_at(ph2, e * 0.5 * b + dP)
+
+            f = lambda ph2: on_pinion(world(ph2, zb(ph2)))[0]
+            lo, hi = ph2_0 - 2e-3, ph2_0 + 2e-3
+            if not (np.isfinite(f(lo)) and np.isfinite(f(hi))) or f(lo) * f(hi) > 0:
+                continue
+            ph2 = brentq(f, lo, hi, xtol=1e-15, rtol=1e-15)
+            W = world(ph2, zb(ph2))
+            R = on_pinion(W)[1]
+            ok = (g1["rF"] <= R <= g1["ra"] and abs(W[2] - dP) <= 0.5 * b + 1e-9
+                  and abs(zb(ph2)) <= 0.5 * b + 1e-9)
+            out[name] = (ph2, ok)
+    else:
+        t = ph1 + 0.5 * np.pi + cf.sig[0] * cf.psi(0, g1["ra"])
+        xy = g1["ra"] * np.array([np.cos(t), np.sin(t)])
+        cases = {"pinion tip/toe corner": ("own", -1), "pinion tip/heel corner": ("own", 1),
+                 "pinion tip x gear toe": ("cross", -1), "pinion tip x gear heel": ("cross", 1),
+                 "section": ("own", 0)}
+        for name, (how, e) in cases.items():
+            # gear body point Q = R_z(-phi2) R_y(-dg) (P - c); its z and radius do not
+            # depend on phi2
+            zp = (e * 0.5 * b + dP if how == "own"
+                  else (e * 0.5 * b - np.sin(dg) * xy[0]) / np.cos(dg))   # world z of P
+            P = np.array([xy[0], xy[1], zp])
+            Q = Ry.T @ (P - c)
+            R2 = np.hypot(Q[0], Q[1])
+            if R2 <= g2["rb"]:
+                continue
+            ph2 = np.arctan2(Q[1], Q[0]) - 0.5 * np.pi - cf.sig[1] * cf.psi(1, R2)
+            ok = (g2["rF"] <= R2 <= g2["ra"] and abs(Q[2]) <= 0.5 * b + 1e-9
+                  and abs(zp - dP) <= 0.5 * b + 1e-9)
+            out[name] = (ph2, ok)
+    return out
+
+
+def _corner_name(name):
+    """EDGE_NAMES' name of a candidate of _tip_corners (a crossing of the mating face end
+    is the tip edge's corner at that end)."""
+    if " x " not in name:
+        return name
+    tip, end = name.split(" x ")
+    return f"{tip}/{end.split()[1]} corner"
+
+
+@pytest.mark.parametrize("da,tip,dg_deg,dP,where", [
+    (1.0, "gear tip", 0.1, 0.0, "gear tip/heel corner"),
+    (1.0, "gear tip", -0.1, 0.0, "gear tip/toe corner"),
+    (1.0, "gear tip", 0.1, -1.0, "gear tip x pinion heel"),
+    (-1.0, "pinion tip", 0.1, 0.0, "pinion tip/heel corner"),
+    (-1.0, "pinion tip", -0.1, 1.0, "pinion tip/toe corner")],
+    ids=["premature+", "premature-", "premature-crossing", "prolonged+", "prolonged-dP"])
+def test_tip_corner_under_a_shaft_angle_error_matches_the_closed_form(traced, mismatch, da,
+                                                                      tip, dg_deg, dP, where):
+    """A base-pitch mismatch (tip contact) and a shaft-angle error dg (the tip edge
+    tilted against the mating flank): the tip touches at the leading end of its tip
+    edge -- its own corner, or where it crosses the mating face end -- ahead of the
+    tip contact in the mid-face section.  The TCA's contact (which candidate, and its
+    gear angle) against the closed form above, at every grid point where the tip
+    carries the load.  With the pinion shifted axially by dP = -1 mm the gear's
+    leading corner lies beyond the pinion's face: the tip edge touches where it crosses
+    the pinion's heel (reported as the gear tip's heel corner, at the pinion's heel).  The lead over the tip's point in the mid-face section (the
+    contact reported before corners were solved) is close to the line-of-action
+    estimate (b/2) dg cos(alpha)/r_b2 = 67.5 arcsec (measured 66.0-69.0: the normal at a
+    tip corner is not the line of action), far above the tolerance."""
+    des, _, _, cf = mismatch[da]
+    dg = np.radians(dg_deg)
+    mis = gj.Misalignment(*(jnp.asarray(v, float) for v in (0.0, dP, 0.0, dg)))
+    from gearjax.tca import rotation_about
+    np.testing.assert_allclose(np.asarray(rotation_about(jnp.array([0.0, 1.0, 0.0]), dg)),
+                               _rot_y(dg), atol=1e-15)         # the closed form's convention
+    path, margin, multi = traced[True](des, mis)
+    kind = np.asarray(path.edge_kind)
+    carried = (np.asarray(margin) >= 0.0) & (kind >= 0)
+    names = [EDGE_NAMES[k] for k in kind]
+    at_tip = [j for j in np.nonzero(carried)[0] if names[j].startswith(tip)]
+    assert len(at_tip) >= 3, [names[j] for j in np.nonzero(carried)[0]]
+    assert {names[j] for j in at_tip} == {_corner_name(where)}
+    phi1, phi2 = np.asarray(path.phi1), np.asarray(path.phi2)
+    lead_first_order = 0.5 * B * dg * np.cos(np.radians(20.0)) / RB2
+    errs = []
+    for j in at_tip:
+        cands = _tip_corners(cf, phi1[j], dg, dP, B, tip)
+        valid = {k: v[0] for k, v in cands.items() if v[1] and k != "section"}
+        # drive: the gear is turned furthest back (largest TE = smallest phi2 here:
+        # TE = -(phi2 - phi2_ref) + ...) by the leading candidate
+        lead = min(valid, key=valid.get)
+        assert lead == where and names[j] == _corner_name(lead), (j, names[j], valid)
+        errs.append(abs(phi2[j] - valid[lead]) / ARCSEC)
+        # ahead of the tip edge's point in the mid-face section (the old result)
+        ahead = (cands["section"][0] - valid[lead])
+        assert 0.9 * abs(lead_first_order) < ahead < 1.1 * abs(lead_first_order)
+    assert max(errs) < 1e-6, errs
+    # on the face end of the member that bounds it (the tip's own, or the mating one)
+    on_pinion = where.startswith("pinion") == (" x " not in where)
+    e = 1.0 if where.endswith("heel") or "heel corner" in where else -1.0
+    body = np.asarray(path.axial1 if on_pinion else path.axial2)[at_tip]
+    np.testing.assert_allclose(body, e * 0.5 * B, atol=1e-9)
+
+
+# -- VH-CATT tip edges -------------------------------------------------------------------
+
+def _vh_gear_corner(pair, cf, ph1, e):
+    """Gear angle (rad) at which the gear's tip corner at face end ``e`` touches the
+    pinion flank of the mismatched VH-CATT pair below, and the pinion point's radius
+    and section -- from the closed-form envelope of each member
+    (:func:`~gearjax.gears.vh_catt.geometry.envelope_point_np`, Willis' condition on
+    the rack, NumPy) and scalar root finding (SciPy): the gear corner is the flank
+    point of radius r_a2 in the section z = e b/2; turned by phi2 about the gear
+    centre, it must lie on the pinion flank in its section: the pinion point of the
+    same radius in that section (root in u) has the same polar angle (root in phi2)."""
+    from scipy.optimize import brentq
+    from gearjax.gears.vh_catt import geometry as G
+    pin = pair["pinion"]
+    k1 = G.tool_data(pin.module, pin.pressure_angle, pin.cutter_radius("pinion"), 17,
+                     G.HANDS["pinion"], -1.0, pin.blade_offset, xp=np)   # drive flanks
+    gp = pair["gear"]
+    k2 = G.tool_data(gp.module, gp.pressure_angle, gp.cutter_radius("gear"), 23,
+                     G.HANDS["gear"], -1.0, gp.blade_offset, xp=np)
+    z = e * 0.5 * float(gp.face_width)
+
+    def radius_u(k, R, zz):
+        # bracketed about the middle section's blade coordinate of that radius (rack
+        # geometry), on the working branch
+        ca, sa = float(k.cos_a), float(k.sin_a)
+        u0 = (np.sqrt(max(R ** 2 - (k.r * ca) ** 2, 0.0)) - k.r * sa) * sa / ca
+        f = lambda u: np.hypot(*G.envelope_point_np(k, u, zz)[0][:2]) - R
+        return brentq(f, u0 - 1.0, u0 + 1.0, xtol=1e-14, rtol=1e-15)
+
+    q2 = G.envelope_point_np(k2, radius_u(k2, cf.g[1]["ra"], z), z)[0]
+
+    def mismatch(ph2):
+        c, s_ = np.cos(ph2), np.sin(ph2)
+        W = np.array([c * q2[0] - s_ * q2[1], cf.a + s_ * q2[0] + c * q2[1]])
+        R = np.hypot(*W)
+        q1 = G.envelope_point_np(k1, radius_u(k1, R, z), z)[0]
+        return np.angle(np.exp(1j * (np.arctan2(W[1], W[0]) - ph1
+                                     - np.arctan2(q1[1], q1[0])))), R
+
+    ph2_0 = cf.candidates(ph1)["gear tip"]
+    ph2 = brentq(lambda p: mismatch(p)[0], ph2_0 - 1.5e-3, ph2_0 + 1.5e-3, xtol=1e-15, rtol=1e-15)
+    return ph2, mismatch(ph2)[1]
+
+
+def test_vh_catt_tip_contact_matches_closed_forms():
+    """VH-CATT: the pinion of the seed's pair (17/23, m = 4 mm, alpha = 20 deg, b = 28 mm,
+    R_T = 400 mm, blade offset 3 mm) cut with a blade angle 1 deg larger -- a deliberate
+    base-pitch mismatch (the pinion's base pitch is the smaller): premature contact of
+    the incoming pair at the gear tip.  Both members are symmetric about the middle
+    section, an exact involute pair (the rack-line envelope, tests/test_vh_catt.py), so
+    the tip edge's point there is a candidate whose gear angle the plane closed form
+    gives (_ClosedFormSpur, x = 0, centre distance r1 + r2); the other sections are not
+    involutes, and at the first grid points the gear's tip edge touches first at its
+    corners (toe and heel, equal by the symmetry): their gear angle from the closed-form
+    envelopes (_vh_gear_corner).  At each grid point where the gear tip carries the
+    load, the TCA's contact is the leading one of these candidates, at its gear angle."""
+    from dataclasses import replace
+    from gearjax.gears.vh_catt.tca import vh_flanks, vh_tca_traced
+    pair = gj.load_design("example:vh_catt_17x23").pair
+    pin = replace(pair, pressure_angle=pair.pressure_angle + np.radians(1.0))
+    run = jax.jit(lambda p, q, m: vh_tca_traced(p, m, -1.0, pinion=q))
+    path, margin, multi = run(pair, pin, _mis(0.0))
+    mid = path.phi1.shape[0] // 2
+    cf = _ClosedFormSpur(17, 23, 4.0, 20.0, 1.0, 80.0, (1.0, 1.0))
+    sig = []
+    r1, r2 = vh_flanks(pair, -1.0, pin)
+    for i, (r, uv) in enumerate(((r1, path.uv1[mid]), (r2, path.uv2[mid]))):
+        q = np.asarray(r(uv))
+        assert abs(q[2]) < 1e-9                              # the middle section
+        sig.append((np.arctan2(q[1], q[0]) - 0.5 * np.pi) / cf.psi(i, np.hypot(q[0], q[1])))
+    np.testing.assert_allclose(np.abs(sig), 1.0, atol=1e-9)   # the closed-form flanks
+    cf.sig = tuple(np.sign(sig))
+    kind = np.asarray(path.edge_kind)
+    carried = (np.asarray(margin) >= 0.0) & (kind >= 0)
+    names = [EDGE_NAMES[k] for k in kind]
+    assert {names[j] for j in np.nonzero(carried)[0]} <= {"gear tip", "gear tip/toe corner",
+                                                        "gear tip/heel corner"}
+    assert carried.sum() >= 3
+    phi1, phi2 = np.asarray(path.phi1), np.asarray(path.phi2)
+    pn = jax.tree_util.tree_map(np.asarray, {"pinion": pin, "gear": pair})
+    errs, seen = [], set()
+    for j in np.nonzero(carried)[0]:
+        cands = {"gear tip": cf.candidates(phi1[j]).get("gear tip")}
+        for e, name in ((-1.0, "gear tip/toe corner"), (1.0, "gear tip/heel corner")):
+            ph2, R = _vh_gear_corner(pn, cf, phi1[j], e)
+            if cf.g[0]["rF"] <= R <= cf.g[0]["ra"]:          # on the pinion flank
+                cands[name] = ph2
+        cands = {k: v for k, v in cands.items() if v is not None}
+        best = min(cands.values())       # drive: TE = -(phi2 - phi2_ref) + ...: max TE
+        lead = {k for k, v in cands.items() if v - best < 1e-6 * ARCSEC}
+        assert names[j] in lead, (j, names[j], cands)
+        errs.append(abs(phi2[j] - cands[names[j]]) / ARCSEC)
+        seen.add(names[j].split("/")[0])
+        if names[j] == "gear tip":
+            assert abs(float(path.axial2[j])) < 1e-9
+    assert max(errs) < 1e-6, errs
+    np.testing.assert_allclose(np.asarray(path.radial2)[carried], cf.g[1]["ra"], atol=1e-9)

@@ -323,7 +323,7 @@ def test_second_branch_past_the_edge_of_regression_is_off_the_flank(pair):
     parts = margin_parts(pair)
     q2 = jnp.asarray(work)[None]          # any on-flank gear point: only the pinion matters
     uv = jnp.zeros((1, 2))
-    _, root_work, _, _ = parts(jnp.asarray(work)[None], q2, uv, uv)
-    _, root_second, _, _ = parts(jnp.asarray(second)[None], q2, jnp.array([[u2, 0.0]]), uv)
+    _, _, root_work, *_ = parts(jnp.asarray(work)[None], q2, uv, uv)
+    _, _, root_second, *_ = parts(jnp.asarray(second)[None], q2, jnp.array([[u2, 0.0]]), uv)
     assert float(root_work[0]) > 0.0
     assert float(root_second[0]) < 0.0

@@ -334,13 +334,14 @@ def involute_tca_traced(des: InvoluteTCA, mis: Misalignment, *, side: int = -1,
                         steps_per_pitch: int = 24, half_pitches: float = 1.25,
                         line_contact: bool = True, n_pairs: int = 3,
                         approach=DEFAULT_APPROACH, face_ends: bool = True,
-                        tip_edges: bool = True):
+                        tip_edges: bool = True, corners: bool = True):
     """Traceable TCA of an involute pair: ``(path, margin, multi)``.
 
     With ``face_ends`` (default) the contact at the face ends of both members is
     solved too, with ``tip_edges`` (default) also the contact of each member's tip
     edge with the mating flank (in line contact: the tip corner of the transverse
-    section solved, :func:`crowned_pinion_flank` with ``transverse``), and the contact made at each pinion angle is the
+    section solved, :func:`crowned_pinion_flank` with ``transverse``) and with ``corners``
+    (default) the corners where a tip edge meets a face end, and the contact made at each pinion angle is the
     surface or the edge contact (:func:`gearjax.edge_contact.face_end_contact`;
     ``path.edge_kind``).
 
@@ -363,7 +364,7 @@ def involute_tca_traced(des: InvoluteTCA, mis: Misalignment, *, side: int = -1,
         path, margin, _ = face_end_contact(r1, r2, asm, mis, path, margin, parts, g1, g2,
                                            drive=side < 0, line_contact=line_contact,
                                            steps_per_pitch=steps_per_pitch,
-                                           tips=tips if tip_edges else None)
+                                           tips=tips if tip_edges else None, corners=corners)
     multi = multi_pair(path, margin, steps_per_pitch, p.z1, drive=(side < 0), n_pairs=n_pairs)
     return path, margin, multi
 

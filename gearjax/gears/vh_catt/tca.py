@@ -21,7 +21,11 @@ move the contact off the middle section, where the sections are not involutes.
 Flank boundaries: tip circles ``r + m``, form circles of the straight blades
 (:func:`gearjax.gears.vh_catt.geometry.pair_geometry`; those of the middle section,
 which the other sections follow to within the trace's small tangential extent) and
-the face ends ``|z| <= b/2`` (with edge contact, :mod:`gearjax.edge_contact`).
+the face ends ``|z| <= b/2``.  Edge contact (:mod:`gearjax.edge_contact`): the face
+ends, the tip edges on the addendum cylinders ``t_k = r_ak - |q_xy|`` and the corners
+where they meet (premature/prolonged contact of a mismatched pair; the corners lead
+where the TE along a tip edge is lowest in the middle section, as found for a pinion
+with a blade angle 1 deg off, tests/test_edge_contact.py).
 
 Units: mm, rad.  References: [VH-CATT]; [Litvin2004] ch. 9.
 """
@@ -64,16 +68,19 @@ def vh_assembly(pair: VHCattPair) -> Assembly:
                     pair.z1, pair.z2, -1)
 
 
-def vh_flanks(pair: VHCattPair, code):
-    """Pinion and gear flanks of side ``code`` (-1 drive, +1 coast; may be traced)."""
-    return generated_flank(pair, "pinion", code), generated_flank(pair, "gear", code)
+def vh_flanks(pair: VHCattPair, code, pinion: VHCattPair | None = None):
+    """Pinion and gear flanks of side ``code`` (-1 drive, +1 coast; may be traced); the
+    pinion cut as the pinion of ``pinion`` where given (a deliberately mismatched pinion,
+    e.g. another blade angle: :func:`vh_tca_traced`)."""
+    return (generated_flank(pair if pinion is None else pinion, "pinion", code),
+            generated_flank(pair, "gear", code))
 
 
-def reference_guess(pair: VHCattPair, code):
+def reference_guess(pair: VHCattPair, code, pinion: VHCattPair | None = None):
     """``(x_ref, phi1_ref)``: guess ``(u1, v1, u2, v2, phi2)`` at the middle-section pitch
     point and the pinion angle that puts the pinion's point there (module docstring).
     ``phi1_ref`` carries its derivative (the grid moves with the design)."""
-    r1, r2 = vh_flanks(pair, code)
+    r1, r2 = vh_flanks(pair, code, pinion)
     zero = jnp.zeros(2)
     q1, q2 = r1(zero), r2(zero)
     phi1 = jnp.pi / 2 - jnp.arctan2(q1[1], q1[0])
@@ -82,9 +89,10 @@ def reference_guess(pair: VHCattPair, code):
     return jax.lax.stop_gradient(x), phi1
 
 
-def _limits(pair: VHCattPair):
+def _limits(pair: VHCattPair, pinion: VHCattPair | None = None):
     geo = pair_geometry(pair)
-    return geo["ra1"], geo["rf1"], geo["ra2"], geo["rf2"], 0.5 * pair.face_width
+    geo1 = geo if pinion is None else pair_geometry(pinion)
+    return geo1["ra1"], geo1["rf1"], geo["ra2"], geo["rf2"], 0.5 * pair.face_width
 
 
 def _root_margin(r, u, rf, rb, rp, alpha):
@@ -99,17 +107,19 @@ def _root_margin(r, u, rf, rb, rp, alpha):
     return jnp.where(u >= u_b, r - rf, 2.0 * rb - rf - r)
 
 
-def _root_parts(pair: VHCattPair):
+def _root_parts(pair: VHCattPair, pinion: VHCattPair | None = None):
     geo = pair_geometry(pair)
-    al = pair.pressure_angle
-    return ((geo["rf1"], geo["rb1"], geo["r1"], al), (geo["rf2"], geo["rb2"], geo["r2"], al))
+    p1 = pair if pinion is None else pinion
+    geo1 = pair_geometry(p1)
+    return ((geo1["rf1"], geo1["rb1"], geo1["r1"], p1.pressure_angle),
+            (geo["rf2"], geo["rb2"], geo["r2"], pair.pressure_angle))
 
 
-def vh_margin(pair: VHCattPair, path: ContactPath):
+def vh_margin(pair: VHCattPair, path: ContactPath, pinion: VHCattPair | None = None):
     """Boundary margin (mm, >= 0 inside both flanks) along the path, and its parts
     (tip, form circle, face width of pinion; the same of the gear)."""
-    ra1, rf1, ra2, rf2, hb = _limits(pair)
-    (c1, c2) = _root_parts(pair)
+    ra1, rf1, ra2, rf2, hb = _limits(pair, pinion)
+    (c1, c2) = _root_parts(pair, pinion)
     parts = jnp.stack([ra1 - path.radial1, _root_margin(path.radial1, path.uv1[:, 0], *c1),
                        hb - jnp.abs(path.axial1),
                        ra2 - path.radial2, _root_margin(path.radial2, path.uv2[:, 0], *c2),
@@ -118,48 +128,65 @@ def vh_margin(pair: VHCattPair, path: ContactPath):
 
 
 def margin_parts(pair: VHCattPair):
-    """``margin_parts(q1, q2, uv1, uv2) -> (face1, tip1_or_root1, face2, tip2_or_root2)``:
+    """``margin_parts(q1, q2, uv1, uv2) -> (face1, tip1, root1, face2, tip2, root2)``:
     the boundary margins (mm, >= 0 inside) of pinion and gear at body points with their
     flank parameters (:func:`gearjax.edge_contact.face_end_contact`)."""
     return _face_ends(pair)[0]
 
 
-def _face_ends(pair: VHCattPair):
-    ra1, rf1, ra2, rf2, hb = _limits(pair)
-    (c1, c2) = _root_parts(pair)
+def _face_ends(pair: VHCattPair, pinion: VHCattPair | None = None):
+    """``(margin_parts, g1, g2, (t1, t2))`` of :func:`gearjax.edge_contact.face_end_contact`:
+    the margins of face width ``b/2 - |q_z|``, tip ``r_a - |q_xy|`` and form circle
+    (:func:`_root_margin`) of each member, the face ends ``g(q, e) = q_z - e b/2`` and
+    the tip edges ``t_k(q) = r_ak - |q_xy|`` (mm): the blank of a VH-CATT member is the
+    addendum cylinder ``r_a = r + m`` (:func:`~gearjax.gears.vh_catt.geometry.pair_geometry`),
+    as for an involute member."""
+    ra1, rf1, ra2, rf2, hb = _limits(pair, pinion)
+    (c1, c2) = _root_parts(pair, pinion)
 
     def margin_parts(q1, q2, uv1, uv2):
         r1 = jnp.linalg.norm(q1[..., :2], axis=-1)
         r2 = jnp.linalg.norm(q2[..., :2], axis=-1)
-        return (hb - jnp.abs(q1[..., 2]),
-                jnp.minimum(ra1 - r1, _root_margin(r1, uv1[..., 0], *c1)),
-                hb - jnp.abs(q2[..., 2]),
-                jnp.minimum(ra2 - r2, _root_margin(r2, uv2[..., 0], *c2)))
+        return (hb - jnp.abs(q1[..., 2]), ra1 - r1, _root_margin(r1, uv1[..., 0], *c1),
+                hb - jnp.abs(q2[..., 2]), ra2 - r2, _root_margin(r2, uv2[..., 0], *c2))
 
     def g(q, e):
         return q[2] - e * hb
 
-    return margin_parts, g, g
+    def t1(q):
+        return ra1 - jnp.linalg.norm(q[:2])
+
+    def t2(q):
+        return ra2 - jnp.linalg.norm(q[:2])
+
+    return margin_parts, g, g, (t1, t2)
 
 
 def vh_tca_traced(pair: VHCattPair, mis: Misalignment, code, *, steps_per_pitch: int = 24,
                   half_pitches: float = 1.25, n_pairs: int = 3, approach=DEFAULT_APPROACH,
-                  face_ends: bool = True):
+                  face_ends: bool = True, tip_edges: bool = True, corners: bool = True,
+                  pinion: VHCattPair | None = None):
     """Traceable point-contact TCA: ``(path, margin, multi)`` on the uniform grid of
     pinion angles ``phi1_ref + k 2 pi/(z1 steps_per_pitch)``, ``|k| <=
     round(half_pitches steps_per_pitch)``; with ``face_ends`` the edge contacts at the
-    face ends are solved too (:func:`gearjax.edge_contact.face_end_contact`)."""
-    x_ref, phi1_ref = reference_guess(pair, code)
+    face ends are solved too, with ``tip_edges`` also those of the tip edges and, with
+    ``corners``, of the corners (tip edge x face end)
+    (:func:`gearjax.edge_contact.face_end_contact`).
+    ``pinion`` : cut the pinion as the pinion of this pair instead (same tooth numbers
+    and module; e.g. another blade angle: a deliberate base-pitch mismatch, whose tip
+    contacts the tests check); its own tip and form circles bound its flank."""
+    x_ref, phi1_ref = reference_guess(pair, code, pinion)
     grid = pinion_angle_grid(phi1_ref, pair.z1, steps_per_pitch, half_pitches)
-    r1, r2 = vh_flanks(pair, code)
+    r1, r2 = vh_flanks(pair, code, pinion)
     asm = vh_assembly(pair)
     path = contact_path(r1, r2, asm, mis, grid, x_ref, line_contact=False, approach=approach)
-    margin, _ = vh_margin(pair, path)
+    margin, _ = vh_margin(pair, path, pinion)
     if face_ends:
-        parts, g1, g2 = _face_ends(pair)
+        parts, g1, g2, tips = _face_ends(pair, pinion)
         path, margin, _ = face_end_contact(r1, r2, asm, mis, path, margin, parts, g1, g2,
                                            drive=code < 0, line_contact=False,
-                                           steps_per_pitch=steps_per_pitch)
+                                           steps_per_pitch=steps_per_pitch,
+                                           tips=tips if tip_edges else None, corners=corners)
     multi = multi_pair(path, margin, steps_per_pitch, pair.z1, drive=(code < 0),
                        n_pairs=n_pairs)
     return path, margin, multi
