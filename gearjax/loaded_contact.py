@@ -311,7 +311,10 @@ def pair_compliance(teeth: MeshTeeth, r_x, load_per_width, model: str = "weber",
     t1, t2 = tooth(0), tooth(1)
     q = (t1.total + t2.total) / teeth.width
     if teeth.line_length is not None:
-        qc = contact_compliance(load_per_width, r_x, t1.half_thickness, t2.half_thickness,
-                                E, nu)
+        # Weber's body depths: from the contact point to each tooth's centre line
+        # along the load line, h = y_m / cos(alpha_m) (docs/compliance.md)
+        h1 = t1.half_thickness / jnp.cos(t1.load_angle)
+        h2 = t2.half_thickness / jnp.cos(t2.load_angle)
+        qc = contact_compliance(load_per_width, r_x, h1, h2, E, nu)
         q = q + qc / teeth.line_length
     return q
