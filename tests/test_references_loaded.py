@@ -521,3 +521,123 @@ def test_spur_member_swap(spur_drive, spur_swapped):
     pw = np.sort(np.asarray(w.loaded.p_max).ravel())
     np.testing.assert_allclose(pw.max(), pd.max(), rtol=0.05)
     np.testing.assert_allclose(pw[pw > 0].min(), pd[pd > 0].min(), rtol=0.05)
+
+
+# ---------------------------------------------------------------------------------
+# VH-CATT: the loaded contact by hand at the loaded contact points
+# ---------------------------------------------------------------------------------
+
+VH_TORQUE, VH_RPM = 100.0, 1000.0
+
+
+@pytest.fixture(scope="module")
+def vh_run(oil_surface):
+    des = gj.load_design("example:vh_catt_17x23")
+    return des.pair, gj.mesh_efficiency(des, VH_TORQUE, VH_RPM, *oil_surface)
+
+
+def test_vh_catt_hertz_by_hand_at_the_loaded_contacts(vh_run):
+    """Exact Hertz (scipy elliptic integrals, Johnson's equations) of each loaded
+    contact from the library's load and principal relative radii."""
+    pair, (eff, res) = vh_run
+    F = np.asarray(eff.loaded.load)
+    rx = _per_pair(res, eff, res.kinematics.r_x)
+    ry = _per_pair(res, eff, res.kinematics.r_y)
+    loaded = F > 0.0
+    assert np.all(np.asarray(eff.valid)) and loaded.sum() >= 24
+    p, a, b = (np.asarray(v) for v in (eff.loaded.p_max, eff.loaded.semi_major,
+                                       eff.loaded.semi_minor))
+    for k, j in zip(*np.nonzero(loaded)):
+        p_ref, ay, bx, _ = _hertz_johnson(F[k, j], rx[k, j], ry[k, j], E_PRIME)
+        np.testing.assert_allclose([p[k, j], a[k, j], b[k, j]], [p_ref, ay, bx], rtol=1e-8)
+
+
+def test_vh_catt_lever_arms_balances_and_approach_by_hand(vh_run):
+    """Aligned VH-CATT pair: the contact lies in the middle section, an exact involute,
+    so the normal force's moment arm about the pinion axis is r_b1 = m z1 cos(alpha)/2
+    (hand, from the point and normal by numpy's cross product); about the gear axis
+    l2 = l1 / |dphi2/dphi1| with the derivative by differencing the TCA's gear angle.
+    Moments: sum l1 F = T1 and sum l2 F = T1 z2 / z1 (power balance).  In single
+    contact the approach is q F + delta_Hertz(F): q from the two teeth's compliance
+    over the loaded width, delta_Hertz by scipy."""
+    pair, (eff, res) = vh_run
+    from gearjax.tooth_compliance import tooth_compliance
+    z1, z2 = int(pair.z1), int(pair.z2)
+    m, al, bw = float(pair.module), float(pair.pressure_angle), float(pair.face_width)
+    F = np.asarray(eff.loaded.load)
+    loaded = F > 0.0
+    pt, nn = np.asarray(res.path.point), np.asarray(res.path.normal)
+    l1_0 = np.abs(np.cross(pt, nn)[:, 2])
+    dphi = np.gradient(np.asarray(res.path.phi2), np.asarray(res.path.phi1))
+    l1 = _per_pair(res, eff, l1_0)
+    l2 = _per_pair(res, eff, l1_0 / np.abs(dphi))
+    rb1 = 0.5 * m * z1 * math.cos(al)
+    np.testing.assert_allclose(l1[loaded], rb1, rtol=1e-7)
+    T1 = 1e3 * VH_TORQUE
+    np.testing.assert_allclose(np.sum(np.where(loaded, l1 * F, 0.0), axis=0), T1, rtol=1e-7)
+    np.testing.assert_allclose(np.sum(np.where(loaded, l2 * F, 0.0), axis=0), T1 * z2 / z1,
+                               rtol=1e-6)
+    # single contact: the leading pair (gap 0) has w = l2 y
+    single = loaded.sum(axis=0) == 1
+    assert single.sum() >= 5
+    k = np.argmax(F, axis=0)
+    j = np.nonzero(single)[0]
+    w = np.asarray(eff.loaded.approach)[k[j], j]
+    y = np.asarray(eff.loaded.deflection)[j]
+    np.testing.assert_allclose(w / y, l2[k[j], j], rtol=1e-6)
+    # the approach by the compliance route
+    rad1 = _per_pair(res, eff, res.path.radial1)[k[j], j]
+    rad2 = _per_pair(res, eff, res.path.radial2)[k[j], j]
+    width = np.minimum(2.0 * _per_pair(res, eff, res.path.semi_major)[k[j], j], bw)
+    rx = _per_pair(res, eff, res.kinematics.r_x)[k[j], j]
+    ry = _per_pair(res, eff, res.kinematics.r_y)[k[j], j]
+    for i, jj in enumerate(j):
+        Fi = F[k[jj], jj]
+        q = (float(tooth_compliance(rad1[i], z1, m, al, 0.0, 1.0, 1.25).total)
+             + float(tooth_compliance(rad2[i], z2, m, al, 0.0, 1.0, 1.25).total)) / width[i]
+        w_ref = q * Fi + _hertz_johnson(Fi, rx[i], ry[i], E_PRIME)[3]
+        np.testing.assert_allclose(w[i], w_ref, rtol=1e-7)
+    # the loaded TE lies behind the unloaded envelope by y (drive)
+    te = np.where(loaded, _per_pair(res, eff, res.path.te), -np.inf).max(axis=0)
+    np.testing.assert_allclose(np.asarray(eff.loaded.te_loaded)[j], te[j] - y, rtol=1e-9)
+
+
+# ---------------------------------------------------------------------------------
+# preset bevel: the virtual cylindrical teeth of ISO 10300-1 by hand
+# ---------------------------------------------------------------------------------
+
+def test_preset_bevel_virtual_teeth_by_hand():
+    """MeshTeeth of the preset-TE bevel pair against ISO 10300-1 by hand: pitch
+    angles, mean cone distance R_m = A_o - b/2, m_mn = 2 R_m sin(delta1) cos(beta)/z1,
+    z_vn = z / (cos(delta) cos^2(beta_vb) cos(beta)), the load radius r_v = z_vn m_mn/2
+    + h, the heights over m_mn and the loaded width min(2 a, b)."""
+    from gearjax.gears.preset_bevel.mesh import preset_mesh_teeth
+    des = gj.load_design("example:preset_te_bevel_10x30").design
+    res = gj.run_tca(des, side="drive", steps_per_pitch=16, half_pitches=1.0, n_pairs=3,
+                     kinematics=False)
+    t = preset_mesh_teeth(des, res, True)
+    z1, z2 = des.z1, des.z2
+    S, beta, an = float(des.shaft_angle), float(des.beta), float(des.alpha_n)
+    d1 = math.atan(math.sin(S) / (z2 / z1 + math.cos(S)))
+    d2 = S - d1
+    Ao = float(des.module_t) * z1 / (2.0 * math.sin(d1))
+    np.testing.assert_allclose(Ao * math.sin(d2) * 2.0 / z2, float(des.module_t), rtol=1e-12)
+    Rm = Ao - 0.5 * float(des.face_width)
+    m_mn = 2.0 * Rm * math.sin(d1) * math.cos(beta) / z1
+    bvb = math.asin(math.sin(beta) * math.cos(an))
+    zvn = [z / (math.cos(d) * math.cos(bvb) ** 2 * math.cos(beta)) for z, d in ((z1, d1), (z2, d2))]
+    np.testing.assert_allclose(t.module, m_mn, rtol=1e-12)
+    np.testing.assert_allclose(t.z, zvn, rtol=1e-12)
+    np.testing.assert_allclose(t.alpha, [an, an], rtol=1e-14)
+    np.testing.assert_allclose(t.beta, beta, rtol=1e-14)
+    np.testing.assert_allclose(t.ha, float(des.addendum) / m_mn, rtol=1e-12)
+    np.testing.assert_allclose(t.hf, float(des.dedendum) / m_mn + 0.25, rtol=1e-12)
+    ok = np.asarray(res.path.converged) & np.isfinite(np.asarray(res.coords["h1"]))
+    for i, key in ((0, "h1"), (1, "h2")):
+        r_ref = 0.5 * zvn[i] * m_mn + np.asarray(res.coords[key])
+        np.testing.assert_allclose(np.asarray(t.r_load[i])[ok], r_ref[ok], rtol=1e-12)
+    a = np.asarray(res.path.semi_major)
+    fin = ok & np.isfinite(a) & (a > 0)
+    np.testing.assert_allclose(np.asarray(t.width)[fin],
+                               np.minimum(2.0 * a[fin], float(des.face_width)), rtol=1e-14)
+    assert t.line_length is None and bool(t.drive)
