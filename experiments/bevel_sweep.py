@@ -386,6 +386,8 @@ def main(argv=None):
     ap.add_argument("--n", type=int, default=100)
     ap.add_argument("--seed", type=int, default=2027)
     ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "bevel_sweep"))
+    ap.add_argument("--skip", type=int, default=0,
+                    help="skip the first SKIP sampled designs (resume a killed run; merge by hand)")
     ap.add_argument("--from-json", action="store_true", help="rebuild OUT.md from OUT.json")
     a = ap.parse_args(argv)
     out = Path(a.out)
@@ -394,7 +396,7 @@ def main(argv=None):
         out.with_suffix(".md").write_text(markdown(data["summary"]))
         return
     rng = np.random.default_rng(a.seed)
-    designs = [sample(rng) for _ in range(a.n)]
+    designs = [sample(rng) for _ in range(a.n)][a.skip:]
     rows = []
     t0 = time.perf_counter()
     for i, d in enumerate(designs):
