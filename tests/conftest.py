@@ -84,7 +84,7 @@ def _release_compiled_code():
 # hypoid TCA program that test_gradients_end_to_end.py compiles early, and it compiles
 # the HFT program that test_synthesis_hypoid.py reuses (persistent cache, same options).
 SLOWEST_FIRST = (
-    "test_gradients_end_to_end.py", "test_cutter_radius_pair.py", "test_fuzz_designs.py",
+    "test_bevel_sweep.py", "test_gradients_end_to_end.py", "test_cutter_radius_pair.py", "test_fuzz_designs.py",
     "test_tca_hypoid.py", "test_synthesis.py", "test_preset_bevel_tca.py",
     "test_synthesis_hypoid.py",
     "test_edge_contact.py", "test_involute_sweep.py", "test_cutter_radius_study.py",

@@ -88,13 +88,16 @@ _DEG = math.pi / 180.0
 #: angle 25 + 5 sqrt(z2/z1) + 90 E/d degrees, nominal pressure angle 19 deg; and
 #: profile shift x_hm1 = 0.5 (a 6-tooth pinion needs a long addendum: Gleason's
 #: gear addendum 0.21 + 0.29 (z1/z2)^2 of the working depth gives x ~ 0.57; with
-#: x_hm1 = 0 the gear tip region shows curvature interference, Phi_II < 0).
+#: x_hm1 = 0 the gear tip region shows curvature interference, Phi_II < 0).  Pinion
+#: hand right: the hand of the cone model's set (pinion axis through (+E, 0, 0) of
+#: ``S_f``, measured on the generated flank; ``study_pair`` builds the mirror image for
+#: "left").  The blank itself does not depend on the hand.
 STUDY_BLANK = {
     "method": "tangent-cones", "z1": 6, "z2": 39, "offset_mm": 35.0,
     "gear_outer_pitch_diameter_mm": 230.0, "gear_face_width_mm": 0.155 * 230.0,
     "spiral_angle_deg": 25.0 + 5.0 * math.sqrt(39.0 / 6.0) + 90.0 * 35.0 / 230.0,
     "cutter_radius_mm": 95.25, "pressure_angle_drive_deg": 19.0,
-    "pressure_angle_coast_deg": 19.0, "profile_shift": 0.5,
+    "pressure_angle_coast_deg": 19.0, "profile_shift": 0.5, "hand": "right",
 }
 #: The three cutters of [Eigenfunctions] (nominal diameter in inches -> radius in mm).
 STUDY_CUTTERS = {"6in": 76.2, "7.5in": 95.25, "9in": 114.3}
@@ -176,6 +179,16 @@ def pitch_setup(inp: BlankInput, settings: StudySettings, flank: str = "convex")
     """
     if flank not in _FLANKS:
         raise ValueError(f"flank = {flank!r} must be one of {_FLANKS}")
+    try:
+        E0 = float(inp.offset)
+    except (TypeError, jax.errors.ConcretizationTypeError):     # traced offset: no check
+        E0 = None
+    if E0 is not None and not E0 > 0.0:
+        # the cutter is laid along the sliding velocity v21 at the pitch point, which
+        # vanishes without offset (pure rolling): j = v21/|v21| would be 0/0 (NaN)
+        raise ValueError(f"offset = {E0:g} mm: the cone model lays the cutter along the "
+                         "sliding velocity at the pitch point, zero for a spiral-bevel pair; "
+                         "range offset > 0 mm (hypoid)")
     r0 = jnp.asarray(settings.cutter_radius, float)
     inp_r = dataclasses.replace(inp, cutter_radius=r0)
     bd = blank_core(inp_r, inp.z2 / inp.z1)

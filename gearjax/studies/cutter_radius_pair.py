@@ -66,6 +66,10 @@ class StudyPair(NamedTuple):
     u_root: jax.Array
 
 
+#: reflection y -> -y (homogeneous): the mirror image of the cone model's set (left hand)
+_MIRROR = jnp.diag(jnp.array([1.0, -1.0, 1.0, 1.0]))
+
+
 def _member_blank(bd, k: int, teeth: int, hand: str) -> MemberBlank:
     f = lambda name: jnp.asarray(bd[f"{name}{k}"], float)
     return MemberBlank(f("Re"), f("b"), f("delta"), f("delta_a"), f("delta_f"), f("hae"), f("hfe"),
@@ -83,7 +87,13 @@ def study_pair(inp: BlankInput, settings: StudySettings, flank: str = "convex",
     centre ``C`` and axes from :func:`~gearjax.studies.cutter_radius.pitch_setup`;
     point radius ``R_p = r0 + shift - sb u_root sin(a)``; crossing points
     ``t1 = (C1 - A1) . z_w1``, ``t2 = -A2 . z_w2`` (``A_k = P - R_k g_k`` the pitch apexes,
-    ``z_wk = sgn(g_k . u_k) u_k`` apex to heel).  Differentiable with respect to
+    ``z_wk = sgn(g_k . u_k) u_k`` apex to heel).  Hand of spiral: the cone model (pinion
+    axis through ``(+E, 0, 0)``) is the right-hand pinion set (pinion blank offset ``+E``
+    on its machine, hand measured on the generated flanks); ``inp.hand == "left"``
+    places the mirror image ``M G M``, ``M = diag(1, -1, 1, 1)`` (the cone reflected in
+    the gear work frame's x-z plane), and the pinion it generates is the mirror image
+    too.  Offset 0 is refused (:func:`~gearjax.studies.cutter_radius.pitch_setup`).
+    Differentiable with respect to
     ``settings`` (and ``edge_radius``); under ``jax.jit`` the mean-contact search of
     :func:`~gearjax.gears.hypoid.formate.generating_gear_pinion` is refused.
     """
@@ -111,6 +121,12 @@ def study_pair(inp: BlankInput, settings: StudySettings, flank: str = "convex",
                             int(-sb))
     G = (jnp.eye(4).at[:3, :3].set(Q.T @ jnp.stack([s.xc, s.yc, s.zc], axis=1))
          .at[:3, 3].set(Q.T @ (s.centre + u_root * jnp.cos(a) * s.zc - A2)))
+    if inp.hand == "left":
+        # the cone model (pinion axis through (+E, 0, 0)) is the right-hand pinion set;
+        # its mirror image in the gear work frame's x-z plane: M G M with M = diag(1, -1,
+        # 1, 1) (work side: the reflection; cutter side: the cone reflected in its own
+        # x-z plane, the same cone; M G M is a proper rigid motion)
+        G = _MIRROR @ G @ _MIRROR
     hands = ("left", "right") if inp.hand == "left" else ("right", "left")
     gear_blank = _member_blank(bd, 2, inp.z2, hands[1])
     gear, phi0 = formate_from_placement(cutter, G, gear_blank)
@@ -129,7 +145,10 @@ def study_uv(sp: StudyPair, p2_body):
     p = jnp.asarray(p2_body, float) + jnp.stack([0.0, 0.0, jnp.asarray(sp.pair.gear_crossing, float)])
     c, s_ = jnp.cos(-sp.phi0), jnp.sin(-sp.phi0)
     Rz = jnp.array([[c, -s_, 0.0], [s_, c, 0.0], [0.0, 0.0, 1.0]])
-    pf = sp.A2 + (p @ Rz.T) @ sp.Q.T
+    pw = p @ Rz.T
+    if sp.pair.gear.blank.hand == "right":       # left-hand pinion: the mirrored cone
+        pw = pw * jnp.array([1.0, -1.0, 1.0])
+    pf = sp.A2 + pw @ sp.Q.T
     st = sp.setup
     d = pf - st.centre
     u = (d @ st.zc) / jnp.cos(st.blade)
