@@ -528,6 +528,10 @@ def test_spur_member_swap(spur_drive, spur_swapped):
 # ---------------------------------------------------------------------------------
 
 VH_TORQUE, VH_RPM = 100.0, 1000.0
+# the example file's [material] (E 203 GPa, nu 0.3), which sets E' and the tooth
+# compliance of its loaded contact: E' = E/(1 - nu^2) of two equal members
+VH_E, VH_NU = 203000.0, 0.3
+VH_E_PRIME = VH_E / (1.0 - VH_NU ** 2)
 
 
 @pytest.fixture(scope="module")
@@ -548,7 +552,7 @@ def test_vh_catt_hertz_by_hand_at_the_loaded_contacts(vh_run):
     p, a, b = (np.asarray(v) for v in (eff.loaded.p_max, eff.loaded.semi_major,
                                        eff.loaded.semi_minor))
     for k, j in zip(*np.nonzero(loaded)):
-        p_ref, ay, bx, _ = _hertz_johnson(F[k, j], rx[k, j], ry[k, j], E_PRIME)
+        p_ref, ay, bx, _ = _hertz_johnson(F[k, j], rx[k, j], ry[k, j], VH_E_PRIME)
         np.testing.assert_allclose([p[k, j], a[k, j], b[k, j]], [p_ref, ay, bx], rtol=1e-8)
 
 
@@ -593,9 +597,9 @@ def test_vh_catt_lever_arms_balances_and_approach_by_hand(vh_run):
     ry = _per_pair(res, eff, res.kinematics.r_y)[k[j], j]
     for i, jj in enumerate(j):
         Fi = F[k[jj], jj]
-        q = (float(tooth_compliance(rad1[i], z1, m, al, 0.0, 1.0, 1.25).total)
-             + float(tooth_compliance(rad2[i], z2, m, al, 0.0, 1.0, 1.25).total)) / width[i]
-        w_ref = q * Fi + _hertz_johnson(Fi, rx[i], ry[i], E_PRIME)[3]
+        q = (float(tooth_compliance(rad1[i], z1, m, al, 0.0, 1.0, 1.25, E=VH_E, nu=VH_NU).total)
+             + float(tooth_compliance(rad2[i], z2, m, al, 0.0, 1.0, 1.25, E=VH_E, nu=VH_NU).total)) / width[i]
+        w_ref = q * Fi + _hertz_johnson(Fi, rx[i], ry[i], VH_E_PRIME)[3]
         np.testing.assert_allclose(w[i], w_ref, rtol=1e-7)
     # the loaded TE lies behind the unloaded envelope by y (drive)
     te = np.where(loaded, _per_pair(res, eff, res.path.te), -np.inf).max(axis=0)
