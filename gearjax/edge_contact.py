@@ -175,6 +175,17 @@ class EdgeContact(NamedTuple):
     residual: jax.Array
 
 
+def _pose(cs, r1, r2, R, z, ph1):
+    """Both flanks' points, normals and flank data at the unknowns ``z`` of the contact
+    system ``cs``, and the members' rotations at pinion angle ``ph1`` (gear mount ``R``):
+    ``(q1, m1, f1, q2, m2, f2, R1, R2)``."""
+    x, psi1, psi2 = cs.split(z)
+    uv1, uv2, ph2 = cs.unpack(x)
+    q1, m1, f1 = flank_at(r1, uv1, psi1)
+    q2, m2, f2 = flank_at(r2, uv2, psi2)
+    return q1, m1, f1, q2, m2, f2, matrix_z(ph1), R @ matrix_z(ph2)
+
+
 def edge_contact_system(r1: Callable, r2: Callable, asm, mis, g1: Callable, g2: Callable,
                         t1: Callable | None = None, t2: Callable | None = None, *,
                         line_contact: bool = False, v1_fixed=0.0):
@@ -212,12 +223,8 @@ def edge_contact_system(r1: Callable, r2: Callable, asm, mis, g1: Callable, g2: 
 
     def F(z, theta):
         ph1, s, g0, pinion, e, tip, g0b, corner = theta
-        x, psi1, psi2 = cs.split(z)
-        uv1, uv2, ph2 = cs.unpack(x)
-        q1, m1, f1 = flank_at(r1, uv1, psi1)
-        q2, m2, f2 = flank_at(r2, uv2, psi2)
-        R1 = matrix_z(ph1)
-        R2 = R @ matrix_z(ph2)
+        q1, m1, f1, q2, m2, f2, R1, R2 = _pose(cs, r1, r2, R, z, ph1)
+        uv1 = cs.unpack(cs.split(z)[0])[0]
         p1 = R1 @ q1 + mis.dP * ez
         p2 = c + R2 @ q2
         ga, da = jax.value_and_grad(h1)(q1, e, tip)
@@ -271,12 +278,7 @@ def _corner_slope(cs, r1, r2, R, c, mis, asm, g1, g2, t1, t2, z, ph1, pinion, e)
     unit gear angle: ``dphi2/deps = (n_2 . R_1 u_1)/(n_2 . w)`` for a pinion corner,
     ``-(n_1 . R_2 u_2)/(n_1 . w)`` for a gear corner; ``dTE = ratio_sign dphi2``
     (orientation-free: ``n_j`` enters above and below)."""
-    x, psi1, psi2 = cs.split(z)
-    uv1, uv2, ph2 = cs.unpack(x)
-    q1, m1, _ = flank_at(r1, uv1, psi1)
-    q2, m2, _ = flank_at(r2, uv2, psi2)
-    R1 = matrix_z(ph1)
-    R2 = R @ matrix_z(ph2)
+    q1, m1, _, q2, m2, _, R1, R2 = _pose(cs, r1, r2, R, z, ph1)
 
     def directions(m, t, g, q):
         # along the tip edge into the face, and down the profile (in the flank's

@@ -65,8 +65,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax.errors import check_range, is_traced
-from gearjax.loaded_contact import (COMPLIANCE_MODELS, LoadedContact, MeshTeeth, contact_stress,
+from gearjax.efficiency_inputs import (RPM_RANGE, TORQUE_RANGE_NM, check_models,  # noqa: F401
+                                       check_efficiency_inputs, check_operating_point)
+from gearjax.loaded_contact import (LoadedContact, MeshTeeth, contact_stress,
                                     hertz_coefficient,
                                     lever_arms, pair_arrays, pair_compliance, share_torque)
 from gearjax.tca_result import TCAResult, family_of
@@ -82,6 +83,9 @@ __all__ = ["MeshEfficiency", "mesh_efficiency", "DEFAULT_COMPLIANCE", "COMPLIANC
            "MU_MAX", "P_MAX_LIMIT_MPA", "DEFLECTION_MAX_PITCH", "HERTZ_SIZE_MAX", "FILM_MIN_MM",
            "EfficiencyGuard", "efficiency_guard"]
 
+#: largest accepted r_y / r_x of a point contact (beyond: degenerate, flagged)
+MAX_RADIUS_RATIO = 1e4
+
 #: the default tooth compliance model of every route (Python and the command line)
 DEFAULT_COMPLIANCE = "weber"
 #: the compliance models in one sentence, word for word in the README, ``gearjax
@@ -91,11 +95,6 @@ COMPLIANCE_HELP = ("weber (the default): Weber/Cornell tooth cantilever + Sainso
                    "line contact); iso6336: the constant single stiffness c' of ISO 6336-1 "
                    "method B, scaled by E/206000 MPa")
 
-#: accepted pinion torque (N m) and speed (rpm)
-TORQUE_RANGE_NM = (1e-3, 1e6)
-#: largest accepted r_y / r_x of a point contact (beyond: degenerate, flagged)
-MAX_RADIUS_RATIO = 1e4
-RPM_RANGE = (1e-3, 1e6)
 
 # -- plausibility of the results (:func:`plausibility`; docs/efficiency.md) ----------
 #: largest plausible friction coefficient of a lubricated steel contact: boundary
@@ -321,63 +320,6 @@ def cycle_window(n_grid: int, steps_per_pitch: int) -> np.ndarray:
     return np.arange(steps_per_pitch) + (mid - steps_per_pitch // 2)
 
 
-def check_operating_point(torque_Nm, pinion_rpm) -> tuple[float, float]:
-    """Validate the operating point (concrete): torque (N m) and pinion speed (rpm) in
-    :data:`TORQUE_RANGE_NM` and :data:`RPM_RANGE` (one-line ValueError naming the
-    parameter, its value and the range; traced values pass unchecked)."""
-    T = check_range("torque_Nm", torque_Nm, *TORQUE_RANGE_NM, unit="N m")
-    n = check_range("pinion_rpm", pinion_rpm, *RPM_RANGE, unit="rpm")
-    return T, n
-
-
-#: ranges of an Oil's and a Surface's fields in library units (those of make_oil and
-#: make_surface: eta0 Pa s, tau0 MPa, rho0 kg/m^3, z; sigma and beta mm, density 1/mm^2,
-#: v_slip mm/s): (low, high, low bound excluded, unit)
-_OIL_RANGES = {"eta0": (math.exp(-9.67), 100.0, True, "Pa s"), "z": (0.0, 3.0, True, ""),
-               "tau0": (0.0, 100.0, True, "MPa"), "rho0": (0.0, 2e4, True, "kg/m^3")}
-_SURFACE_RANGES = {"sigma": (0.0, 0.01, True, "mm"), "density": (0.0, 1e6, True, "1/mm^2"),
-                   "beta": (0.0, 1.0, True, "mm"), "f_c": (0.0, 1.0, False, ""),
-                   "v_slip": (0.0, 1000.0, True, "mm/s"),
-                   "asperity_film_factor": (0.5, 1.0, False, "")}
-
-
-def _check_fields(what, obj, ranges):
-    """The scalar fields of an Oil / Surface in their ranges (concrete values only:
-    traced fields and batches -- arrays with dimensions -- are not checked here)."""
-    for name, (lo, hi, lo_open, unit) in ranges.items():
-        v = getattr(obj, name)
-        if is_traced(v) or np.ndim(v):
-            continue
-        check_range(f"{what}.{name}", v, lo, hi, lo_open=lo_open, unit=unit)
-
-
-def check_efficiency_inputs(torque_Nm, pinion_rpm, oil, surface, E_prime, poisson,
-                            compliance, viscosity_model, film_method):
-    """Validate the concrete operating inputs of :func:`mesh_efficiency` /
-    :func:`efficiency_function` before any work, as the command line does: torque and
-    speed (:func:`check_operating_point`), E′ in (0, 1e7] MPa (E′ typed in Pa is
-    refused), ν in [0, 0.5], the oil and surface fields in the ranges of
-    :func:`gearjax.tribology.make_oil` / :func:`~gearjax.tribology.make_surface`, and
-    the model names.  Traced values are not checked.  One-line ValueError."""
-    from gearjax.materials import POISSON_RANGE, check_e_prime
-
-    check_operating_point(torque_Nm, pinion_rpm)
-    check_e_prime(E_prime)
-    check_range("poisson", poisson, *POISSON_RANGE)
-    _check_fields("oil", oil, _OIL_RANGES)
-    _check_fields("surface", surface, _SURFACE_RANGES)
-    _check_models(compliance, viscosity_model, film_method)
-
-
-def _check_models(compliance, viscosity_model, film_method):
-    """The model names (one-line ValueError listing the allowed ones)."""
-    for name, v, allowed in (("compliance", compliance, COMPLIANCE_MODELS),
-                             ("viscosity_model", viscosity_model, ("roelands", "barus")),
-                             ("film_method", film_method, ("auto", "point", "line"))):
-        if v not in allowed:
-            raise ValueError(f"{name} = {v!r} must be one of {tuple(allowed)}")
-
-
 def _equivalent_ry(F, r_x, L, E_prime):
     """R_y of the ellipse whose major semi-axis is L/2 under F (line contact)."""
     k2 = jnp.pi * E_prime * (0.5 * L) ** 3 / (6.0 * F * r_x)
@@ -525,7 +467,7 @@ def efficiency_function(design, *, side=None, compliance: str = DEFAULT_COMPLIAN
 
     mat = pair_material(design, E_prime)
     Ep, nu = float(mat.e_prime_MPa), float(mat.poisson)
-    _check_models(compliance, viscosity_model, film_method)
+    check_models(compliance, viscosity_model, film_method)
     check_design(design)
     ad = family_of(design)
     opts = {**ad.defaults, **tca_options}
