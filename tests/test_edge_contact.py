@@ -67,6 +67,17 @@ def test_crossed_uncrowned_spur_touches_at_the_leading_face_end(traced, sign):
     # ahead of the mid-face section by (b/2) dg cos aw / r_b2 (drive: larger TE)
     lead = (np.asarray(path.te) - np.asarray(section.te))[carried]
     np.testing.assert_allclose(lead, LEAD, rtol=2e-3)
+    # the contact normal is that of the flank the edge touches (the edge has none):
+    # a spur flank's normal is transverse in its own body; the gear is turned by dg
+    # about the y axis, (nx, ny, 0) -> (nx cos dg, ny, -nx sin dg).  A pinion edge on
+    # the gear flank: |n_z| = |n_x| tan dg; a gear edge on the pinion flank: n_z = 0.
+    # (Planted bug caught: the normal of the edge's own flank.)
+    nrm = np.asarray(path.normal)[carried]
+    np.testing.assert_allclose(np.linalg.norm(nrm, axis=1), 1.0, rtol=1e-12)
+    pin = kind[carried] < 2
+    np.testing.assert_allclose(np.abs(nrm[:, 2]),
+                               np.where(pin, np.abs(nrm[:, 0]) * np.tan(DG), 0.0),
+                               rtol=1e-6, atol=1e-12)
 
 
 def test_the_other_crossing_sense_loads_the_other_end(traced):

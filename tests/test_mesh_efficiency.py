@@ -152,6 +152,57 @@ def test_weber_mean_mesh_stiffness_against_iso6336(spur, weber_run):
     assert y[n == 2].max() < y[n == 1].min()
 
 
+def test_weber_single_contact_approach_is_the_path_model(spur, weber_run):
+    """Weber/Sainsot through the whole loaded chain: in single contact the one loaded
+    pair carries F = T1 / r_b1 and its approach is q F, q the stand-alone path model
+    of gearjax.tooth_compliance (per unit width, mm^2/N) over the face width at the
+    roll distance of the contact (hand, from the contact radius) and the load per
+    unit face width F / b.  Planted bugs caught: the nominal line load not taken per
+    unit width (it enters the contact term's logarithm), the face width missing
+    from q."""
+    from gearjax.tooth_compliance import pair_compliance as path_compliance
+    eff, res = weber_run
+    geo = pair_geometry(spur[0])
+    rb1, rho_P = float(geo["rb1"]), float(geo["rho_P"])
+    from gearjax.loaded_contact import pair_arrays
+    from gearjax.mesh_efficiency import cycle_window
+    spp = eff.phi1.shape[0]
+    win = cycle_window(res.path.phi1.shape[0], spp)
+    r1 = np.asarray(pair_arrays(res.path.radial1, spp, 3, np.nan, win))
+    F = np.asarray(eff.loaded.load)
+    single = np.asarray(eff.loaded.n_loaded) == 1
+    assert single.sum() >= 4
+    k = np.argmax(F, axis=0)[single]
+    j = np.nonzero(single)[0]
+    F_tot = 1e3 * TORQUE / rb1
+    np.testing.assert_allclose(F[k, j], F_tot, rtol=1e-9)
+    s = np.sqrt(r1[k, j] ** 2 - rb1 ** 2) - rho_P
+    q = path_compliance(jnp.asarray(s), Z1, Z2, M, np.radians(20.0),
+                        load_per_width=F_tot / B).total / B                 # mm/N
+    w = np.asarray(eff.loaded.approach)[k, j]
+    np.testing.assert_allclose(w, np.asarray(q) * F_tot, rtol=1e-8)
+
+
+def test_line_contact_equivalent_ellipse_spans_the_face(spur, iso_run):
+    """The line contact goes to the elliptic friction model as the ellipse whose major
+    semi-axis is half the contact line (module docstring): with R_y of the run, the
+    Hamrock-Dowson ellipse a = (6 k^2 E F R / (pi E'))^(1/3), k = 1.0339 (R_y/R_x)^0.636,
+    E = 1.0003 + 0.5968 R_x/R_y, R = R_x R_y / (R_x + R_y) (hand), spans b/2 to the
+    approximation's own accuracy.  Planted bug caught: the semi-axis set to the whole
+    line length."""
+    from gearjax.tribology import STEEL_E_PRIME
+    eff, _ = iso_run
+    F = np.asarray(eff.loaded.load)
+    on = F > 0.0
+    Rx, Ry = np.asarray(eff.r_x)[on], np.asarray(eff.r_y)[on]
+    assert np.all(Ry > 20.0 * Rx)
+    k = 1.0339 * (Ry / Rx) ** 0.636
+    ell = 1.0003 + 0.5968 * Rx / Ry
+    R = Rx * Ry / (Rx + Ry)
+    a = (6.0 * k ** 2 * ell * F[on] * R / (np.pi * STEEL_E_PRIME)) ** (1.0 / 3.0)
+    np.testing.assert_allclose(a, 0.5 * B, rtol=5e-3)
+
+
 def test_line_contact_material_scaling(spur, oil_surface, iso_run, weber_run):
     """E' doubled (``E_prime=``; an involute pair has no material table, the default is
     steel): at single-contact positions the load is statics only, the line-contact Hertz

@@ -607,6 +607,50 @@ def test_vh_catt_lever_arms_balances_and_approach_by_hand(vh_run):
 
 
 # ---------------------------------------------------------------------------------
+# involute: the virtual spur teeth of ISO 6336-1 by hand
+# ---------------------------------------------------------------------------------
+
+def test_involute_mesh_teeth_by_hand():
+    """MeshTeeth of a crowned helical pair with a pinion pressure-angle change, from a
+    path given by hand (contact radii and ellipse semi-axes): z_n = z / (cos^2(beta_b)
+    cos(beta)), the normal module, the pinion's normal pressure angle alpha_n + dalpha
+    (its rack's, InvoluteTCA docstring) and the gear's alpha_n, the load radius at the
+    same height over the reference circle on the virtual gear, and the load-carrying
+    width of a point contact: the full major axis 2a of the contact ellipse, at most b.
+    A spur pair in line contact carries its load over b along a line of length b.
+    Planted bugs caught: the width set to the semi-axis a, the sign of dalpha, the
+    virtual tooth numbers of the transverse section."""
+    from types import SimpleNamespace
+    from gearjax.gears.involute.mesh import involute_mesh_teeth
+    z1, z2, m, an, bd, b, dad = 19, 53, 3.0, 20.0, 17.0, 24.0, 0.4
+    des = gj.InvoluteTCA.create(gj.InvolutePair.create(z1, z2, m, an, bd, 0.25, -0.1), b,
+                                dalpha_deg=dad, lead_crown=2e-4)
+    beta, alpha_n = math.radians(bd), math.radians(an)
+    alpha_t = math.atan(math.tan(alpha_n) / math.cos(beta))
+    beta_b = math.atan(math.tan(beta) * math.cos(alpha_t))
+    r1_ref, r2_ref = 0.5 * z1 * m / math.cos(beta), 0.5 * z2 * m / math.cos(beta)
+    semi = np.array([2.0, 7.5, 11.9, 12.1, 40.0])
+    path = SimpleNamespace(phi1=np.zeros(5), radial1=r1_ref + np.linspace(-2.0, 2.5, 5),
+                           radial2=r2_ref + np.linspace(2.0, -2.5, 5), semi_major=semi)
+    t = involute_mesh_teeth(des, SimpleNamespace(path=path), False, True)
+    zn = [z / (math.cos(beta_b) ** 2 * math.cos(beta)) for z in (z1, z2)]
+    np.testing.assert_allclose(t.z, zn, rtol=1e-12)
+    np.testing.assert_allclose(t.module, m, rtol=1e-14)
+    np.testing.assert_allclose(t.alpha, [alpha_n + math.radians(dad), alpha_n], rtol=1e-12)
+    np.testing.assert_allclose(t.beta, beta, rtol=1e-14)
+    np.testing.assert_allclose(t.x, [0.25, -0.1], rtol=1e-14)
+    np.testing.assert_allclose(t.r_load[0], 0.5 * zn[0] * m + (path.radial1 - r1_ref), rtol=1e-12)
+    np.testing.assert_allclose(t.r_load[1], 0.5 * zn[1] * m + (path.radial2 - r2_ref), rtol=1e-12)
+    np.testing.assert_allclose(t.width, [4.0, 15.0, 23.8, 24.0, 24.0], rtol=1e-14)
+    assert t.line_length is None and bool(t.drive)
+    spur = gj.InvoluteTCA.create(gj.InvolutePair.create(z1, z2, m, an), b)
+    t = involute_mesh_teeth(spur, SimpleNamespace(path=path), True, False)
+    np.testing.assert_allclose(t.width, b, rtol=1e-14)
+    np.testing.assert_allclose(t.line_length, b, rtol=1e-14)
+    assert not bool(t.drive)
+
+
+# ---------------------------------------------------------------------------------
 # preset bevel: the virtual cylindrical teeth of ISO 10300-1 by hand
 # ---------------------------------------------------------------------------------
 
@@ -645,3 +689,90 @@ def test_preset_bevel_virtual_teeth_by_hand():
     np.testing.assert_allclose(np.asarray(t.width)[fin],
                                np.minimum(2.0 * a[fin], float(des.face_width)), rtol=1e-14)
     assert t.line_length is None and bool(t.drive)
+
+
+PB_TORQUE, PB_RPM = 150.0, 1200.0
+
+
+@pytest.fixture(scope="module")
+def pb_run(oil_surface):
+    des = gj.load_design("example:preset_te_bevel_10x30").design
+    return des, gj.mesh_efficiency(des, PB_TORQUE, PB_RPM, *oil_surface)
+
+
+def _pb_virtual(des):
+    """ISO 10300-1 virtual cylindrical teeth of the preset bevel by hand (as in
+    test_preset_bevel_virtual_teeth_by_hand): m_mn, (z_vn1, z_vn2)."""
+    z1, z2 = des.z1, des.z2
+    S, beta, an = float(des.shaft_angle), float(des.beta), float(des.alpha_n)
+    d1 = math.atan(math.sin(S) / (z2 / z1 + math.cos(S)))
+    d2 = S - d1
+    Rm = float(des.module_t) * z1 / (2.0 * math.sin(d1)) - 0.5 * float(des.face_width)
+    m_mn = 2.0 * Rm * math.sin(d1) * math.cos(beta) / z1
+    bvb = math.asin(math.sin(beta) * math.cos(an))
+    return m_mn, [z / (math.cos(d) * math.cos(bvb) ** 2 * math.cos(beta))
+                  for z, d in ((z1, d1), (z2, d2))]
+
+
+def test_preset_bevel_loaded_contacts_by_hand(pb_run):
+    """The preset-TE bevel pair through the loaded chain (steel: the example has no
+    material table): exact Hertz of every loaded contact (scipy, Johnson), the normal
+    force's moment arm about the pinion axis from the contact point and normal (numpy
+    cross product), the pinion moment balance sum l1 F = T1, the gear's sum l2 F = T1
+    z2/z1 to the preset TE's ratio variation, and in single contact the approach
+    w = q F + delta_Hertz with q of the two virtual teeth (Weber/Sainsot, the ISO
+    10300-1 virtual gears by hand) over the loaded width min(2a, b) and w = l2 y.
+    Planted bugs caught: the virtual tooth height, dedendum or width slips of the
+    preset mesh, a TE envelope with the wrong pitch (loads of the wrong pairs), Hertz
+    of a wrong radius, the gear lever arm."""
+    from gearjax.tooth_compliance import tooth_compliance
+    des, (eff, res) = pb_run
+    z1, z2 = des.z1, des.z2
+    F = np.asarray(eff.loaded.load)
+    loaded = F > 0.0
+    assert np.all(np.asarray(eff.valid)) and loaded.sum() >= 16
+    rx = _per_pair(res, eff, res.kinematics.r_x)
+    ry = _per_pair(res, eff, res.kinematics.r_y)
+    p, a, b = (np.asarray(v) for v in (eff.loaded.p_max, eff.loaded.semi_major,
+                                       eff.loaded.semi_minor))
+    for k, j in zip(*np.nonzero(loaded)):
+        p_ref, ay, bx, _ = _hertz_johnson(F[k, j], rx[k, j], ry[k, j], E_PRIME)
+        np.testing.assert_allclose([p[k, j], a[k, j], b[k, j]], [p_ref, ay, bx], rtol=1e-8)
+    pt, nn = np.asarray(res.path.point), np.asarray(res.path.normal)
+    l1_0 = np.abs(np.cross(pt, nn)[:, 2])
+    dphi = np.gradient(np.asarray(res.path.phi2), np.asarray(res.path.phi1))
+    l1 = _per_pair(res, eff, l1_0)
+    l2 = _per_pair(res, eff, l1_0 / np.abs(dphi))
+    T1 = 1e3 * PB_TORQUE
+    np.testing.assert_allclose(np.sum(np.where(loaded, l1 * F, 0.0), axis=0), T1, rtol=1e-7)
+    np.testing.assert_allclose(np.sum(np.where(loaded, l2 * F, 0.0), axis=0), T1 * z2 / z1,
+                               rtol=2e-3)
+    single = loaded.sum(axis=0) == 1
+    assert single.sum() >= 3
+    k = np.argmax(F, axis=0)
+    j = np.nonzero(single)[0]
+    w = np.asarray(eff.loaded.approach)[k[j], j]
+    y = np.asarray(eff.loaded.deflection)[j]
+    np.testing.assert_allclose(w / y, l2[k[j], j], rtol=1e-5)
+    m_mn, zv = _pb_virtual(des)
+    an = float(des.alpha_n)
+    ha, hf = float(des.addendum) / m_mn, float(des.dedendum) / m_mn + 0.25
+    h1 = _per_pair(res, eff, res.coords["h1"])[k[j], j]
+    h2 = _per_pair(res, eff, res.coords["h2"])[k[j], j]
+    width = np.minimum(2.0 * _per_pair(res, eff, res.path.semi_major)[k[j], j],
+                       float(des.face_width))
+    for i, jj in enumerate(j):
+        Fi = F[k[jj], jj]
+        q = sum(float(tooth_compliance(0.5 * zv[m] * m_mn + h, zv[m], m_mn, an, 0.0, ha, hf).total)
+                for m, h in ((0, h1[i]), (1, h2[i]))) / width[i]
+        w_ref = q * Fi + _hertz_johnson(Fi, rx[k[jj], jj], ry[k[jj], jj], E_PRIME)[3]
+        np.testing.assert_allclose(w[i], w_ref, rtol=1e-7)
+    # the loaded TE lies behind the unloaded envelope by y in the sense of the load: the
+    # drive flank of this family pushes the gear backwards for increasing phi1 (its
+    # envelope is the minimum over the pairs, gearjax.gears.preset_bevel.pair.drives_forward)
+    from gearjax.gears.preset_bevel.pair import drives_forward
+    sense = 1.0 if drives_forward("drive") else -1.0
+    assert sense == -1.0
+    te = sense * np.where(loaded, sense * _per_pair(res, eff, res.path.te), -np.inf).max(axis=0)
+    np.testing.assert_allclose(np.asarray(eff.loaded.te_loaded)[j], te[j] - sense * y,
+                               rtol=1e-9)
