@@ -420,11 +420,16 @@ def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, pinion_r
         seen[src[(src >= 0) & (src < n)]] = True
     inside0 = (res.margin >= 0.0) & path.converged
     truncated = jnp.any(inside0 & ~seen) | inside0[0] | inside0[-1]
+    nothing_loaded = ~jnp.any(loaded_on, axis=0)
+
     def pressed(mask0):
         """(M,) a contact of pair 0 in ``mask0`` (no load modelled there) would be
-        compressed by the loaded gear at the position."""
+        compressed by the loaded gear at the position: ahead of the loaded TE, or
+        the position has no surface contact carrying load at all (the gear then rests
+        on such a contact: an uncrowned pair whose every contact is at a face end)."""
         te_m = pairs(jnp.where(mask0, path.te, 0.0), 0.0)
-        return jnp.any(pairs(mask0, False) & (sgn * (te_m - te_loaded) > 0.0), axis=0)
+        ahead = (sgn * (te_m - te_loaded) > 0.0) | nothing_loaded[None, :]
+        return jnp.any(pairs(mask0, False) & ahead, axis=0)
 
     edge_loaded = pressed(res.edge_points)          # face-end (edge) contacts
     degenerate = pressed(degenerate0)              # beyond an edge of regression

@@ -14,6 +14,7 @@
 """
 
 import dataclasses
+import math
 
 import jax
 import jax.numpy as jnp
@@ -203,6 +204,32 @@ def test_line_contact_equivalent_ellipse_spans_the_face(spur, iso_run):
     np.testing.assert_allclose(a, 0.5 * B, rtol=5e-3)
 
 
+def test_loaded_edge_contact_is_flagged_and_not_valid(spur, oil_surface, weber_run):
+    """A crossed uncrowned spur pair (dSigma = 0.05 deg) touches at the leading face end
+    (the closed form of tests/test_edge_contact.py): that edge contact is the one the
+    loaded gear presses, and its load is not modelled -- every position where it is the
+    contact made is flagged ``edge_loaded`` and is not valid, and the warnings say so;
+    the aligned pair has none.  Same compiled programs as ``weber_run`` (the
+    misalignment is traced).  Planted bug caught: the sign of the 'pressed by the loaded
+    gear' test (an edge contact behind the loaded gear flagged, the one it presses not)."""
+    eff0, _ = weber_run
+    assert not np.any(np.asarray(eff0.edge_loaded))
+    mis = gj.Misalignment.create(dSigma_deg=0.05)
+    eff, res = mesh_efficiency(spur[1], TORQUE, RPM, *oil_surface, compliance="weber",
+                               misalignment=mis, strict=False)
+    from gearjax.loaded_contact import pair_arrays
+    from gearjax.mesh_efficiency import cycle_window
+    spp = eff.phi1.shape[0]
+    win = cycle_window(res.path.phi1.shape[0], spp)
+    edge_pairs = np.asarray(pair_arrays(res.edge_points, spp, 3, False, win))
+    made = edge_pairs.any(axis=0)
+    assert made.sum() >= spp // 2, "the crossed uncrowned pair must be in edge contact"
+    flagged = np.asarray(eff.edge_loaded)
+    np.testing.assert_array_equal(flagged, made)
+    assert not np.any(np.asarray(eff.valid) & flagged)
+    assert any("edge" in w for w in efficiency_warnings(eff, res))
+
+
 def test_line_contact_material_scaling(spur, oil_surface, iso_run, weber_run):
     """E' doubled (``E_prime=``; an involute pair has no material table, the default is
     steel): at single-contact positions the load is statics only, the line-contact Hertz
@@ -230,45 +257,79 @@ def test_line_contact_material_scaling(spur, oil_surface, iso_run, weber_run):
         assert float(e2.te_loaded_ptp) != float(e1.te_loaded_ptp)
 
 
-def test_gradients_against_central_differences(spur, oil_surface, iso_run):
-    """d eta_bar through the loads, kinematics and friction: with respect to torque,
-    roughness, viscosity and two perturbations of the TCA result (on the unloaded TE,
-    i.e. the separations the load closes, and a scale on the radii of curvature r_x), against central differences.  The TE perturbation is a
-    slope ``a (phi1 - phi1_ref)`` (rad/rad), a base-pitch-mismatch-like separation of
-    the pairs in double contact.  (The TCA's own gradients
-    w.r.t. design fields are tested in tests/test_tca*.py; the whole chain of the
-    hypoid example against central differences is experiments/efficiency_gradients.py.)"""
+@pytest.fixture(scope="module")
+def traced_spur(spur, oil_surface, iso_run):
+    """The loaded chain of the spur run as one jitted function of
+    ``v = (torque, sigma, eta0, a, b, c, d)``: perturbations of the TCA result -- a TE
+    slope ``a (phi1 - phi1_ref)`` (rad/rad, a base-pitch-mismatch-like separation of the
+    pairs in double contact), a scale ``1 + b`` on the radii r_x, a side sliding
+    ``u_s_side = c u_s`` (along the ellipse's major axis) and an entrainment angle
+    ``d`` (rad from the rolling direction) -- returning the whole MeshEfficiency; and
+    the unperturbed point."""
     oil, surf = oil_surface
     oil = dataclasses.replace(oil, name="")
     _, res = iso_run
     des = spur[1]
     teeth_of = gj.family_of(des).mesh(des)[0]
 
-    def eta(v):
-        T, sigma, eta0, a, b = v
+    def full(v):
+        T, sigma, eta0, a, b, c, d = v
         mid = res.path.phi1.shape[0] // 2
         path = res.path._replace(te=res.path.te + a * (res.path.phi1 - res.path.phi1[mid]))
-        kin = res.kinematics._replace(r_x=res.kinematics.r_x * (1.0 + b))
+        kin = res.kinematics._replace(r_x=res.kinematics.r_x * (1.0 + b),
+                                      u_s_side=c * res.kinematics.u_s,
+                                      entrainment_angle=res.kinematics.entrainment_angle + d)
         r = dataclasses.replace(res, path=path, kinematics=kin)
-        eff = mesh_efficiency_traced(r, teeth_of(des, r), T, RPM,
-                                     dataclasses.replace(oil, eta0=eta0),
-                                     dataclasses.replace(surf, sigma=sigma),
-                                     steps_per_pitch=24, n_pairs=3, compliance="weber")
-        return eff.mean_efficiency
+        return mesh_efficiency_traced(r, teeth_of(des, r), T, RPM,
+                                      dataclasses.replace(oil, eta0=eta0),
+                                      dataclasses.replace(surf, sigma=sigma),
+                                      steps_per_pitch=24, n_pairs=3, compliance="weber")
 
-    x0 = jnp.array([TORQUE, float(surf.sigma), float(oil.eta0), 0.0, 0.0])
-    jeta = jax.jit(eta)
+    x0 = jnp.array([TORQUE, float(surf.sigma), float(oil.eta0), 0.0, 0.0, 0.0, 0.0])
+    return full, x0
+
+
+def test_gradients_against_central_differences(spur, oil_surface, traced_spur):
+    """d eta_bar through the loads, kinematics and friction: with respect to torque,
+    roughness, viscosity and the four perturbations of the TCA result of
+    ``traced_spur``, against central differences.  (The TCA's own gradients
+    w.r.t. design fields are tested in tests/test_tca*.py; the whole chain of the
+    hypoid example against central differences is experiments/efficiency_gradients.py.)"""
+    oil, surf = oil_surface
+    full, x0 = traced_spur
+    des = spur[1]
+
+    def eta(v):
+        return full(v).mean_efficiency
+
+    jfull = jax.jit(full)
     # the traced route takes the speed in rpm, as mesh_efficiency (one convention)
     eff_w = mesh_efficiency(des, TORQUE, RPM, oil, surf, compliance="weber")[0]
-    assert float(jeta(x0)) == pytest.approx(float(eff_w.mean_efficiency), rel=1e-12)
+    assert float(jfull(x0).mean_efficiency) == pytest.approx(float(eff_w.mean_efficiency),
+                                                              rel=1e-12)
     g = jax.jit(jax.grad(eta))(x0)
     assert np.all(np.isfinite(g))
-    for i in range(5):
+    for i in range(x0.shape[0]):
         h = 1e-4 * float(x0[i]) if x0[i] != 0 else 1e-6
-        fd = (jeta(x0.at[i].add(h)) - jeta(x0.at[i].add(-h))) / (2 * h)
+        fd = (jfull(x0.at[i].add(h)).mean_efficiency
+              - jfull(x0.at[i].add(-h)).mean_efficiency) / (2 * h)
         np.testing.assert_allclose(g[i], fd, rtol=1e-5, atol=1e-12)
     # the separations matter: a TE slope unbalances the double-contact sharing
     assert abs(float(g[3])) > 1e-6
+    # sliding and entrainment magnitudes from their components (ContactKinematics):
+    # the sliding vector has u_s along the rolling direction and u_s_side across it,
+    # |u_s| = omega sqrt(u_s^2 + u_s_side^2); u_e is the component along the rolling
+    # direction of an entrainment vector at angle theta_e, |u_e| = omega |u_e| / cos
+    # theta_e.  (A spur pair has neither; the perturbation gives them.)  Planted bugs
+    # caught: the side component dropped, cos for 1/cos.
+    c, d = 0.3, 0.4
+    e0, e1 = jfull(x0), jfull(x0.at[5].set(c).at[6].set(d))
+    on = np.asarray(e0.loaded.load) > 0.0
+    np.testing.assert_allclose(np.asarray(e1.u_s)[on],
+                               np.sqrt(1.0 + c * c) * np.asarray(e0.u_s)[on], rtol=1e-9,
+                               atol=1e-6)                     # mm/s (the pitch point: 0)
+    np.testing.assert_allclose(np.asarray(e1.u_e)[on], np.asarray(e0.u_e)[on] / math.cos(d),
+                               rtol=1e-9)
 
 
 def test_cycle_summary_over_valid_positions_only():
