@@ -556,6 +556,39 @@ def test_vh_catt_hertz_by_hand_at_the_loaded_contacts(vh_run):
         np.testing.assert_allclose([p[k, j], a[k, j], b[k, j]], [p_ref, ay, bx], rtol=1e-8)
 
 
+def _arms_and_balances(res, eff, T1, ratio, rtol_gear):
+    """Moment arms of every loaded pair by hand -- about the pinion axis (z) from the
+    contact point and normal (numpy cross product), about the gear axis l1 / |dphi2/dphi1|
+    with the derivative by differencing the TCA's gear angle -- and the moment balances
+    sum l1 F = T1 (N mm) and sum l2 F = T1 ratio.  Returns (l1, l2) per pair."""
+    F = np.asarray(eff.loaded.load)
+    loaded = F > 0.0
+    pt, nn = np.asarray(res.path.point), np.asarray(res.path.normal)
+    l1_0 = np.abs(np.cross(pt, nn)[:, 2])
+    dphi = np.gradient(np.asarray(res.path.phi2), np.asarray(res.path.phi1))
+    l1 = _per_pair(res, eff, l1_0)
+    l2 = _per_pair(res, eff, l1_0 / np.abs(dphi))
+    np.testing.assert_allclose(np.sum(np.where(loaded, l1 * F, 0.0), axis=0), T1, rtol=1e-7)
+    np.testing.assert_allclose(np.sum(np.where(loaded, l2 * F, 0.0), axis=0), T1 * ratio,
+                               rtol=rtol_gear)
+    return l1, l2
+
+
+def _single_contact(eff, l2, min_positions, rtol):
+    """Single-contact positions: (pair index k, position j, approach w, fall-back y) of
+    the one loaded pair, after checking w = l2 y (the gear's fall-back seen along the
+    normal at its arm)."""
+    F = np.asarray(eff.loaded.load)
+    single = (F > 0.0).sum(axis=0) == 1
+    assert single.sum() >= min_positions
+    j = np.nonzero(single)[0]
+    k = np.argmax(F, axis=0)[j]
+    w = np.asarray(eff.loaded.approach)[k, j]
+    y = np.asarray(eff.loaded.deflection)[j]
+    np.testing.assert_allclose(w / y, l2[k, j], rtol=rtol)
+    return k, j, w, y
+
+
 def test_vh_catt_lever_arms_balances_and_approach_by_hand(vh_run):
     """Aligned VH-CATT pair: the contact lies in the middle section, an exact involute,
     so the normal force's moment arm about the pinion axis is r_b1 = m z1 cos(alpha)/2
@@ -570,25 +603,13 @@ def test_vh_catt_lever_arms_balances_and_approach_by_hand(vh_run):
     m, al, bw = float(pair.module), float(pair.pressure_angle), float(pair.face_width)
     F = np.asarray(eff.loaded.load)
     loaded = F > 0.0
-    pt, nn = np.asarray(res.path.point), np.asarray(res.path.normal)
-    l1_0 = np.abs(np.cross(pt, nn)[:, 2])
-    dphi = np.gradient(np.asarray(res.path.phi2), np.asarray(res.path.phi1))
-    l1 = _per_pair(res, eff, l1_0)
-    l2 = _per_pair(res, eff, l1_0 / np.abs(dphi))
+    l1, l2 = _arms_and_balances(res, eff, 1e3 * VH_TORQUE, z2 / z1, 1e-6)
     rb1 = 0.5 * m * z1 * math.cos(al)
     np.testing.assert_allclose(l1[loaded], rb1, rtol=1e-7)
-    T1 = 1e3 * VH_TORQUE
-    np.testing.assert_allclose(np.sum(np.where(loaded, l1 * F, 0.0), axis=0), T1, rtol=1e-7)
-    np.testing.assert_allclose(np.sum(np.where(loaded, l2 * F, 0.0), axis=0), T1 * z2 / z1,
-                               rtol=1e-6)
     # single contact: the leading pair (gap 0) has w = l2 y
-    single = loaded.sum(axis=0) == 1
-    assert single.sum() >= 5
-    k = np.argmax(F, axis=0)
-    j = np.nonzero(single)[0]
-    w = np.asarray(eff.loaded.approach)[k[j], j]
-    y = np.asarray(eff.loaded.deflection)[j]
-    np.testing.assert_allclose(w / y, l2[k[j], j], rtol=1e-6)
+    kk, j, w, y = _single_contact(eff, l2, 5, 1e-6)
+    k = np.zeros(F.shape[1], int)
+    k[j] = kk
     # the approach by the compliance route
     rad1 = _per_pair(res, eff, res.path.radial1)[k[j], j]
     rad2 = _per_pair(res, eff, res.path.radial2)[k[j], j]
@@ -738,22 +759,10 @@ def test_preset_bevel_loaded_contacts_by_hand(pb_run):
     for k, j in zip(*np.nonzero(loaded)):
         p_ref, ay, bx, _ = _hertz_johnson(F[k, j], rx[k, j], ry[k, j], E_PRIME)
         np.testing.assert_allclose([p[k, j], a[k, j], b[k, j]], [p_ref, ay, bx], rtol=1e-8)
-    pt, nn = np.asarray(res.path.point), np.asarray(res.path.normal)
-    l1_0 = np.abs(np.cross(pt, nn)[:, 2])
-    dphi = np.gradient(np.asarray(res.path.phi2), np.asarray(res.path.phi1))
-    l1 = _per_pair(res, eff, l1_0)
-    l2 = _per_pair(res, eff, l1_0 / np.abs(dphi))
-    T1 = 1e3 * PB_TORQUE
-    np.testing.assert_allclose(np.sum(np.where(loaded, l1 * F, 0.0), axis=0), T1, rtol=1e-7)
-    np.testing.assert_allclose(np.sum(np.where(loaded, l2 * F, 0.0), axis=0), T1 * z2 / z1,
-                               rtol=2e-3)
-    single = loaded.sum(axis=0) == 1
-    assert single.sum() >= 3
-    k = np.argmax(F, axis=0)
-    j = np.nonzero(single)[0]
-    w = np.asarray(eff.loaded.approach)[k[j], j]
-    y = np.asarray(eff.loaded.deflection)[j]
-    np.testing.assert_allclose(w / y, l2[k[j], j], rtol=1e-5)
+    l1, l2 = _arms_and_balances(res, eff, 1e3 * PB_TORQUE, z2 / z1, 2e-3)
+    kk, j, w, y = _single_contact(eff, l2, 3, 1e-5)
+    k = np.zeros(F.shape[1], int)
+    k[j] = kk
     m_mn, zv = _pb_virtual(des)
     an = float(des.alpha_n)
     ha, hf = float(des.addendum) / m_mn, float(des.dedendum) / m_mn + 0.25
