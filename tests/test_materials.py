@@ -236,3 +236,21 @@ def test_hand_built_hypoid_pair_checked_before_work(field, words):
             fn(bad)
         msg = str(exc.value)
         assert "\n" not in msg and all(w in msg for w in words), msg
+
+
+def test_operating_point_accepts_its_documented_range():
+    """The operating point accepted by the Python entry points and the command line is
+    the documented one (docs/efficiency.md): torque 1e-3..1e6 N m, pinion speed 1e-3..1e6
+    rpm -- high-speed gearing (turbine and e-drive pinions at 2e4..1e5 rpm) included --
+    and one step outside either end is refused in one line naming the parameter.
+    Planted bugs caught: a range narrowed below the documented one (a legitimate
+    high-speed point refused), an open end."""
+    from gearjax.efficiency_inputs import check_operating_point
+    for T, n in ((1e-3, 1e-3), (200.0, 1500.0), (50.0, 3.0e4), (5.0, 1.2e5), (1e6, 1e6)):
+        assert check_operating_point(T, n) == (T, n)
+    for T, n, name in ((0.5e-3, 1500.0, "torque_Nm"), (2e6, 1500.0, "torque_Nm"),
+                       (200.0, 0.5e-3, "pinion_rpm"), (200.0, 2e6, "pinion_rpm")):
+        with pytest.raises(ValueError) as exc:
+            check_operating_point(T, n)
+        msg = str(exc.value)
+        assert "\n" not in msg and name in msg, msg
