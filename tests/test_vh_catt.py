@@ -254,6 +254,33 @@ def test_misaligned_contact_moves_off_the_middle(tca_runs):
     assert float(r.ptp) / gj.ARCSEC > 0.05
 
 
+def test_bearing_pushed_past_either_face_end_leaves_the_flank(pair, tca_runs):
+    """The pair is symmetric about its middle section: a misalignment (dSigma, dP)
+    and its mirror (-dSigma, -dP) put the contact at mirror-image axial positions (to
+    1e-9 mm).  With dSigma = 0.663 deg and the pinion moved 5 mm along its axis the
+    bearing runs from the middle past one face end, the pinion's and the gear's axial
+    positions differing by dP: where the pinion point lies beyond its face end and the
+    gear point inside the gear's, the contact is off the flank -- a point is on the flank
+    only inside both faces, at the heel (+) and at the toe (-).  Same compiled program
+    as ``tca_runs`` (the misalignment is traced).  Planted bug caught: a face-width
+    margin that checks one end only (the toe side never out of the face)."""
+    opts = dict(kinematics=False, face_ends=False, strict=False)
+    runs = {s: gj.run_tca(pair, gj.Misalignment.create(dSigma_deg=s * 0.663, dP=s * 5.0),
+                          **opts) for s in (1.0, -1.0)}
+    conv = np.asarray(runs[1.0].path.converged) & np.asarray(runs[-1.0].path.converged)
+    assert conv.sum() > 20
+    ax1 = {s: np.asarray(r.path.axial1) for s, r in runs.items()}
+    np.testing.assert_allclose(ax1[-1.0][conv], -ax1[1.0][conv], atol=1e-9)
+    half = 0.5 * float(pair.face_width)
+    for s, r in runs.items():
+        a1, a2 = np.abs(ax1[s]), np.abs(np.asarray(r.path.axial2))
+        on = np.asarray(r.on_flank)
+        assert on.sum() >= 5, s
+        assert np.all((a1 <= half + 1e-9) & (a2 <= half + 1e-9) | ~on), s
+        only_gear_inside = conv & (a1 > half) & (a2 < half)
+        assert only_gear_inside.sum() >= 3 and not np.any(on & only_gear_inside), s
+
+
 def _timoshenko(F, Rx, Ry, E_prime):
     """Seed's formula a, b = k_a, k_b [3w/(2E'(A+B))]^(1/3), k_a = (2 E(e)/(pi (1 -
     e^2)))^(1/3), k_b = k_a sqrt(1 - e^2), e from B/A = ((E/(1 - e^2)) - K)/(K - E)
