@@ -438,7 +438,7 @@ def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, pinion_r
     plaus = plausibility(ml.efficiency, ml.mu.T, F, p_max, y, _pitch(path.phi1, steps_per_pitch),
                          b_ax, R_x)
     valid = (conv & jnp.all(fr.converged | ~loaded_on, axis=0) & ~edge_loaded & ~truncated
-             & ~degenerate & jnp.any(loaded_on, axis=0) & plaus.all)
+             & ~degenerate & ~nothing_loaded & plaus.all)
     sm = cycle_summary(ml.power_loss, power_in, ml.mu.T, F, us, p_max, te_loaded, valid)
     return MeshEfficiency(path.phi1[win], lc, ue, us, R_x, R_y, fr, ml.power_loss, ml.efficiency,
                           sm.mean_efficiency, sm.mean_mu, sm.max_p_max, power_in, valid, truncated,
