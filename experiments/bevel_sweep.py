@@ -3,10 +3,11 @@ synthesis -> TCA, drive and coast (issue 27, item 4).
 
 Each design is drawn from the sampler :func:`sample`:
 
-* tooth numbers from :data:`TOOTH_PAIRS` (ratios 1, 2.5, 4.44, 8: the tooth numbers,
-  the hands and the flank side are static fields of the pair pytree, so each
-  combination compiles its own synthesis and TCA programs; a small pool keeps the
-  sweep at a few compiled programs per structure -- every other input is traced);
+* ratio ``u`` uniform in [1, 8], pinion teeth ``z1`` an integer in
+  ``[max(6, round(16 - 1.5 u)), max(that, min(30, round(45/u)))]`` (small pinions at
+  high ratios, as built), ``z2 = round(u z1)``.  Tooth numbers, hands and flank sides
+  are data of the pair pytree (``gearjax.gears.hypoid.pair.program_pair``), so the
+  whole sweep runs on a handful of compiled programs (counted in the report);
 * hypoid offset ``E = f * d_e2/2`` with ``f`` uniform in [0, 0.4] (the gear outer
   pitch radius), 15 % of the designs at ``E = 0`` (spiral bevel);
 * ISO 23509 Method 0 for ``E = 0`` (Method 0 is defined for zero offset only),
@@ -31,8 +32,11 @@ Pipeline (one design):
    the shipped hypoid examples (experiments/synthesis_hypoid.py): bearing at mid face
    (xi1 = 0) and mid working depth, 8 arcsec TE drop to +-p/2, apex at the mean
    contact, no cubic term, semi-major F/6, path angle -45 deg (drive) / +45 deg
-   (coast); start ``d_radius = +-2 mm, 2C = 0.02``.  Direct solve first; if it does
-   not converge, continuation from +-65 deg in 5-deg steps (as the example script).
+   (coast); start ``d_radius = +-2 mm, 2C = 0.02``, then the other sign of ``d_radius``
+   when the starting pinion makes no contact near the mean point (which sign localises
+   the bearing depends on the mounting hand and sense of rotation).  Direct solve
+   first; if it does not converge, continuation from +-65 deg in 5-deg steps (as the
+   example script).
 4. **TCA**: :func:`gearjax.gears.hypoid.synthesis.verify` (independent full TCA, 16
    steps per pitch, +-2 pitches, 5 pairs) and the contact-quality flags of
    :meth:`gearjax.tca_result.TCAResult.flags` of that TCA.
@@ -54,7 +58,8 @@ independent-TCA test; ``T`` = targets):
   parabolas one pitch apart cross half a pitch from either apex) and the transfers
   within 0.05 pitch of +-1/2;
 * envelope peak-to-peak on the 16-step grid between its closed-form bounds
-  ``8 (1 - 1/16)^2 = 7.03`` (transfer half a grid step off a node) and 8.5 arcsec;
+  ``T (1 - 2/16)`` (``T`` the smaller measured transfer drop: apex and transfer both
+  half a grid step off a node -- they are half a pitch, 8 steps, apart) and 8.5 arcsec;
 * path angle within 0.5 deg, semi-major axis within 0.05 mm of the target;
 * contact on both flanks between the transfers (min margin > 0) and contact ratio
   along the path > 1.
@@ -91,7 +96,6 @@ from gearjax.tca import ARCSEC  # noqa: E402
 from gearjax.tca_result import TCAResult  # noqa: E402
 
 #: tooth-number pool: ratios 1, 2.5, 4.44, 8 (static fields: one structure each)
-TOOTH_PAIRS = ((20, 20), (12, 30), (9, 40), (6, 48))
 #: side -> (gear flank of study_pair, path-angle target (deg), start d_radius (mm))
 SIDES = {"drive": ("convex", -45.0, 2.0), "coast": ("concave", 45.0, -2.0)}
 TE_TARGET = 8.0
@@ -113,7 +117,10 @@ jax.monitoring.register_event_duration_secs_listener(_on_duration)
 # ---------------------------------------------------------------- sampler
 def sample(rng) -> dict:
     """One design in file units (module docstring)."""
-    z1, z2 = TOOTH_PAIRS[int(rng.integers(len(TOOTH_PAIRS)))]
+    u = float(rng.uniform(1.0, 8.0))
+    lo = max(6, round(16 - 1.5 * u))
+    z1 = int(rng.integers(lo, max(lo, min(30, round(45 / u))) + 1))
+    z2 = max(z1, round(u * z1))
     de2 = float(rng.uniform(150.0, 300.0))
     frac = 0.0 if rng.uniform() < 0.15 else float(rng.uniform(0.0, 0.4))
     return dict(
@@ -162,7 +169,11 @@ def target_checks(ver: dict, tgt) -> list[str]:
     lo, hi = ver["transfer_offset_pitch"]
     if not (abs(lo + 0.5) < 0.05 and abs(hi - 0.5) < 0.05):
         fails.append("transfer_points")
-    ptp_lo = TE_TARGET * (1.0 - 1.0 / VERIFY_STEPS) ** 2
+    # grid sampling of two parabolas of drop T (apex to transfer) m steps per pitch apart:
+    # apex and transfer share their offset from the nearest nodes (half a pitch apart), at
+    # most half a step; the sampled top is at most T/m^2 below the apex, the sampled
+    # bottom at most T (1 - (1 - 1/m)^2) above the transfer: ptp >= T (1 - 2/m)
+    ptp_lo = min(ver["te_transfer_arcsec"]) * (1.0 - 2.0 / VERIFY_STEPS)
     if not ptp_lo - 1e-9 <= ver["ptp_arcsec"] <= TE_TARGET + 0.5:
         fails.append("te_ptp")
     if not abs(ver["path_angle_deg"] - math.degrees(b_t)) < 0.5:
@@ -181,6 +192,8 @@ def measured_hand(fl) -> str:
     tests/test_hypoid_surface.py): right hand when, going toe -> heel at mid height,
     the tooth turns positively about the work axis (apex -> heel)."""
     g = flank_surface(fl, 9, 5, strict=False)
+    if not bool(np.all(np.asarray(g.converged))):
+        raise ConvergenceError("the generated flank's grid did not converge (no hand to measure)")
     P = np.asarray(g.points)
     j = P.shape[1] // 2
     t, r = P[-1, j] - P[0, j], P[P.shape[0] // 2, j]
@@ -203,14 +216,28 @@ def flank_pair(inp: BlankInput, side: str):
 
 
 def synthesise_side(st, side: str):
-    """Direct solve, then continuation from +-65 deg; returns (result, route)."""
+    """Direct solve from ``d_radius = +-2 mm`` (the side's sign first, then the other: the
+    sign that localises the bearing depends on the mounting hand and the sense of
+    rotation, not on the side alone), then continuation from +-65 deg from the first
+    start whose TCA ran; returns (result, route).  Raises the ConvergenceError of the
+    last start when no start gives a TCA."""
     _, angle, dr = SIDES[side]
-    v0 = np.array([dr, 0.02, 0, 0, 0, 0, 0], float)
     tg = sy.Targets(path_angle_deg=angle)
-    res = sy.synthesise(st, tg, v0=v0, strict=False)
-    if res.converged:
-        return res, "direct"
-    v = v0
+    first, err = None, None
+    for sign in (1.0, -1.0):
+        v0 = np.array([sign * dr, 0.02, 0, 0, 0, 0, 0], float)
+        try:
+            res = sy.synthesise(st, tg, v0=v0, strict=False)
+        except ConvergenceError as exc:         # the start's TCA failed: the other sign
+            err = exc
+            continue
+        route = "direct" if sign > 0 else "direct, other start sign"
+        if res.converged:
+            return res, route
+        first = first or (res, v0, route)
+    if first is None:
+        raise err
+    res, v, route = first
     for a in np.arange(65.0, abs(angle) - 1e-9, -5.0):
         r = sy.synthesise(st, sy.Targets(path_angle_deg=float(np.sign(angle) * a)), v0=v,
                           strict=False)
@@ -388,6 +415,13 @@ def main(argv=None):
     ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "bevel_sweep"))
     ap.add_argument("--skip", type=int, default=0,
                     help="skip the first SKIP sampled designs (resume a killed run; merge by hand)")
+    ap.add_argument("--resume", action="store_true",
+                    help="continue OUT.json: keep its rows and run the designs after them "
+                         "(a long run in several processes: one XLA process accumulating "
+                         "thousands of programs ran out of LLVM memory after ~700 compilations)")
+    ap.add_argument("--chunk", type=int, default=0,
+                    help="stop after CHUNK designs (0: all); with --resume, a shell loop "
+                         "runs the sweep in fresh processes")
     ap.add_argument("--from-json", action="store_true", help="rebuild OUT.md from OUT.json")
     a = ap.parse_args(argv)
     out = Path(a.out)
@@ -396,22 +430,31 @@ def main(argv=None):
         out.with_suffix(".md").write_text(markdown(data["summary"]))
         return
     rng = np.random.default_rng(a.seed)
-    designs = [sample(rng) for _ in range(a.n)][a.skip:]
-    rows = []
+    rows, prior = [], dict(wall_s=0.0, compiles=0, compile_s=0.0)
+    if a.resume and out.with_suffix(".json").exists():
+        old = json.loads(out.with_suffix(".json").read_text())
+        rows = old["rows"]
+        prior = {k: old["summary"].get(k, 0) for k in prior}
+    skip = a.skip + len(rows)
+    designs = [sample(rng) for _ in range(a.n)][skip:]
+    if a.chunk:
+        designs = designs[:a.chunk]
     t0 = time.perf_counter()
-    for i, d in enumerate(designs):
+    for i, d in enumerate(designs, start=skip):
         try:
             rows.append(run_design(d))
         except Exception as exc:                   # noqa: BLE001 -- a crash is a finding
             rows.append(dict(design=d, outcome="crash", error=_msg(exc),
                              traceback=traceback.format_exc()))
-        meta = dict(seed=a.seed, n_requested=a.n, wall_s=time.perf_counter() - t0,
-                    compiles=COMPILES["n"], compile_s=COMPILES["seconds"])
+        meta = dict(seed=a.seed, n_requested=a.n,
+                    wall_s=prior["wall_s"] + time.perf_counter() - t0,
+                    compiles=prior["compiles"] + COMPILES["n"],
+                    compile_s=prior["compile_s"] + COMPILES["seconds"])
         summary = summarise([r for r in rows if r["outcome"] != "crash"], meta)
         summary["crashes"] = [r for r in rows if r["outcome"] == "crash"]
         out.with_suffix(".json").write_text(json.dumps(dict(summary=summary, rows=rows), indent=1,
                                                        default=float))
-        print(f"[{i + 1}/{a.n}] {time.perf_counter() - t0:.0f} s  {COMPILES['n']} compiles  "
+        print(f"[{i + 1}/{a.n}] {meta['wall_s']:.0f} s  {meta['compiles']} compiles  "
               f"{rows[-1]['outcome']}  "
               f"{d['z1']}/{d['z2']} E={d['offset_mm']:.1f} b={d['spiral_angle_deg']:.1f} {d['hand']}",
               flush=True)

@@ -94,6 +94,8 @@ def require_converged(converged: Any, what: str, residual: Any = None) -> None:
         n_bad = int(c.size - np.count_nonzero(c))
         msg = f"{what}: {n_bad} of {c.size} solves did not converge"
         if residual is not None:
-            r = np.asarray(residual)
-            msg += f" (worst residual {float(np.nanmax(np.where(np.isfinite(r), r, np.inf))):.3g})"
+            # the residual of the failed solves only (a converged neighbour's residual
+            # says nothing about them)
+            r = np.broadcast_to(np.asarray(residual, float), c.shape)[~c.astype(bool)]
+            msg += f" (worst residual among them {float(np.max(np.where(np.isfinite(r), r, np.inf))):.3g})"
         raise ConvergenceError(msg + "; pass strict=False to get masks instead")

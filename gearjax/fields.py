@@ -63,6 +63,19 @@ def float64_array(v):
     return jnp.asarray(v, jnp.float64)
 
 
+def floats_for_ints(obj, names) -> None:
+    """In a frozen dataclass's ``__post_init__``: each field of ``names`` given as a Python
+    or NumPy integer (a tooth number, a hand +-1, a blade sign) stored as a float64 array,
+    so that the pytree has only inexact leaves (``jax.grad`` of a whole design refuses
+    integer leaves) and one compiled program serves ints and floats.  Anything else
+    (arrays, tracers, the placeholders JAX unflattens with) is left as it is."""
+    import numpy as np
+    for name in names:
+        v = getattr(obj, name)
+        if isinstance(v, (int, np.integer)) and not isinstance(v, (bool, np.bool_)):
+            object.__setattr__(obj, name, jnp.asarray(float(v), jnp.float64))
+
+
 def strong_float64(tree):
     """``tree`` with every floating-point leaf as a strongly typed float64 array.
 

@@ -142,14 +142,16 @@ class Assembly:
     R0 : (3,3) gear body frame -> fixed frame at phi2 = 0.
     c0 : (3,) crossing point on the gear axis (mm).
     d : (3,) unit common perpendicular (direction of dE, axis of dSigma).
-    z1, z2 : tooth numbers (static); ratio_sign : sign of the nominal rho (static).
+    z1, z2 : tooth numbers (data, so that pairs of other tooth numbers share a compiled
+        program: they only enter the nominal ratio); ratio_sign : sign of the nominal
+        rho (static).
     """
 
     R0: jnp.ndarray
     c0: jnp.ndarray
     d: jnp.ndarray
-    z1: int = field(metadata=dict(static=True))
-    z2: int = field(metadata=dict(static=True))
+    z1: jnp.ndarray
+    z2: jnp.ndarray
     ratio_sign: int = field(metadata=dict(static=True), default=-1)
 
 

@@ -123,7 +123,7 @@ def test_formate_from_placement_reproduces_the_cone():
             h = (p - c) @ ax
             r = np.linalg.norm(p - c - h * ax)
             assert r == pytest.approx(float(g.cutter.point_radius) + math.tan(float(g.cutter.blade_angle)) * h
-                                      * g.cutter.sign, abs=1e-9)
+                                      * float(g.cutter.sign), abs=1e-9)
 
 
 @pytest.fixture(scope="module")

@@ -179,16 +179,6 @@ def pitch_setup(inp: BlankInput, settings: StudySettings, flank: str = "convex")
     """
     if flank not in _FLANKS:
         raise ValueError(f"flank = {flank!r} must be one of {_FLANKS}")
-    try:
-        E0 = float(inp.offset)
-    except (TypeError, jax.errors.ConcretizationTypeError):     # traced offset: no check
-        E0 = None
-    if E0 is not None and not E0 > 0.0:
-        # the cutter is laid along the sliding velocity v21 at the pitch point, which
-        # vanishes without offset (pure rolling): j = v21/|v21| would be 0/0 (NaN)
-        raise ValueError(f"offset = {E0:g} mm: the cone model lays the cutter along the "
-                         "sliding velocity at the pitch point, zero for a spiral-bevel pair; "
-                         "range offset > 0 mm (hypoid)")
     r0 = jnp.asarray(settings.cutter_radius, float)
     inp_r = dataclasses.replace(inp, cutter_radius=r0)
     bd = blank_core(inp_r, inp.z2 / inp.z1)
@@ -202,7 +192,18 @@ def pitch_setup(inp: BlankInput, settings: StudySettings, flank: str = "convex")
     wg = jax.lax.stop_gradient(sg) * (inp.z1 / inp.z2) * u2
     mesh = Mesh(omega1=wg, omega2=wp, a=C1)
     v21 = jnp.cross(wg, P) - vp
-    j = v21 / jnp.linalg.norm(v21)
+    # lengthwise direction at the pitch point: along the sliding velocity v21 of a
+    # hypoid pair; a spiral-bevel pair (E = 0) rolls purely there (v21 = 0), and the
+    # tooth trace is the line at the gear's mean spiral angle from its pitch
+    # generatrix in the pitch plane, j = -cos(b2) g2' + sin(b2) (k x g2') (g2' the
+    # generatrix in the tangent plane) -- the same direction v21 has on every hypoid
+    # (tests/test_bevel_sweep.py), so the two agree in the limit E -> 0
+    g2t = g2 - jnp.dot(g2, k) * k
+    g2t = g2t / jnp.linalg.norm(g2t)
+    j_trace = -jnp.cos(bd["beta_m2"]) * g2t + jnp.sin(bd["beta_m2"]) * jnp.cross(k, g2t)
+    nv = jnp.linalg.norm(v21)
+    hypoid = nv > 1e-9 * jnp.linalg.norm(P) * jnp.linalg.norm(wp)
+    j = jnp.where(hypoid, v21 / jnp.where(hypoid, nv, 1.0), j_trace)
     i = jnp.cross(j, k)
     e = -g2 + jnp.dot(g2, j) * j
     e = e / jnp.linalg.norm(e)

@@ -28,6 +28,7 @@ Units: mm, rad.  Reference: [Eigenfunctions] §2.
 
 from __future__ import annotations
 
+import math
 from typing import NamedTuple
 
 import jax
@@ -92,13 +93,15 @@ def study_pair(inp: BlankInput, settings: StudySettings, flank: str = "convex",
     on its machine, hand measured on the generated flanks); ``inp.hand == "left"``
     places the mirror image ``M G M``, ``M = diag(1, -1, 1, 1)`` (the cone reflected in
     the gear work frame's x-z plane), and the pinion it generates is the mirror image
-    too.  Offset 0 is refused (:func:`~gearjax.studies.cutter_radius.pitch_setup`).
+    too.  A spiral-bevel set (offset 0) lays the cutter along the tooth trace at the mean
+    spiral angle (:func:`~gearjax.studies.cutter_radius.pitch_setup`).
     Differentiable with respect to
     ``settings`` (and ``edge_radius``); under ``jax.jit`` the mean-contact search of
     :func:`~gearjax.gears.hypoid.formate.generating_gear_pinion` is refused.
     """
     s = pitch_setup(inp, settings, flank)
     bd = s.blank
+    _check_gear_spiral(bd["beta_m2"])
     geo = pitch_cones.cone_tangency(bd["delta1"], bd["delta2"], inp.shaft_angle, inp.offset,
                                     bd["Rm2"])
     P, g1, g2, u1, u2 = s.P, geo["g1"], geo["g2"], s.u1, s.u2
@@ -135,6 +138,23 @@ def study_pair(inp: BlankInput, settings: StudySettings, flank: str = "convex",
                       inp.z1, inp.z2, 1)
     pair, info = generating_gear_pinion(pair)
     return StudyPair(pair, s, info, A2, Q, phi0, u_root)
+
+
+def _check_gear_spiral(beta_m2) -> None:
+    """Refuse a blank whose gear mean spiral angle is not positive (concrete values; a
+    traced one passes).  With ``beta_m2 <= 0`` (a large offset with a small pinion spiral
+    angle: ``beta_m2 = beta_m1 - eps'``) the gear's trace turns the other way and the
+    route's mirror rule for the hand no longer holds: it cut a right-hand design's
+    pinion left-handed (measured on the generated flanks; the bevel sweep, docs/hypoid.md)."""
+    from gearjax.errors import is_traced
+    if is_traced(beta_m2):
+        return
+    b = float(beta_m2)
+    if not b > 0.0:
+        raise ValueError(f"beta_m2 = {math.degrees(b):.4g} deg (the blank's gear mean spiral "
+                         "angle): the cone-model flank route needs beta_m2 > 0 deg (gear and "
+                         "pinion of opposite hands); raise the pinion spiral angle or reduce "
+                         "the offset")
 
 
 def study_uv(sp: StudyPair, p2_body):

@@ -89,7 +89,6 @@ def _outward_normal(fl, surf, uv):
     return work_point(fl, uv[1], uv[0], psi)[1]
 
 
-@functools.partial(jax.jit, static_argnames=("line_contact",))
 def path_kinematics(pair: th.HypoidPair, path: ContactPath, mis: Misalignment | None = None,
                     *, line_contact: bool = False) -> PathKinematics:
     """Model and pair kinematics at every point of ``path`` (module docstring; jitted).
@@ -99,7 +98,13 @@ def path_kinematics(pair: th.HypoidPair, path: ContactPath, mis: Misalignment | 
     (``line_contact``).  Points where the path did not converge give meaningless
     values: mask them with ``path.converged``.
     """
+    from gearjax.gears.hypoid.pair import program_pair   # one program for every pair
     mis = Misalignment.zero() if mis is None else mis
+    return _path_kinematics(program_pair(pair), path, mis, line_contact=line_contact)
+
+
+@functools.partial(jax.jit, static_argnames=("line_contact",))
+def _path_kinematics(pair, path, mis, *, line_contact):
     r1 = th.flank_function(pair.pinion, pair.pinion_crossing)
     r2 = th.flank_function(pair.gear, pair.gear_crossing)
     asm = th.hypoid_assembly(pair)

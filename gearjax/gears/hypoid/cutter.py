@@ -47,6 +47,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from gearjax.errors import check_range, is_traced
+from gearjax.fields import floats_for_ints
 
 __all__ = ["FaceMillCutter", "make_cutter", "cutter_point", "cutter_normal",
            "cutter_tangents", "fillet_start", "fillet_point", "fillet_normal",
@@ -54,8 +55,8 @@ __all__ = ["FaceMillCutter", "make_cutter", "cutter_point", "cutter_normal",
 
 
 @functools.partial(jax.tree_util.register_dataclass,
-                   data_fields=["point_radius", "blade_angle", "edge_radius"],
-                   meta_fields=["sign"])
+                   data_fields=["point_radius", "blade_angle", "edge_radius", "sign"],
+                   meta_fields=[])
 @dataclass(frozen=True)
 class FaceMillCutter:
     """One blade of a straight-blade face-mill cutter (a pytree).
@@ -65,13 +66,18 @@ class FaceMillCutter:
     point_radius : R_p, radius of the blade tip corner (mm).
     blade_angle : alpha, blade (pressure) angle, in (0, pi/4) (rad).
     edge_radius : rho_f, radius of the blade tip fillet (mm), >= 0.
-    sign : +1 inside blade (cuts a convex flank), -1 outside blade (concave flank).
+    sign : +1 inside blade (cuts a convex flank), -1 outside blade (concave flank);
+        a data field (it only multiplies: the drive and coast flanks share a compiled
+        program).
     """
 
     point_radius: jax.Array
     blade_angle: jax.Array
     edge_radius: jax.Array
-    sign: int = 1
+    sign: jax.Array = 1
+
+    def __post_init__(self):
+        floats_for_ints(self, ("sign",))
 
     @property
     def side(self) -> str:

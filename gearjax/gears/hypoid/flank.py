@@ -56,6 +56,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from gearjax import frames
+from gearjax.fields import floats_for_ints
 from gearjax.gears.hypoid.cutter import (FaceMillCutter, blade_data, cone_normal, cone_point,
                                          cutter_normal, cutter_point, fillet_start)
 from gearjax.errors import check_int, check_positive, check_range, require_converged
@@ -78,15 +79,19 @@ BLANK_FIELDS = ["outer_cone_distance", "face_width", "pitch_angle", "face_angle"
                 "outer_addendum", "outer_dedendum", "mean_spiral_angle"]
 
 
-@functools.partial(jax.tree_util.register_dataclass, data_fields=BLANK_FIELDS,
-                   meta_fields=["teeth", "hand"])
+@functools.partial(jax.tree_util.register_dataclass, data_fields=BLANK_FIELDS + ["teeth"],
+                   meta_fields=["hand"])
 @dataclass(frozen=True)
 class MemberBlank:
     """Cone data of one member's blank (mm, rad), as in [HFT-hypoid] Table 1.
 
     outer_cone_distance A_o, face_width F (mm), pitch/face/root cone angles,
     outer addendum and dedendum (mm, at the heel, Gleason convention), mean spiral
-    angle; static: number of teeth and hand of spiral ("left"/"right").
+    angle; number of teeth (a data field: it only enters arithmetic, so blanks of
+    every tooth number share a compiled program); hand of spiral ("left"/"right",
+    static, a label: no computation reads it -- the hand of a flank is the geometry of
+    its machine settings -- and :func:`gearjax.gears.hypoid.pair.program_pair` drops it
+    at the family's jit boundaries).
     """
 
     outer_cone_distance: jax.Array
@@ -97,8 +102,11 @@ class MemberBlank:
     outer_addendum: jax.Array
     outer_dedendum: jax.Array
     mean_spiral_angle: jax.Array
-    teeth: int = 1
+    teeth: jax.Array = 1
     hand: str = "right"
+
+    def __post_init__(self):
+        floats_for_ints(self, ("teeth",))
 
 
 def make_member_blank(*, outer_cone_distance, face_width, pitch_angle, face_angle, root_angle,
@@ -431,7 +439,8 @@ def flank_surface(fl: FlankSpec, n_xi: int = 21, n_s: int = 11, *, strict: bool 
     converged (``strict=False`` returns the grid with its ``converged`` mask)."""
     n_xi = check_int("n_xi", n_xi, 2, 2001)
     n_s = check_int("n_s", n_s, 2, 2001)
-    g = _flank_points_jit(fl, n_xi, n_s)
+    from gearjax.gears.hypoid.pair import program_pair   # one program per grid size
+    g = _flank_points_jit(program_pair(fl), n_xi, n_s)
     if strict:
         require_converged(g.converged, "hypoid flank grid", g.residual)
     return g

@@ -297,7 +297,16 @@ def generating_gear_pinion(pair, *, hand: int | None = None, depth=None):
              for sols in [mean_contact_angle(pair, h, gear_mean=gm)] if sols]
     if not cands:
         raise ConvergenceError("the gear's mean point is in contact at no gear angle")
-    _, hand, sol = min(cands, key=lambda c: c[0])
+    bad, hand, sol = min(cands, key=lambda c: c[0])
+    if bad > 1.0:
+        # the best root puts the gear's mean point off the pinion blank (beyond a face
+        # end, or more than 1 mm outside its cones): a pinion generated from it is not
+        # this design's (the bevel sweep: a left-hand 9/40 spiral bevel got a right-hand
+        # pinion from a root at xi = -129) -- refuse
+        raise ConvergenceError(
+            f"the gear's mean point meets the pinion blank nowhere near its face (best root: "
+            f"xi = {float(_primal(sol['xi'])):.3g}, height above the root cone "
+            f"{float(_primal(sol['h'])):.3g} mm; on the blank: |xi| <= 1, height >= 0)")
     D = (mean_dedendum(pair.pinion.blank) + mean_dedendum(g.blank) if depth is None
          else jnp.asarray(depth, float))
     G = cutter_to_work(g.machine, 0.0)

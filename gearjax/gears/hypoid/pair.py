@@ -61,7 +61,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax.fields import float64_array
+from gearjax.fields import float64_array, floats_for_ints
 from gearjax.frames import matrix_x
 from gearjax.gears.hypoid.cutter import FaceMillCutter
 from gearjax.gears.hypoid.flank import (FlankSpec, face_cone_gap, mid_estimate, pitch_distance,
@@ -70,7 +70,7 @@ from gearjax.gears.hypoid.machine import MachineSettings, cutter_to_cradle
 from gearjax.surfaces import GeneratedSurface
 from gearjax.tca import Assembly, ContactPath
 
-__all__ = ["SIDES", "HypoidPair", "pair_flanks", "mean_dedendum", "complementary_pinion",
+__all__ = ["SIDES", "HypoidPair", "program_pair", "pair_flanks", "mean_dedendum", "complementary_pinion",
            "with_point_radius", "flank_function", "hypoid_assembly", "mean_point",
            "flank_coordinates", "hypoid_margin"]
 
@@ -81,8 +81,8 @@ SIDES = {"drive": ("concave", "convex"), "coast": ("convex", "concave")}
 
 @functools.partial(jax.tree_util.register_dataclass,
                    data_fields=["pinion", "gear", "shaft_angle", "offset", "pinion_crossing",
-                                "gear_crossing"],
-                   meta_fields=["z1", "z2", "hand"])
+                                "gear_crossing", "z1", "z2", "hand"],
+                   meta_fields=[])
 @dataclass(frozen=True)
 class HypoidPair:
     """One meshing flank pair and its nominal mounting (a pytree; mm, rad).
@@ -93,7 +93,10 @@ class HypoidPair:
         axis in its work frame (mm from the pitch apex towards the heel; ISO 23509's
         "pitch apex beyond crossing point" t_z, 0 for a spiral-bevel pair).
     z1, z2 : tooth numbers; hand : +1 / -1, the mirror image of the mounting
-        (static; found by :func:`reference_guess` when not known).
+        (found by :func:`~gearjax.gears.hypoid.tca.prepare` when not known).  Data
+        fields, not static ones: they enter the programs only through arithmetic (the
+        ratio, the angular pitch, the sign of a rotation), so pairs of every tooth
+        number and hand share one compiled program (:func:`program_pair`).
     """
 
     pinion: FlankSpec
@@ -102,13 +105,45 @@ class HypoidPair:
     offset: jax.Array
     pinion_crossing: jax.Array
     gear_crossing: jax.Array
-    z1: int = 1
-    z2: int = 1
-    hand: int = 1
+    z1: jax.Array = 1
+    z2: jax.Array = 1
+    hand: jax.Array = 1
+
+    def __post_init__(self):
+        floats_for_ints(self, ("z1", "z2", "hand"))
 
 
 def _f(v):
     return float64_array(float(v))
+
+
+def program_pair(tree):
+    """``tree`` (a :class:`HypoidPair`, a :class:`FlankSpec` or any pytree holding them)
+    as the argument of a compiled program of this family: every number a strongly
+    typed float64 array -- tooth numbers, the mounting hand and the blade signs
+    included (Python ints and weakly typed floats would each key their own program) --
+    and each blank's hand-of-spiral label set to None (a label no computation reads;
+    :class:`~gearjax.gears.hypoid.flank.MemberBlank`).  One compiled TCA, synthesis
+    or kinematics program then serves every tooth number, hand of spiral, mounting
+    hand and flank side; what stays static is the structure: which members are
+    generated (a generated flank is an envelope, a formate one a cone) and the grid
+    options.  Tracers pass through unchanged; booleans are kept."""
+    from gearjax.gears.hypoid.flank import MemberBlank
+
+    def strip(x):
+        return replace(x, hand=None) if isinstance(x, MemberBlank) else x
+
+    def leaf(v):
+        if isinstance(v, jax.core.Tracer) or isinstance(v, (bool, np.bool_)):
+            return v
+        dt = getattr(v, "dtype", None)
+        if isinstance(v, (int, float, np.integer, np.floating)) or (
+                dt is not None and np.issubdtype(dt, np.number)):
+            return float64_array(v)
+        return v
+
+    tree = jax.tree_util.tree_map(strip, tree, is_leaf=lambda x: isinstance(x, MemberBlank))
+    return jax.tree_util.tree_map(leaf, tree)
 
 
 def check_pair_fields(pair: HypoidPair) -> None:

@@ -125,7 +125,12 @@ def _tangency(s1, c1, s2, c2, gamma, Sigma, E, R2):
     # coincident points: R1 g1 + s1' u1 - s2' u2 = C2 - C1 + R2 g2 (linear)
     A = jnp.stack([g1, u1, -u2], axis=1)
     rhs = C2 - C1 + R2 * g2
-    R1, sp1, sp2 = jnp.linalg.solve(A, rhs)
+    # E = 0 (spiral bevel, intersecting axes): g1, u1, u2 are coplanar and the system
+    # is singular -- the cones touch along the whole common generatrix g1 = g2 through
+    # the common apex at the crossing point: R1 = R2, both apexes at the crossing point
+    degenerate = jnp.abs(jnp.linalg.det(A)) < 1e-12
+    R1, sp1, sp2 = jnp.where(degenerate, jnp.stack([R2, 0.0 * R2, 0.0 * R2]),
+                             jnp.linalg.solve(jnp.where(degenerate, jnp.eye(3), A), rhs))
     P = C2 + sp2 * u2 + R2 * g2
     theta1 = jnp.arctan2(jnp.dot(m1, jnp.cross(u1, ex)), jnp.dot(m1, ex))
     theta2 = jnp.arctan2(jnp.dot(m2, jnp.cross(u2, ex)), jnp.dot(m2, ex))

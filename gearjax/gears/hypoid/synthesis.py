@@ -114,6 +114,7 @@ import numpy as np
 
 from gearjax import optimize
 from gearjax.gears.hypoid import tca as th
+from gearjax.gears.hypoid.pair import program_pair
 from gearjax.errors import ConvergenceError, check_int, check_range
 from gearjax.gears.hypoid.formate import generating_gear_pinion
 from gearjax.newton import newton_solve
@@ -268,15 +269,17 @@ def _parts(pair, v, tgt, y_guess, theta_m, sgn, steps_per_pitch):
     ref = newton_solve(G, jax.lax.stop_gradient(y_guess), (), tol=1e-11, max_steps=40)
     m = steps_per_pitch
     k = m // 2
-    p = 2.0 * np.pi / pair.z1
-    t = (p / m) * np.arange(-k, k + 1, dtype=float)
-    grid = ref.x[5] + jnp.asarray(t)
+    p = 2.0 * np.pi / pair.z1                   # traced: tooth numbers are data
+    n = np.arange(-k, k + 1, dtype=float)       # grid index (static)
+    grid = ref.x[5] + (p / m) * jnp.asarray(n)
     path = contact_path(r1, r2, asm, mis, grid, ref.x[:5], line_contact=False)
     dx, dh = jax.vmap(fc)(path.p1_body)
     mid = k
     eta = -sb * dx[mid] + cb * dh[mid]
-    V = np.stack([np.ones_like(t), t, t ** 2, t ** 3], axis=1)
-    c = jnp.asarray(np.linalg.pinv(V)) @ path.te
+    # cubic least-squares fit of TE in t = (p/m) n: fitted in the static index n, the
+    # coefficients then scaled by (m/p)^j
+    V = np.stack([np.ones_like(n), n, n ** 2, n ** 3], axis=1)
+    c = (jnp.asarray(np.linalg.pinv(V)) @ path.te) * (m / p) ** jnp.arange(4.0)
     apex = c[1] * (0.5 * p) / ARCSEC
     cubic = c[3] * (0.5 * p) ** 3 / ARCSEC
     level = -sgn * c[2] * (0.5 * p) ** 2
@@ -335,7 +338,7 @@ def _solve(st: Start, v0, tgt, y_guess, free_mask, *, steps_per_pitch, max_iter,
     sgn = 1.0 if st.drive else -1.0
     # strong float64 leaves: pairs built from files (weak-typed scalars) and from
     # computations then share one compiled function
-    pair = jax.tree_util.tree_map(lambda x: jnp.asarray(x, dtype=jnp.float64), st.pair)
+    pair = program_pair(st.pair)
     n = len(VARIABLES)
     free_mask = np.asarray(free_mask, bool)
     bound = np.where(free_mask, np.inf, 0.0)
@@ -524,6 +527,10 @@ def verify(pair: th.HypoidPair, tgt, *, steps_per_pitch: int = 16, half_pitches:
     sgn = 1.0 if prep.drive else -1.0
     key = np.where(ok, sgn * te, -np.inf)
     j = int(np.argmax(key))
+    if not 0 < j < len(te) - 1 or not (ok[j - 1] and ok[j + 1]):
+        raise ConvergenceError("verify: the TE apex of pair 0 is at an end of its on-flank "
+                               "contact (no parabola top on the grid): the bearing is not "
+                               "localised near the reference")
     y0, y1, y2 = sgn * te[j - 1], sgn * te[j], sgn * te[j + 1]
     den = y0 - 2 * y1 + y2
     off = 0.5 * (y0 - y2) / den
@@ -543,7 +550,10 @@ def verify(pair: th.HypoidPair, tgt, *, steps_per_pitch: int = 16, half_pitches:
         transfer_offset_pitch=[float((t - phi_c) / pitch) for t in tr],
         apex_offset_pitch=float((phi_apex - phi_c) / pitch),
         ptp_arcsec=float(np.asarray(out.multi.ptp) / ARCSEC),
-        min_margin_between_transfers_mm=float(np.min(np.asarray(out.margin)[lo:hi])),
+        # no grid node between the transfers (or a transfer not found: NaN): NaN, not a
+        # crash -- the contact ratio and the flags say what is wrong
+        min_margin_between_transfers_mm=(float(np.min(np.asarray(out.margin)[lo:hi]))
+                                         if hi > lo else float("nan")),
         contact_ratio=float(np.asarray(out.multi.contact_ratio)),
         seconds=secs, result=out, prepared=prep)
 

@@ -31,6 +31,7 @@ import numpy as np
 from gearjax.gears.hypoid.design_file import HypoidDesign
 from gearjax.gears.hypoid.flank import face_apex_offset, root_apex_offset
 from gearjax.gears.hypoid.pair import (SIDES, HypoidPair, complementary_pinion, flank_coordinates,
+                                       program_pair,
                                        flank_function, hypoid_assembly, hypoid_face_ends,
                                        hypoid_margin,
                                        mean_dedendum, mean_point, pair_flanks, with_point_radius)
@@ -273,12 +274,14 @@ def hypoid_tca_traced(pair: HypoidPair, mis: Misalignment, x_ref, phi1_ref, *,
     return HypoidTCA(path, margin, multi, coords)
 
 
-_STATIC = ("steps_per_pitch", "half_pitches", "line_contact", "n_pairs", "drive")
+# ``drive`` (the sense of rotation) is a traced argument of the programs, ``side`` a label
+# put on the result outside them: the drive and coast flanks share one program
+_STATIC = ("steps_per_pitch", "half_pitches", "line_contact", "n_pairs")
 
 
 @functools.partial(jax.jit, static_argnames=_STATIC)
-def _tca_jit(pair, mis, x_ref, phi1_ref, approach, *, steps_per_pitch, half_pitches,
-             line_contact, n_pairs, drive):
+def _tca_jit(pair, mis, x_ref, phi1_ref, approach, drive, *, steps_per_pitch, half_pitches,
+             line_contact, n_pairs):
     return hypoid_tca_traced(pair, mis, x_ref, phi1_ref, steps_per_pitch=steps_per_pitch,
                              half_pitches=half_pitches, line_contact=line_contact,
                              n_pairs=n_pairs, drive=drive, approach=approach)
@@ -303,10 +306,10 @@ def hypoid_tca(pair: HypoidPair | Prepared, mis: Misalignment | None = None, *,
     prep = pair if isinstance(pair, Prepared) else prepare(pair)
     if mis is None:
         mis = Misalignment.zero()
-    out = _tca_jit(strong_float64(prep.pair), strong_float64(mis), jnp.asarray(prep.x_ref),
-                   jnp.asarray(prep.phi1_ref), float(approach), steps_per_pitch=int(steps_per_pitch),
-                   half_pitches=float(half_pitches), line_contact=bool(line_contact),
-                   n_pairs=int(n_pairs), drive=bool(prep.drive))
+    out = _tca_jit(program_pair(prep.pair), strong_float64(mis), jnp.asarray(prep.x_ref),
+                   jnp.asarray(prep.phi1_ref), float(approach), jnp.asarray(bool(prep.drive)),
+                   steps_per_pitch=int(steps_per_pitch), half_pitches=float(half_pitches),
+                   line_contact=bool(line_contact), n_pairs=int(n_pairs))
     if strict:
         check_on_flank_converged(out.path, out.margin)
     return out
@@ -338,8 +341,8 @@ def tca_summary(pair: HypoidPair, res: HypoidTCA):
 
 
 @functools.partial(jax.jit, static_argnames=_STATIC)
-def _sensitivity_jit(pair, mis, x_ref, phi1_ref, approach, *, steps_per_pitch, half_pitches,
-                     line_contact, n_pairs, drive):
+def _sensitivity_jit(pair, mis, x_ref, phi1_ref, approach, drive, *, steps_per_pitch,
+                     half_pitches, line_contact, n_pairs):
     def f(m):
         res = hypoid_tca_traced(pair, m, x_ref, phi1_ref, steps_per_pitch=steps_per_pitch,
                                 half_pitches=half_pitches, line_contact=line_contact,
@@ -362,12 +365,13 @@ def misalignment_sensitivity(prep: Prepared, mis: Misalignment | None = None, *,
     check_tca_options(steps_per_pitch, half_pitches, n_pairs, approach)
     if mis is None:
         mis = Misalignment.zero()
-    vals, jac = _sensitivity_jit(strong_float64(prep.pair), strong_float64(mis),
+    vals, jac = _sensitivity_jit(program_pair(prep.pair), strong_float64(mis),
                                  jnp.asarray(prep.x_ref),
                                  jnp.asarray(prep.phi1_ref), float(approach),
+                                 jnp.asarray(bool(prep.drive)),
                                  steps_per_pitch=int(steps_per_pitch),
                                  half_pitches=float(half_pitches), line_contact=False,
-                                 n_pairs=int(n_pairs), drive=bool(prep.drive))
+                                 n_pairs=int(n_pairs))
     values = {k: float(v) for k, v in zip(SUMMARY_KEYS, np.asarray(vals))}
     table = {k: {name: float(np.asarray(getattr(jac, name))[i])
                  for name in ("dE", "dP", "dG", "dSigma")} for i, k in enumerate(SUMMARY_KEYS)}
@@ -420,16 +424,30 @@ def hypoid_result_traced(pair: HypoidPair, mis: Misalignment, x_ref, phi1_ref, *
     return TCAResult(res.path, res.margin, res.multi, res.coords, kin, side, "hypoid")
 
 
-_RSTATIC = ("side", "drive", "steps_per_pitch", "half_pitches", "line_contact", "n_pairs", "kinematics")
+_RSTATIC = ("steps_per_pitch", "half_pitches", "line_contact", "n_pairs", "kinematics")
 
 
 @functools.partial(jax.jit, static_argnames=_RSTATIC)
-def _result_jit(pair, mis, x_ref, phi1_ref, approach, *, side, drive, steps_per_pitch,
-                half_pitches, line_contact, n_pairs, kinematics):
-    return hypoid_result_traced(pair, mis, x_ref, phi1_ref, side=side, drive=drive,
+def _result_program(pair, mis, x_ref, phi1_ref, approach, drive, *, steps_per_pitch,
+                    half_pitches, line_contact, n_pairs, kinematics):
+    return hypoid_result_traced(pair, mis, x_ref, phi1_ref, side="", drive=drive,
                                 steps_per_pitch=steps_per_pitch, half_pitches=half_pitches,
                                 line_contact=line_contact, n_pairs=n_pairs, approach=approach,
                                 kinematics=kinematics)
+
+
+def _result_jit(pair, mis, x_ref, phi1_ref, approach, *, side, drive, **static):
+    """The compiled TCA-result program (one for both sides and every tooth number and
+    hand: ``pair`` through :func:`program_pair`, ``drive`` traced) with ``side`` put
+    on the result."""
+    res = _result_program(program_pair(pair), mis, x_ref, phi1_ref, approach,
+                          jnp.asarray(drive), **static)
+    return replace(res, side=side)
+
+
+def _join_unchanged(pair, _extra):
+    """The loaded chain's ``join_pair`` of this family: the pair needs nothing back."""
+    return pair
 
 
 class _Adapter:
@@ -440,6 +458,10 @@ class _Adapter:
 
     family = "hypoid"
     defaults = dict(steps_per_pitch=16, half_pitches=2.0, n_pairs=5)
+    # the loaded chain's program takes the pair through program_pair (one program for
+    # every tooth number and hand)
+    split_pair = staticmethod(lambda pair: (program_pair(pair), None))
+    join_pair = staticmethod(_join_unchanged)
 
     @staticmethod
     def _prepared(design, side):
@@ -473,7 +495,7 @@ class _Adapter:
         check_tca_options(steps_per_pitch, half_pitches, n_pairs, approach)
         prep, side = self._prepared(design, side)
         mis = Misalignment.zero() if mis is None else mis
-        res = _result_jit(strong_float64(prep.pair), strong_float64(mis), jnp.asarray(prep.x_ref),
+        res = _result_jit(program_pair(prep.pair), strong_float64(mis), jnp.asarray(prep.x_ref),
                           jnp.asarray(prep.phi1_ref),
                           float(approach), side=side, drive=bool(prep.drive),
                           steps_per_pitch=int(steps_per_pitch),
@@ -495,7 +517,7 @@ class _Adapter:
             # it is traced once and inlined; called eagerly it runs compiled, not op
             # by op)
             mis = Misalignment.zero() if mis is None else mis
-            return _result_jit(strong_float64(replace(pair, hand=hand)), strong_float64(mis),
+            return _result_jit(program_pair(replace(pair, hand=hand)), strong_float64(mis),
                                x_ref, phi1_ref, approach,
                                side=side, drive=drive, steps_per_pitch=int(steps_per_pitch),
                                half_pitches=float(half_pitches), line_contact=bool(line_contact),
