@@ -38,12 +38,14 @@ LEAD = 0.5 * B * DG * np.cos(np.radians(20.0)) / RB2      # rad, edge ahead of m
 
 @pytest.fixture(scope="module")
 def traced():
-    """The involute TCA (drive side, line contact) with and without face ends: one
-    compiled program each."""
-    run = {fe: jax.jit(lambda d, m, fe=fe: itca.involute_tca_traced(d, m, side=-1,
-                                                                  face_ends=fe))
-           for fe in (True, False)}
-    return run
+    """The involute TCA (line contact) with and without face ends: one compiled program
+    each, ``traced[fe](design, misalignment, side=-1.0)``; the side (-1 drive, +1 coast)
+    is a traced argument, so both sides share the program."""
+    progs = {fe: jax.jit(lambda d, m, s, fe=fe: itca.involute_tca_traced(d, m, side=s,
+                                                                       face_ends=fe))
+             for fe in (True, False)}
+    return {fe: (lambda d, m, side=-1.0, p=p: p(d, m, jnp.asarray(side, float)))
+            for fe, p in progs.items()}
 
 
 def _mis(dg):
@@ -89,6 +91,37 @@ def test_the_other_crossing_sense_loads_the_other_end(traced):
         ends[sign] = {EDGE_NAMES[k].split()[1] for k in kind[carried]}
     assert ends[1.0] == {"heel"} and ends[-1.0] == {"toe"} or \
         ends[1.0] == {"toe"} and ends[-1.0] == {"heel"}, ends
+
+
+@pytest.mark.parametrize("sign", [1.0, -1.0])
+def test_coast_side_touches_at_the_other_face_end(traced, sign):
+    """The crossed uncrowned spur pair on the coast side (the other flanks in contact,
+    the load sense reversed).  The crossing moves a gear tooth at axial position z
+    sideways by dg z (rotation about the centre line): towards the pinion tooth's drive
+    flank at one face end and towards its coast flank at the other.  So the coast
+    contact is made at the face end opposite the drive side's, at the same distance
+    (b/2) dg cos(aw)/r_b2 from the mid-face section but ahead in the coast sense: a
+    smaller TE (the closed form of the module docstring with the load sense reversed).
+    Same compiled programs as the drive tests (the side is traced).  Planted bug
+    caught: the edge candidate picked by the largest TE whatever the side (the
+    trailing end on the coast side)."""
+    ends = {}
+    for side in (-1.0, 1.0):
+        path, margin, _ = traced[True](SPUR, _mis(sign * DG), side)
+        section, _, _ = traced[False](SPUR, _mis(sign * DG), side)
+        kind = np.asarray(path.edge_kind)
+        carried = (np.asarray(margin) >= 0.0) & (kind >= 0)
+        assert carried.sum() > 20, side
+        ax = np.where(kind[carried] < 2, np.asarray(path.axial1)[carried],
+                      np.asarray(path.axial2)[carried])
+        np.testing.assert_allclose(np.abs(ax), 0.5 * B, atol=1e-6)
+        ends[side] = {EDGE_NAMES[k].split()[1] for k in kind[carried]}
+        assert len(ends[side]) == 1, ends
+        # ahead of the mid-face section in the sense of the load: larger TE on the drive
+        # side, smaller on the coast side
+        lead = (np.asarray(path.te) - np.asarray(section.te))[carried]
+        np.testing.assert_allclose(-side * lead, LEAD, rtol=2e-3)
+    assert ends[-1.0] != ends[1.0], ends
 
 
 HELICAL = gj.InvoluteTCA.create(gj.InvolutePair.create(20, 40, 4.0, 20.0, 15.0, 0.2, 0.0), B)
@@ -544,6 +577,32 @@ def test_tip_corner_under_a_shaft_angle_error_matches_the_closed_form(traced, mi
 
 # -- VH-CATT tip edges -------------------------------------------------------------------
 
+def _vh_tools(pair):
+    """Closed-form cutting data (NumPy) of the drive flanks of the VH-CATT pinion and gear
+    of ``pair`` = {"pinion": pair the pinion is cut as, "gear": the seed's pair}
+    (NumPy leaves): the blade cones of :func:`~gearjax.gears.vh_catt.geometry.
+    envelope_point_np`."""
+    from gearjax.gears.vh_catt import geometry as G
+    pin, gp = pair["pinion"], pair["gear"]
+    k1 = G.tool_data(pin.module, pin.pressure_angle, pin.cutter_radius("pinion"), 17,
+                     G.HANDS["pinion"], -1.0, pin.blade_offset, xp=np)   # drive flanks
+    k2 = G.tool_data(gp.module, gp.pressure_angle, gp.cutter_radius("gear"), 23,
+                     G.HANDS["gear"], -1.0, gp.blade_offset, xp=np)
+    return k1, k2
+
+
+def _vh_u_at_radius(k, R, zz):
+    """Blade coordinate u of the closed-form flank point of radius R in section zz
+    (SciPy root), bracketed about the middle section's blade coordinate of that radius
+    (rack geometry), on the working branch."""
+    from scipy.optimize import brentq
+    from gearjax.gears.vh_catt import geometry as G
+    ca, sa = float(k.cos_a), float(k.sin_a)
+    u0 = (np.sqrt(max(R ** 2 - (k.r * ca) ** 2, 0.0)) - k.r * sa) * sa / ca
+    f = lambda u: np.hypot(*G.envelope_point_np(k, u, zz)[0][:2]) - R
+    return brentq(f, u0 - 1.0, u0 + 1.0, xtol=1e-14, rtol=1e-15)
+
+
 def _vh_gear_corner(pair, cf, ph1, e):
     """Gear angle (rad) at which the gear's tip corner at face end ``e`` touches the
     pinion flank of the mismatched VH-CATT pair below, and the pinion point's radius
@@ -555,29 +614,15 @@ def _vh_gear_corner(pair, cf, ph1, e):
     same radius in that section (root in u) has the same polar angle (root in phi2)."""
     from scipy.optimize import brentq
     from gearjax.gears.vh_catt import geometry as G
-    pin = pair["pinion"]
-    k1 = G.tool_data(pin.module, pin.pressure_angle, pin.cutter_radius("pinion"), 17,
-                     G.HANDS["pinion"], -1.0, pin.blade_offset, xp=np)   # drive flanks
-    gp = pair["gear"]
-    k2 = G.tool_data(gp.module, gp.pressure_angle, gp.cutter_radius("gear"), 23,
-                     G.HANDS["gear"], -1.0, gp.blade_offset, xp=np)
-    z = e * 0.5 * float(gp.face_width)
-
-    def radius_u(k, R, zz):
-        # bracketed about the middle section's blade coordinate of that radius (rack
-        # geometry), on the working branch
-        ca, sa = float(k.cos_a), float(k.sin_a)
-        u0 = (np.sqrt(max(R ** 2 - (k.r * ca) ** 2, 0.0)) - k.r * sa) * sa / ca
-        f = lambda u: np.hypot(*G.envelope_point_np(k, u, zz)[0][:2]) - R
-        return brentq(f, u0 - 1.0, u0 + 1.0, xtol=1e-14, rtol=1e-15)
-
-    q2 = G.envelope_point_np(k2, radius_u(k2, cf.g[1]["ra"], z), z)[0]
+    k1, k2 = _vh_tools(pair)
+    z = e * 0.5 * float(pair["gear"].face_width)
+    q2 = G.envelope_point_np(k2, _vh_u_at_radius(k2, cf.g[1]["ra"], z), z)[0]
 
     def mismatch(ph2):
         c, s_ = np.cos(ph2), np.sin(ph2)
         W = np.array([c * q2[0] - s_ * q2[1], cf.a + s_ * q2[0] + c * q2[1]])
         R = np.hypot(*W)
-        q1 = G.envelope_point_np(k1, radius_u(k1, R, z), z)[0]
+        q1 = G.envelope_point_np(k1, _vh_u_at_radius(k1, R, z), z)[0]
         return np.angle(np.exp(1j * (np.arctan2(W[1], W[0]) - ph1
                                      - np.arctan2(q1[1], q1[0])))), R
 
@@ -586,7 +631,18 @@ def _vh_gear_corner(pair, cf, ph1, e):
     return ph2, mismatch(ph2)[1]
 
 
-def test_vh_catt_tip_contact_matches_closed_forms():
+@pytest.fixture(scope="module")
+def vh_tip_run():
+    """The seed's VH-CATT pair and its TCA with edges (drive side), the pinion cut as the
+    pinion of a given pair (e.g. another blade angle: a base-pitch mismatch): one
+    compiled program, ``run(pair, pinion_pair, misalignment)``, for every pinion and
+    misalignment."""
+    from gearjax.gears.vh_catt.tca import vh_tca_traced
+    pair = gj.load_design("example:vh_catt_17x23").pair
+    return pair, jax.jit(lambda p, q, m: vh_tca_traced(p, m, -1.0, pinion=q))
+
+
+def test_vh_catt_tip_contact_matches_closed_forms(vh_tip_run):
     """VH-CATT: the pinion of the seed's pair (17/23, m = 4 mm, alpha = 20 deg, b = 28 mm,
     R_T = 400 mm, blade offset 3 mm) cut with a blade angle 1 deg larger -- a deliberate
     base-pitch mismatch (the pinion's base pitch is the smaller): premature contact of
@@ -599,10 +655,9 @@ def test_vh_catt_tip_contact_matches_closed_forms():
     envelopes (_vh_gear_corner).  At each grid point where the gear tip carries the
     load, the TCA's contact is the leading one of these candidates, at its gear angle."""
     from dataclasses import replace
-    from gearjax.gears.vh_catt.tca import vh_flanks, vh_tca_traced
-    pair = gj.load_design("example:vh_catt_17x23").pair
+    from gearjax.gears.vh_catt.tca import vh_flanks
+    pair, run = vh_tip_run
     pin = replace(pair, pressure_angle=pair.pressure_angle + np.radians(1.0))
-    run = jax.jit(lambda p, q, m: vh_tca_traced(p, m, -1.0, pinion=q))
     path, margin, multi = run(pair, pin, _mis(0.0))
     mid = path.phi1.shape[0] // 2
     cf = _ClosedFormSpur(17, 23, 4.0, 20.0, 1.0, 80.0, (1.0, 1.0))
@@ -639,3 +694,129 @@ def test_vh_catt_tip_contact_matches_closed_forms():
             assert abs(float(path.axial2[j])) < 1e-9
     assert max(errs) < 1e-6, errs
     np.testing.assert_allclose(np.asarray(path.radial2)[carried], cf.g[1]["ra"], atol=1e-9)
+
+
+def _vh_boundaries(z, module, alpha, face_width):
+    """Closed-form flank boundaries of a VH-CATT member (rack geometry of the straight
+    blade): tip radius ``r + m``; form radius ``sqrt(r_b^2 + rho_F^2)`` of the straight
+    blade, ``rho_F = r sin(alpha) - m/sin(alpha)`` the roll distance at which the blade's
+    end (depth m below the pitch line) meets the line of action, clipped at the base
+    circle where the member is undercut (``rho_F < 0``); half face width."""
+    r = 0.5 * z * module
+    rb = r * np.cos(alpha)
+    rho_f = max(r * np.sin(alpha) - module / np.sin(alpha), 0.0)
+    return dict(tip=r + module, root=np.hypot(rb, rho_f), face=0.5 * face_width)
+
+
+def _rot_z(t):
+    c, s = np.cos(t), np.sin(t)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+@pytest.mark.parametrize("dP,dg_deg", [(0.0, 0.02), (0.0, 0.1), (3.0, 0.0)],
+                         ids=["tilt-small", "tilt", "shift"])
+def test_vh_catt_edge_contacts_on_both_flanks_and_tangent(vh_tip_run, dP, dg_deg):
+    """The seed's VH-CATT pair (17/23: unequal members) with the pinion cut with a blade
+    angle 1 deg smaller (base pitch larger: prolonged contact at the pinion tip) under a
+    shaft-angle error (the tip contact moves off the middle section; at 0.1 deg the
+    bearing also runs onto the heel: face-end edges and corners) or the pinion pushed
+    3 mm along its axis (the contact runs along the pinion's toe end, then on its tip
+    edge near the toe).  At every grid point where an edge carries the contact, against
+    the closed-form boundaries of each member (_vh_boundaries: tip, form circle, face
+    width, from the rack; radii and axial positions of the reported body points):
+
+    * both points lie on their flanks (every margin >= 0);
+    * the reported margin is the distance to the nearest boundary other than the edge
+      itself (a face end's own face end, a tip edge's own tip circle); 0 at a corner,
+      which lies on a face end by its equations (face_end_contact's contract) -- with
+      unequal members and the bearing off the middle the nearest boundary is now the
+      edge point's own form circle or face end, now the mating member's form circle;
+    * at a tip-edge contact the two points coincide in the fixed frame and the tip edge
+      is tangent to the mating flank: its tangent (central difference along the
+      closed-form tip edge, the flank points of radius r_a in neighbouring sections)
+      lies in the mating flank's tangent plane (normal from the closed-form envelope's
+      partial derivatives) -- where the TE along the tip edge is stationary, the point
+      the rigid teeth touch first.
+
+    Same compiled program as test_vh_catt_tip_contact_matches_closed_forms.  Planted
+    bugs caught: the edge's own root or face margin taken from the mating member, the
+    mating member's root boundary not checked (tip/fillet interference accepted), the
+    pinion tip-edge tangency written with the gear's tip gradient."""
+    from dataclasses import replace
+    from gearjax.gears.vh_catt import geometry as G
+    pair, run = vh_tip_run
+    pin = replace(pair, pressure_angle=pair.pressure_angle - np.radians(1.0))
+    dg = np.radians(dg_deg)
+    mis = gj.Misalignment(*(jnp.asarray(v, float) for v in (0.0, dP, 0.0, dg)))
+    path, margin, _ = run(pair, pin, mis)
+    kind = np.asarray(path.edge_kind)
+    mg = np.asarray(margin)
+    carried = np.nonzero((mg >= 0.0) & (kind >= 0))[0]
+    names = [EDGE_NAMES[k] for k in kind]
+    assert len(carried) >= 3 and any(names[j] == "pinion tip" for j in carried)
+    b = float(pair.face_width)
+    lim = (_vh_boundaries(17, 4.0, float(pin.pressure_angle), b),
+           _vh_boundaries(23, 4.0, float(pair.pressure_angle), b))
+    radial = (np.asarray(path.radial1), np.asarray(path.radial2))
+    axial = (np.asarray(path.axial1), np.asarray(path.axial2))
+    pn = jax.tree_util.tree_map(np.asarray, {"pinion": pin, "gear": pair})
+    tools = _vh_tools(pn)
+    a = 0.5 * (17 + 23) * 4.0
+    nearest = set()
+    n_tip = 0
+    for j in carried:
+        own = 0 if names[j].startswith("pinion") else 1
+        parts = {}
+        for i in (0, 1):
+            parts[i, "tip"] = lim[i]["tip"] - radial[i][j]
+            parts[i, "root"] = radial[i][j] - lim[i]["root"]
+            parts[i, "face"] = lim[i]["face"] - abs(axial[i][j])
+        assert min(parts.values()) >= -1e-9, (j, names[j], parts)
+        if "corner" in names[j]:
+            assert abs(mg[j]) < 2e-8, (j, names[j], mg[j])
+            continue
+        parts.pop((own, "tip" if names[j].endswith("tip") else "face"))
+        key = min(parts, key=parts.get)
+        nearest.add(("own " if key[0] == own else "mating ") + key[1])
+        assert abs(mg[j] - parts[key]) < 1e-9, (j, names[j], mg[j], parts)
+        if not names[j].endswith("tip"):
+            continue
+        # the tip edge touching the mating flank: a common point, edge tangent in the
+        # mating flank's tangent plane (closed-form envelopes, NumPy)
+        n_tip += 1
+        mate = 1 - own
+        k_own, k_mate = tools[own], tools[mate]
+        R_tip = lim[own]["tip"]
+
+        def tip_point(zz):
+            return G.envelope_point_np(k_own, _vh_u_at_radius(k_own, R_tip, zz), zz)[0]
+
+        def mate_point(u, zz):
+            return G.envelope_point_np(k_mate, u, zz)[0]
+
+        q_own = tip_point(axial[own][j])
+        u_m = _vh_u_at_radius(k_mate, radial[mate][j], axial[mate][j])
+        q_mate = mate_point(u_m, axial[mate][j])
+        h = 1e-4
+        t = (tip_point(axial[own][j] + h) - tip_point(axial[own][j] - h)) / (2 * h)
+        du = (mate_point(u_m + h, axial[mate][j]) - mate_point(u_m - h, axial[mate][j])) / (2 * h)
+        dz = (mate_point(u_m, axial[mate][j] + h) - mate_point(u_m, axial[mate][j] - h)) / (2 * h)
+        n = np.cross(du, dz)
+        # body frames -> fixed frame: pinion turned by phi1 about z (shifted by dP along
+        # z), gear turned by phi2 about its axis, then by dg about the centre line y,
+        # its centre at (0, a, 0)
+        R1 = _rot_z(float(path.phi1[j]))
+        R2 = _rot_y(dg) @ _rot_z(float(path.phi2[j]))
+        q1, q2 = (q_own, q_mate) if own == 0 else (q_mate, q_own)
+        W1 = R1 @ q1 + np.array([0.0, 0.0, dP])
+        W2 = np.array([0.0, a, 0.0]) + R2 @ q2
+        np.testing.assert_allclose(W1, W2, rtol=0, atol=1e-8)
+        Rown, Rmate = (R1, R2) if own == 0 else (R2, R1)
+        tw, nw = Rown @ t, Rmate @ n
+        cos_tn = np.dot(tw, nw) / (np.linalg.norm(tw) * np.linalg.norm(nw))
+        assert abs(cos_tn) < 1e-8, (j, names[j], cos_tn)
+    assert n_tip >= 3
+    # the cases reach the boundaries the planted bugs confuse
+    assert "mating root" in nearest
+    if dP:
+        assert {"own root", "own face"} <= nearest, nearest

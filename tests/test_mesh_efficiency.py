@@ -210,8 +210,9 @@ def test_loaded_edge_contact_is_flagged_and_not_valid(spur, oil_surface, weber_r
     loaded gear presses, and its load is not modelled -- every position where it is the
     contact made is flagged ``edge_loaded`` and is not valid, and the warnings say so;
     the aligned pair has none.  Same compiled programs as ``weber_run`` (the
-    misalignment is traced).  Planted bug caught: the sign of the 'pressed by the loaded
-    gear' test (an edge contact behind the loaded gear flagged, the one it presses not)."""
+    misalignment is traced).  (No surface contact carries load there: the positions count
+    as pressed whatever the sign of the 'pressed by the loaded gear' comparison, which
+    test_tip_contact_ahead_of_the_loaded_gear_is_flagged decides.)"""
     eff0, _ = weber_run
     assert not np.any(np.asarray(eff0.edge_loaded))
     mis = gj.Misalignment.create(dSigma_deg=0.05)
@@ -228,6 +229,42 @@ def test_loaded_edge_contact_is_flagged_and_not_valid(spur, oil_surface, weber_r
     np.testing.assert_array_equal(flagged, made)
     assert not np.any(np.asarray(eff.valid) & flagged)
     assert any("edge" in w for w in efficiency_warnings(eff, res))
+
+
+@pytest.mark.parametrize("dalpha", [1.0, -1.0], ids=["premature", "prolonged"])
+def test_tip_contact_ahead_of_the_loaded_gear_is_flagged(spur, oil_surface, weber_run, dalpha):
+    """A base-pitch mismatch (the pinion cut with the pressure angle 1 deg larger /
+    smaller): the rigid teeth touch at a tooth tip off the line of action, where the
+    incoming pair's gear tip (premature contact) or the outgoing pair's pinion tip
+    (prolonged contact) leads the mesh (closed forms in tests/test_edge_contact.py),
+    while the other pair's surface contact -- the only contact whose load is modelled
+    -- is behind it.  Second route: the TCA's rigid TE envelope (with the tip contacts)
+    against the envelope of the surface contacts alone.  Where a tip contact leads
+    every surface contact it is ahead of the loaded gear whatever the deflection (the
+    loaded TE falls back from the surface envelope), so the gear presses on it: the
+    position is flagged ``edge_loaded`` and is not valid, although a surface contact
+    carries load there; at every other position no edge is touched and the position
+    is valid.  Same compiled programs as ``weber_run`` (the mismatch is a traced field
+    of the design).  Planted bug caught: the sign of the 'pressed by the loaded gear'
+    test (an edge contact behind the loaded gear flagged, the one it presses not)."""
+    from gearjax.loaded_contact import pair_arrays
+    from gearjax.mesh_efficiency import cycle_window
+    des = gj.InvoluteTCA.create(spur[0], B, dalpha_deg=dalpha)
+    eff, res = mesh_efficiency(des, TORQUE, RPM, *oil_surface, compliance="weber", strict=False)
+    spp = eff.phi1.shape[0]
+    win = cycle_window(res.path.phi1.shape[0], spp)
+    te_surface = np.asarray(pair_arrays(jnp.where(res.on_flank, res.path.te, -jnp.inf), spp, 3,
+                                        -np.inf, win)).max(axis=0)
+    rigid = np.asarray(res.multi.envelope)[win]
+    tip_leads = rigid > te_surface + 1e-8                     # rad
+    assert 3 <= tip_leads.sum() <= spp // 2
+    edge = np.asarray(pair_arrays(res.edge_points, spp, 3, False, win)).any(axis=0)
+    np.testing.assert_array_equal(edge, tip_leads)            # the tip contact made
+    n_loaded = np.asarray(eff.loaded.n_loaded)
+    assert np.all(n_loaded[tip_leads] >= 1)                   # a surface contact carries load
+    np.testing.assert_array_equal(np.asarray(eff.edge_loaded), tip_leads)
+    np.testing.assert_array_equal(np.asarray(eff.valid), ~tip_leads)
+    assert any("edge contact under load" in w for w in efficiency_warnings(eff, res))
 
 
 def test_line_contact_material_scaling(spur, oil_surface, iso_run, weber_run):

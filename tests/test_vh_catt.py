@@ -354,3 +354,48 @@ def test_second_branch_past_the_edge_of_regression_is_off_the_flank(pair):
     _, _, root_second, *_ = parts(jnp.asarray(second)[None], q2, jnp.array([[u2, 0.0]]), uv)
     assert float(root_work[0]) > 0.0
     assert float(root_second[0]) < 0.0
+
+
+def test_root_margin_is_continuous_across_the_edge_of_regression(pair):
+    """Both members (17/23: different base circles), middle section: the blade point
+    ``u_b = -r sin^2(alpha)/cos(alpha)`` generates the base-circle point (closed form,
+    1e-9 mm), where the working involute and the second branch meet -- one point, so
+    one root margin: ``r_b - r_F`` from either side (``r_F`` the form radius of the
+    straight blade, clipped at the base circle for the undercut pinion: closed form);
+    continuous there to the rounding of a radius that grows as the square of the
+    distance.  On the second branch the margin keeps counting the way along the flank
+    from the form circle down to the base circle and back up: ``-(r_F - r_b) - (r - r_b)``
+    at the radius r of the point, e.g. at the pitch radius (``u = 2 u_b``).  Planted bug
+    caught: the gear's second-branch margin with the pinion's base radius (a jump of
+    2 (r_b2 - r_b1) = 22.6 mm at the base circle)."""
+    from gearjax.gears.vh_catt.tca import margin_parts, vh_flanks
+    flanks = vh_flanks(pair, -1.0)
+    parts = margin_parts(pair)
+    al = float(pair.pressure_angle)
+    m = float(pair.module)
+    other = jnp.asarray(flanks[0](jnp.zeros(2)))[None]      # an on-flank point (the other slot)
+    zero_uv = jnp.zeros((1, 2))
+    eps = 1e-3
+    for i, z in enumerate((pair.z1, pair.z2)):
+        r = 0.5 * z * m
+        rb = r * math.cos(al)
+        rF = math.hypot(rb, max(r * math.sin(al) - m / math.sin(al), 0.0))
+        u_b = -r * math.sin(al) ** 2 / math.cos(al)
+
+        def root(u):
+            q = jnp.asarray(flanks[i](jnp.array([u, 0.0])))
+            assert abs(float(q[2])) < 1e-9                 # the middle section
+            uv = jnp.array([[u, 0.0]])
+            args = (q[None], other, uv, zero_uv) if i == 0 else (other, q[None], zero_uv, uv)
+            return float(parts(*args)[2 if i == 0 else 5][0]), float(jnp.hypot(q[0], q[1]))
+
+        _, r_b = root(u_b)
+        assert abs(r_b - rb) < 1e-9, (i, r_b, rb)
+        (m_work, r_work), (m_second, r_second) = root(u_b + eps), root(u_b - eps)
+        assert r_work > rb and r_second > rb
+        np.testing.assert_allclose([m_work, m_second], rb - rF, atol=1e-5)
+        np.testing.assert_allclose(m_work, r_work - rF, rtol=0, atol=1e-12)
+        m_pitch, r_pitch = root(2.0 * u_b)
+        assert abs(r_pitch - r) < 1e-6
+        np.testing.assert_allclose(m_pitch, -(rF - rb) - (r_pitch - rb), rtol=0, atol=1e-12)
+        assert m_pitch < 0.0
