@@ -490,3 +490,27 @@ def test_implausible_results_are_flagged_and_not_valid(spur, iso_run):
     # the spur run's own contacts are far inside Hertz theory (half-width / R_x)
     hw = np.asarray(eff.loaded.semi_minor) / np.asarray(eff.r_x)
     assert np.max(hw[np.asarray(eff.loaded.load) > 0]) < 0.1
+
+
+def test_cycle_is_one_pitch_starting_half_a_pitch_before_the_reference(spur, iso_run):
+    """The mesh cycle is one angular pitch 2 pi/z1 of the pinion centred on the TCA
+    reference angle (the middle of the odd TCA grid, phi1_ref): the half-open interval
+    [phi1_ref - pi/z1, phi1_ref + pi/z1) sampled with the grid step 2 pi/(z1 spp).
+    Indices by hand: the grid has 2 k + 1 angles (middle index k = N // 2); the cycle
+    takes grid indices k - spp/2 .. k + spp/2 - 1, the reference at cycle index spp/2.
+    Planted bug caught: the window shifted one grid step off the reference."""
+    eff, res = iso_run
+    phi = np.asarray(res.path.phi1)
+    cyc = np.asarray(eff.phi1)
+    n, spp = phi.shape[0], cyc.shape[0]
+    assert n % 2 == 1 and spp % 2 == 0
+    h = 2.0 * np.pi / (Z1 * spp)
+    np.testing.assert_allclose(np.diff(phi), h, rtol=1e-12)
+    ref = phi[(n - 1) // 2]
+    # the half-open pitch [ref - pi/z1, ref + pi/z1) on the grid ref + j h
+    np.testing.assert_allclose(cyc, ref + h * np.arange(-spp // 2, spp // 2), rtol=0,
+                               atol=1e-12)
+    np.testing.assert_allclose(cyc[0], ref - np.pi / Z1, rtol=0, atol=1e-12)
+    assert cyc[-1] < ref + np.pi / Z1 - 0.5 * h
+    start = (n - 1) // 2 - spp // 2
+    np.testing.assert_array_equal(cyc, phi[start:start + spp])

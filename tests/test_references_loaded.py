@@ -785,3 +785,32 @@ def test_preset_bevel_loaded_contacts_by_hand(pb_run):
     te = sense * np.where(loaded, sense * _per_pair(res, eff, res.path.te), -np.inf).max(axis=0)
     np.testing.assert_allclose(np.asarray(eff.loaded.te_loaded)[j], te[j] - sense * y,
                                rtol=1e-9)
+
+
+def test_vh_catt_friction_radii_along_the_entrainment_by_hand(vh_run):
+    """Point contact (r_x != r_y): the radii given to the friction model are the
+    relative radii of curvature along and across the entrainment vector.  By hand,
+    with the curvature tensor diag(1/r_x, 1/r_y) of the TCA kinematics in its
+    principal frame (t, e_major) and the entrainment direction d = (1, tan theta_e)
+    normalised (the vector's components, module docstring) -- the normal curvature
+    d^T K d (Euler) and that of the perpendicular direction; at theta_e = 0 they are
+    r_x and r_y themselves.  Planted bug caught: R_x built with cos/sin swapped."""
+    pair, (eff, res) = vh_run
+    F = np.asarray(eff.loaded.load)
+    loaded = F > 0.0
+    assert loaded.sum() >= 24
+    rx = _per_pair(res, eff, res.kinematics.r_x)[loaded]
+    ry = _per_pair(res, eff, res.kinematics.r_y)[loaded]
+    th = _per_pair(res, eff, res.kinematics.entrainment_angle)[loaded]
+    assert np.all(ry > 2.0 * rx)                       # a true point contact
+    d = np.stack([np.ones_like(th), np.tan(th)]) / np.sqrt(1.0 + np.tan(th) ** 2)
+    e = np.stack([-d[1], d[0]])                        # across the entrainment
+    K = np.stack([1.0 / rx, 1.0 / ry])                 # principal curvatures
+    Rx_hand = 1.0 / np.sum(K * d ** 2, axis=0)
+    Ry_hand = 1.0 / np.sum(K * e ** 2, axis=0)
+    Rx, Ry = np.asarray(eff.r_x)[loaded], np.asarray(eff.r_y)[loaded]
+    np.testing.assert_allclose(Rx, Rx_hand, rtol=1e-12)
+    np.testing.assert_allclose(Ry, Ry_hand, rtol=1e-12)
+    # where the entrainment runs along t the radii are the principal ones
+    zero = np.abs(th) < 1e-9
+    np.testing.assert_allclose(Rx[zero], rx[zero], rtol=1e-12)

@@ -5,6 +5,8 @@ tooth thickness, Hertz), from the ISO 6336-1 formulas ([ISO6336-1], docs/referen
 or from central differences — never from the code under test.
 """
 
+import math
+
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -251,3 +253,30 @@ def test_virtual_teeth_of_helical_and_bevel_members():
     a = pair(20.0, 45.0, beta)
     b = pair(zn1, zn2, 0.0)
     np.testing.assert_allclose(float(a), float(b), rtol=1e-13)
+
+
+def test_path_of_contact_of_a_shifted_pair_against_iso21771():
+    """A profile-shifted pair with x1 + x2 != 0 (so alpha_w != alpha): ISO 21771 gives
+    the base pitch p_b = pi m cos(alpha) -- the reference pressure angle, a property of
+    the rack, not of the centre distance -- and the transverse contact ratio
+    eps_alpha = [sqrt(r_a1^2 - r_b1^2) + sqrt(r_a2^2 - r_b2^2) - a_w sin(alpha_w)] / p_b
+    with a_w = (r_b1 + r_b2)/cos(alpha_w); alpha_w from inv(alpha_w) = inv(alpha)
+    + 2 tan(alpha)(x1 + x2)/(z1 + z2) solved here by scipy's brentq.  Planted bug
+    caught: the base pitch from the operating pressure angle."""
+    from scipy.optimize import brentq
+    z1, z2, m, x1, x2 = 18, 41, 3.0, 0.45, 0.25
+    inv = lambda a: math.tan(a) - a  # noqa: E731
+    target = inv(ALPHA) + 2.0 * math.tan(ALPHA) * (x1 + x2) / (z1 + z2)
+    a_w = brentq(lambda a: inv(a) - target, 1e-3, 1.2, xtol=1e-15, rtol=1e-15)
+    assert a_w - ALPHA > 0.02                          # the shift changes the angle
+    r1, r2 = 0.5 * m * z1, 0.5 * m * z2
+    rb1, rb2 = r1 * math.cos(ALPHA), r2 * math.cos(ALPHA)
+    ra1, ra2 = r1 + (1.0 + x1) * m, r2 + (1.0 + x2) * m
+    p_b = math.pi * m * math.cos(ALPHA)
+    aw = (rb1 + rb2) / math.cos(a_w)
+    eps = (math.sqrt(ra1 ** 2 - rb1 ** 2) + math.sqrt(ra2 ** 2 - rb2 ** 2)
+           - aw * math.sin(a_w)) / p_b
+    path = tc.path_of_contact(z1, z2, m, ALPHA, x1, x2)
+    np.testing.assert_allclose(float(path.alpha_w), a_w, rtol=1e-12)
+    np.testing.assert_allclose(float(path.p_b), p_b, rtol=1e-14)
+    np.testing.assert_allclose(float(path.eps_alpha), eps, rtol=1e-12)
