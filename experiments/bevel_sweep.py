@@ -59,7 +59,8 @@ independent-TCA test; ``T`` = targets):
   within 0.05 pitch of +-1/2;
 * envelope peak-to-peak on the 16-step grid between its closed-form bounds
   ``T (1 - 2/16)`` (``T`` the smaller measured transfer drop: apex and transfer both
-  half a grid step off a node -- they are half a pitch, 8 steps, apart) and 8.5 arcsec;
+  half a grid step off a node -- they are half a pitch, 8 steps, apart) less 0.05 arcsec
+  for the TE's departure from two parabolas (measured: 0.006), and 8.5 arcsec;
 * path angle within 0.5 deg, semi-major axis within 0.05 mm of the target;
 * contact on both flanks between the transfers (min margin > 0) and contact ratio
   along the path > 1.
@@ -100,6 +101,7 @@ from gearjax.tca_result import TCAResult  # noqa: E402
 SIDES = {"drive": ("convex", -45.0, 2.0), "coast": ("concave", 45.0, -2.0)}
 TE_TARGET = 8.0
 VERIFY_STEPS = 16
+PTP_SHAPE_ARCSEC = 0.05
 
 # ---------------------------------------------------------------- compile counter
 COMPILES = {"n": 0, "seconds": 0.0}
@@ -173,7 +175,9 @@ def target_checks(ver: dict, tgt) -> list[str]:
     # apex and transfer share their offset from the nearest nodes (half a pitch apart), at
     # most half a step; the sampled top is at most T/m^2 below the apex, the sampled
     # bottom at most T (1 - (1 - 1/m)^2) above the transfer: ptp >= T (1 - 2/m)
-    ptp_lo = min(ver["te_transfer_arcsec"]) * (1.0 - 2.0 / VERIFY_STEPS)
+    # (less PTP_SHAPE_ARCSEC: the TE curves are parabolas only to the order synthesis
+    # controls; quartic and higher terms move the sampled values by a few milliarcsec)
+    ptp_lo = min(ver["te_transfer_arcsec"]) * (1.0 - 2.0 / VERIFY_STEPS) - PTP_SHAPE_ARCSEC
     if not ptp_lo - 1e-9 <= ver["ptp_arcsec"] <= TE_TARGET + 0.5:
         fails.append("te_ptp")
     if not abs(ver["path_angle_deg"] - math.degrees(b_t)) < 0.5:

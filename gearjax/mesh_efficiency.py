@@ -315,7 +315,9 @@ def _pitch(phi1, steps_per_pitch):
 
 
 def cycle_window(n_grid: int, steps_per_pitch: int) -> np.ndarray:
-    """Grid indices of one mesh cycle (one pitch) centred on the reference."""
+    """Grid indices of one mesh cycle (one pitch) on the reference: the half-open interval
+    ``[phi_ref - p/2, phi_ref + p/2)`` of the grid (``steps_per_pitch`` angles, the
+    reference at index ``steps_per_pitch // 2`` of the window; one pitch counted once)."""
     mid = n_grid // 2
     return np.arange(steps_per_pitch) + (mid - steps_per_pitch // 2)
 

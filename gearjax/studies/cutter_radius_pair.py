@@ -136,8 +136,22 @@ def study_pair(inp: BlankInput, settings: StudySettings, flank: str = "convex",
     placeholder = FlankSpec(cutter, gear.machine, _member_blank(bd, 1, inp.z1, hands[0]))
     pair = HypoidPair(placeholder, gear, jnp.asarray(inp.shaft_angle, float), off, t1, t2,
                       inp.z1, inp.z2, 1)
-    pair, info = generating_gear_pinion(pair)
+    # mounting hand: the cone model is the right-hand set (+1), its mirror image the
+    # left-hand one (-1); searching both (the closer mean contact wins) picked the mirror
+    # mounting for a gear spiral angle near 0 (8/43, E = 47 mm, beta_m2 = 0.26 deg: a
+    # right-hand design's pinion cut left-handed; the bevel sweep).  At E = 0 both
+    # mountings are the same set (mirror images through the plane of the axes): searched
+    pair, info = generating_gear_pinion(pair, hand=_mount_hand(inp))
     return StudyPair(pair, s, info, A2, Q, phi0, u_root)
+
+
+def _mount_hand(inp) -> int | None:
+    """+1 (right-hand design) / -1 (left-hand) for an offset pair, None (search) at E = 0
+    or for a traced offset."""
+    from gearjax.errors import is_traced
+    if is_traced(inp.offset) or not float(inp.offset) > 0.0:
+        return None
+    return 1 if inp.hand == "right" else -1
 
 
 def _check_gear_spiral(beta_m2) -> None:
