@@ -495,7 +495,7 @@ class _Adapter:
         check_tca_options(steps_per_pitch, half_pitches, n_pairs, approach)
         prep, side = self._prepared(design, side)
         mis = Misalignment.zero() if mis is None else mis
-        res = _result_jit(program_pair(prep.pair), strong_float64(mis), jnp.asarray(prep.x_ref),
+        res = _result_jit(prep.pair, strong_float64(mis), jnp.asarray(prep.x_ref),
                           jnp.asarray(prep.phi1_ref),
                           float(approach), side=side, drive=bool(prep.drive),
                           steps_per_pitch=int(steps_per_pitch),
@@ -517,7 +517,7 @@ class _Adapter:
             # it is traced once and inlined; called eagerly it runs compiled, not op
             # by op)
             mis = Misalignment.zero() if mis is None else mis
-            return _result_jit(program_pair(replace(pair, hand=hand)), strong_float64(mis),
+            return _result_jit(replace(pair, hand=hand), strong_float64(mis),
                                x_ref, phi1_ref, approach,
                                side=side, drive=drive, steps_per_pitch=int(steps_per_pitch),
                                half_pitches=float(half_pitches), line_contact=bool(line_contact),
