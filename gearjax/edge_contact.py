@@ -126,7 +126,7 @@ import numpy as np
 
 from gearjax.frames import matrix_z
 from gearjax.newton import newton_solve
-from gearjax.tca import ContactPath, contact_system, flank_at, gear_mount
+from gearjax.tca import ContactPath, contact_system, flank_at, gear_mount, relative_to_start
 
 __all__ = ["EDGE_NAMES", "FACE_END_KINDS", "TIP_KINDS", "CORNER_KINDS", "EDGE_LEAD",
            "EdgeContact", "edge_contact_system", "face_end_contact"]
@@ -304,6 +304,34 @@ def _corner_slope(cs, r1, r2, R, c, mis, asm, g1, g2, t1, t2, z, ph1, pinion, e)
     return jnp.stack([dte(u1, u2), dte(v1, v2)])
 
 
+def corner_leads(slope, drive):
+    """True where a corner candidate leads (module docstring, "Corners"): the TE at the
+    flank points beside the corner -- along its tip edge into the face and down the
+    profile, ``slope = dTE/d(eps)`` (rad/mm, ``(..., 2)``, :func:`_corner_slope`) --
+    falls in the sense of the load, or stays level within ``CORNER_SLOPE_TOL``, in
+    *both* directions: ``max_j(s dTE_j/d eps) <= tol`` with ``s`` +1 on the drive side,
+    -1 on the coast side.  Where it rises in either direction that flank point would
+    pass through the mating flank before the corner, so the corner cannot be the
+    contact."""
+    sgn_load = jnp.where(drive, 1.0, -1.0)
+    return jnp.max(sgn_load * slope, axis=-1) <= CORNER_SLOPE_TOL
+
+
+def neighbour_key(key, steps_per_pitch: int):
+    """``max_{k != 0} key[i + k p]`` over every whole pitch ``p = steps_per_pitch`` that
+    stays on the grid (``-inf`` where none): the load key of the neighbouring tooth pairs
+    at grid point ``i`` (pair 0's contact shifted by ``k`` angular pitches is pair
+    ``k``'s contact at the same angle, ``k`` = +-1, +-2, ... up to the grid's length)."""
+    n = key.shape[0]
+    idx = np.arange(n)
+    others = jnp.full((n,), -jnp.inf)
+    for k in range(1, n // max(steps_per_pitch, 1) + 1):
+        for src in (idx - k * steps_per_pitch, idx + k * steps_per_pitch):
+            ok = (src >= 0) & (src < n)
+            others = jnp.maximum(others, jnp.where(ok, key[np.clip(src, 0, n - 1)], -jnp.inf))
+    return others
+
+
 def _give_up_system(F):
     """``G(z, (theta, keep, dead)) = z - keep`` where ``dead``, else ``F(z, theta)``
     (a pure function of its arguments: the implicit derivative of
@@ -447,7 +475,10 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
         def whole(field):
             return field[way, pos]
 
-        return whole(sols.x), whole(sols.converged) & ok_ref, whole(sols.residual)
+        conv_e, res_e = relative_to_start(
+            whole(sols.converged), whole(sols.residual), ok_ref,
+            jnp.maximum(sols.residual[0, k - 1], sols.residual[1, k - 1]))
+        return whole(sols.x), conv_e, res_e
 
     pin_np, tip_np, corner_np = _PINION[:nc], _TIP[:nc], _CORNER[:nc]
     Z, conv, res = jax.vmap(one_edge)(*(jnp.asarray(a) for a in
@@ -499,8 +530,7 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
     # a corner leads only where the tip edge runs from it into the face behind it in
     # the sense of the load (module docstring, "Corners"): else the tip edge's interior
     # would pass through the mating flank (a corner point on the flank from inside)
-    sgn_load = jnp.where(drive, 1.0, -1.0)
-    ahead = ~is_corner | (jnp.max(sgn_load * slope, axis=-1) <= CORNER_SLOPE_TOL)
+    ahead = ~is_corner | corner_leads(slope, drive)
     valid = conv & (other >= 0.0) & ahead
     # TE from the reference contact of the path (not from the path's own value at each
     # angle: where the surface solve failed that may be NaN, and an edge contact there
@@ -526,13 +556,7 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
     # carries the load: not behind the neighbouring tooth pairs (pair 0 shifted by
     # whole pitches, with the contacts of (a))
     key_a = jnp.where(use, lead, key_s)
-    idx = np.arange(n)
-    others = jnp.full((n,), -jnp.inf)
-    for k in range(1, n // max(steps_per_pitch, 1) + 1):
-        for src in (idx - k * steps_per_pitch, idx + k * steps_per_pitch):
-            ok = (src >= 0) & (src < n)
-            others = jnp.maximum(others, jnp.where(ok, key_a[np.clip(src, 0, n - 1)], -jnp.inf))
-    carries = lead >= others - EDGE_LEAD
+    carries = lead >= neighbour_key(key_a, steps_per_pitch) - EDGE_LEAD
     use = use | (~surf_ok & ~same & jnp.isfinite(lead) & carries)
     kind = jnp.where(use, best, -1)
     cols = jnp.arange(n)

@@ -85,7 +85,8 @@ from gearjax.newton import newton_solve
 from gearjax.surfaces import GeneratedSurface, local_geometry, unit_normal
 
 __all__ = ["pair_arrays", "Misalignment", "Assembly", "contact_equations", "contact_system", "ContactSystem",
-           "local_geometry_on", "point_normal", "flank_at", "path_tangent", "solve_grid", "gear_mount",
+           "local_geometry_on", "point_normal", "flank_at", "path_tangent", "relative_to_start",
+           "solve_grid", "gear_mount",
            "ContactPath", "contact_path", "te_arcsec", "require_path",
            "ARCSEC", "ellipse_from_weingarten", "rotation_about", "relative_curvature",
            "MultiPair", "multi_pair", "DEFAULT_APPROACH", "NoContactError",
@@ -179,8 +180,11 @@ class ContactPath(NamedTuple):
         contact on each flank (body z and distance from the body axis).
     semi_major, semi_minor : contact-ellipse semi-axes (mm; inf for line contact).
     major_dir : (N, 3) unit direction of the major axis (fixed frame).
-    residual : max |F| of the contact solve (mm / dimensionless).
-    converged : Newton converged (and the residual is finite).
+    residual : max |F| of the contact solve (mm / dimensionless); where the solve
+        this point is continued from (the reference contact) failed, at least that
+        solve's residual -- every point's TE and pair angle are relative to it.
+    converged : Newton converged (and the residual is finite), the reference contact
+        too (a point not converged reports the residual of the solve that failed).
     weingarten1, weingarten2 : (N, 3, 3) Weingarten maps of pinion and gear flank in
         the fixed frame for the common normal ``normal`` (1/mm; ``dn = W dr``), the
         curvatures the ellipses come from; the kinematics at the contact points reuse
@@ -299,6 +303,19 @@ def solve_grid(F, x_prev, x_prev2, phis, tol, max_steps):
 
 
 _solve_grid = solve_grid
+
+
+def relative_to_start(converged, residual, start_converged, start_residual):
+    """``(converged, residual)`` of solves continued from a start solve: a point is
+    converged only where the start converged too, and its residual is at least the
+    start's where the start failed (a continuation from a failed start solves the
+    equations relative to a wrong reference: its own tiny residual must not read as
+    a converged point, and a convergence message must report the start's residual)."""
+    conv = converged & start_converged
+    res = jnp.where(start_converged, residual,
+                    jnp.maximum(residual, jnp.where(jnp.isfinite(start_residual),
+                                                    start_residual, jnp.inf)))
+    return conv, res
 
 
 def path_tangent(F, x, phi):
@@ -492,8 +509,9 @@ def contact_path(r1: Callable, r2: Callable, asm: Assembly, mis: Misalignment, p
         return jnp.concatenate([two_ways[1][::-1], at_ref[None], two_ways[0]], axis=0)
 
     Z = whole(sols.x, ref.x)
-    res = whole(sols.residual, ref.residual)
-    conv = whole(sols.converged, ref.converged) & ref.converged
+    conv, res = relative_to_start(whole(sols.converged, ref.converged),
+                                  whole(sols.residual, ref.residual), ref.converged,
+                                  ref.residual)
     ref_x = cs.split(ref.x)[0]
 
     def post(z, ph1):

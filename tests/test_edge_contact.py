@@ -820,3 +820,44 @@ def test_vh_catt_edge_contacts_on_both_flanks_and_tangent(vh_tip_run, dP, dg_deg
     assert "mating root" in nearest
     if dP:
         assert {"own root", "own face"} <= nearest, nearest
+
+
+@pytest.mark.parametrize("n, p", [(33, 16), (13, 4), (49, 16), (65, 16), (9, 9), (40, 7)])
+def test_neighbour_key_covers_every_whole_pitch_on_the_grid(n, p):
+    """The neighbouring pairs' key at grid point i is the largest key at i + k p,
+    k = +-1, +-2, ... on the grid (pair 0 shifted by whole pitches), by brute force over
+    the grid.  Catches a loop over k that stops a pitch short: with a contact ratio
+    above 2 (or at the grid's ends, where only the far neighbour is on the grid) pair
+    0's edge contact would be compared with too few neighbours and kept behind a pair
+    that carries the load."""
+    from gearjax.edge_contact import neighbour_key
+    key = np.random.default_rng(n * 100 + p).normal(size=n)
+    got = np.asarray(neighbour_key(jnp.asarray(key), p))
+    want = np.array([max([key[j] for j in range(n) if j != i and (j - i) % p == 0],
+                         default=-np.inf) for i in range(n)])
+    np.testing.assert_array_equal(got, want)
+    # a key that only the farthest whole pitch reaches is seen at the grid's first point
+    far = (n - 1) // p * p
+    if far > 0:
+        only = np.full(n, -1.0)
+        only[far] = 5.0
+        assert float(neighbour_key(jnp.asarray(only), p)[0]) == 5.0
+
+
+@pytest.mark.parametrize("drive", [True, False])
+def test_corner_leads_only_where_the_te_falls_both_ways(drive):
+    """A corner is the contact only where the TE at the flank points beside it falls
+    (in the sense of the load) along the tip edge *and* down the profile; a corner
+    with one slope falling and the other rising is not (the rising side's flank point
+    would be through the mating flank first).  Rule by cases, both sides (the sense
+    of the load flips the signs)."""
+    from gearjax.edge_contact import CORNER_SLOPE_TOL, corner_leads
+    s = 1.0 if drive else -1.0
+    slopes = s * jnp.array([[-1e-3, -2e-3],     # falls both ways: leads
+                            [-1e-3, 0.0],       # falls and level: leads
+                            [-1e-3, 2e-3],      # mixed: not
+                            [3e-3, -1e-3],      # mixed the other way: not
+                            [1e-3, 1e-3],       # rises both ways: not
+                            [0.5 * CORNER_SLOPE_TOL, -1.0]])   # level within tol: leads
+    got = np.asarray(corner_leads(slopes, jnp.asarray(drive)))
+    np.testing.assert_array_equal(got, [True, True, False, False, False, True])

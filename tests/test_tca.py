@@ -623,3 +623,37 @@ def test_pinion_angle_grid_of_the_adapters():
     gj = jax.jit(pinion_angle_grid, static_argnums=(1, 2, 3))(jnp.float64(-0.1), 17, 8, 1.25)
     assert np.asarray(gj)[10] == -0.1
     np.testing.assert_allclose(np.asarray(gj), g - 0.4, rtol=0, atol=1e-14)
+
+
+def test_points_continued_from_a_failed_reference_are_not_converged(pair):
+    """A continuation that starts from a reference contact that did not converge solves
+    the equations relative to a wrong reference: its points are flagged not converged
+    and carry (at least) the reference's residual, so a convergence message names the
+    failure, not a neighbour's 1e-14 (a 7/45 hypoid coast side of the bevel sweep
+    reported "not converged, worst residual 9.2e-14").  Forced here with two Newton steps
+    from a guess 0.3 mm off: the reference is left well above the tolerance, the continued points, started
+    from it with the path's predictor, converge on their own in two steps."""
+    from gearjax.gears.involute.tca import (crowned_pinion_flank, involute_assembly,
+                                            reference_guess)
+    from gearjax.tca import pinion_angle_grid, relative_to_start
+    des = InvoluteTCA.create(pair, 20.0)
+    x_ref, phi1_ref, _ = reference_guess(des, -1, True)
+    r1 = crowned_pinion_flank(des, -1, True)
+    r2 = generated_flank(pair.module, pair.pressure_angle, -pair.helix, pair.x2, pair.z2, -1)
+    grid = pinion_angle_grid(phi1_ref, Z1, 8, 1.0)
+    path = jax.jit(lambda x: contact_path(r1, r2, involute_assembly(pair), Misalignment.zero(),
+                                          grid, x, line_contact=True, max_steps=2))(
+        jnp.asarray(x_ref) + jnp.array([0.3, 0.0, -0.3, 0.0, 3e-2]))
+    conv, res = np.asarray(path.converged), np.asarray(path.residual)
+    mid = conv.shape[0] // 2
+    assert res[mid] > 1e-11                      # the reference did not converge ...
+    assert not conv.any()                        # ... so nothing is converged
+    assert np.all(res >= res[mid])               # and every point says so
+    # the rule itself, both ways
+    c, r = relative_to_start(jnp.array([True, False, True]), jnp.array([1e-14, 1e-3, 1e-14]),
+                             jnp.asarray(False), jnp.asarray(jnp.nan))
+    assert not np.asarray(c).any() and np.all(np.isinf(np.asarray(r)))
+    c, r = relative_to_start(jnp.array([True, False]), jnp.array([1e-14, 1e-3]),
+                             jnp.asarray(True), jnp.asarray(1e-13))
+    np.testing.assert_array_equal(np.asarray(c), [True, False])
+    np.testing.assert_array_equal(np.asarray(r), [1e-14, 1e-3])
