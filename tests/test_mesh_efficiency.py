@@ -514,3 +514,31 @@ def test_cycle_is_one_pitch_starting_half_a_pitch_before_the_reference(spur, iso
     assert cyc[-1] < ref + np.pi / Z1 - 0.5 * h
     start = (n - 1) // 2 - spp // 2
     np.testing.assert_array_equal(cyc, phi[start:start + spp])
+
+
+def test_efficiency_function_is_mesh_efficiency_as_a_pure_function(spur, oil_surface):
+    """``gj.efficiency_function`` -- the traceable entry point optimisers use -- gives the
+    numbers of ``mesh_efficiency`` for the same design, material and options (one jitted
+    program: TCA, loads, friction): mean efficiency, mean mu, every load and p_max and
+    the loaded TE.  Planted bugs caught: the material's E' or nu not passed on (or
+    swapped), another compliance model or grid than the one documented, the speed
+    taken in rad/s, the TCA options dropped.  Concrete inputs are checked on every call
+    (a negative torque: one-line ValueError before any work)."""
+    from gearjax.tribology import STEEL_E_PRIME
+    oil, surf = oil_surface
+    des = spur[1]
+    f = gj.efficiency_function(des, E_prime=1.5 * STEEL_E_PRIME)
+    assert f.material.e_prime_MPa == pytest.approx(1.5 * STEEL_E_PRIME)
+    assert f.options["compliance"] == gj.DEFAULT_COMPLIANCE
+    got, res = jax.jit(lambda p, T: f(p, T, RPM, oil, surf))(f.pair, jnp.asarray(TORQUE))
+    want, res_w = mesh_efficiency(des, TORQUE, RPM, oil, surf, E_prime=1.5 * STEEL_E_PRIME)
+    for name in ("mean_efficiency", "mean_mu", "te_loaded_ptp"):
+        assert float(getattr(got, name)) == pytest.approx(float(getattr(want, name)),
+                                                          rel=1e-10, abs=1e-15), name
+    for name in ("load", "p_max", "deflection"):
+        np.testing.assert_allclose(np.asarray(getattr(got.loaded, name)),
+                                   np.asarray(getattr(want.loaded, name)), rtol=1e-10,
+                                   atol=1e-12, err_msg=name)
+    np.testing.assert_allclose(np.asarray(res.path.te), np.asarray(res_w.path.te), atol=1e-14)
+    with pytest.raises(ValueError, match="torque"):
+        f(f.pair, -5.0, RPM, oil, surf)
