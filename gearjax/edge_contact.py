@@ -126,7 +126,8 @@ import numpy as np
 
 from gearjax.frames import matrix_z
 from gearjax.newton import newton_solve
-from gearjax.tca import ContactPath, contact_system, flank_at, gear_mount, relative_to_start
+from gearjax.tca import (ContactPath, contact_system, flank_at, gear_mount, relative_to_start,
+                         whole_turns_removed)
 
 __all__ = ["EDGE_NAMES", "FACE_END_KINDS", "TIP_KINDS", "CORNER_KINDS", "EDGE_LEAD",
            "EdgeContact", "edge_contact_system", "face_end_contact"]
@@ -537,6 +538,7 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
     # is still a contact)
     te = (path.te[mid] + asm.ratio_sign * (ph2 - path.phi2[mid])
           - (asm.z1 / asm.z2) * (path.phi1 - path.phi1[mid])[None, :])
+    te, ph2 = whole_turns_removed(te, ph2, asm.ratio_sign)
     sgn = jnp.where(drive, 1.0, -1.0)
     surf_ok = (margin >= 0.0) & path.converged
     key_s = jnp.where(surf_ok, sgn * path.te, -jnp.inf)

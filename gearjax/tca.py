@@ -86,6 +86,7 @@ from gearjax.surfaces import GeneratedSurface, local_geometry, unit_normal
 
 __all__ = ["pair_arrays", "Misalignment", "Assembly", "contact_equations", "contact_system", "ContactSystem",
            "local_geometry_on", "point_normal", "flank_at", "path_tangent", "relative_to_start",
+           "whole_turns_removed",
            "solve_grid", "gear_mount",
            "ContactPath", "contact_path", "te_arcsec", "require_path",
            "ARCSEC", "ellipse_from_weingarten", "rotation_about", "relative_curvature",
@@ -318,6 +319,17 @@ def relative_to_start(converged, residual, start_converged, start_residual):
     return conv, res
 
 
+def whole_turns_removed(te, ph2, ratio_sign):
+    """``(te, phi2)`` with whole gear turns taken out of the TE (rad): a solve may land on
+    the gear turned by ``2 pi k`` from the pair's position -- the same contact of the same
+    teeth, exactly -- whose TE computed from the raw angle is off by ``2 pi k``
+    (a KHK 12/24 spur pair at 8 grid steps per pitch: tip-edge contacts at 50, 100 and
+    150 rad of TE).  ``k = round(te / 2 pi)``; ``phi2`` moves with it.  No derivative flows
+    through ``k`` (piecewise constant)."""
+    k = jax.lax.stop_gradient(jnp.round(te / (2.0 * jnp.pi)))
+    return te - 2.0 * jnp.pi * k, ph2 - ratio_sign * 2.0 * jnp.pi * k
+
+
 def path_tangent(F, x, phi):
     """``dx/dphi = -F_x^{-1} F_phi`` of the root ``x(phi)`` of ``F(x, phi) = 0`` at a
     solved point (no derivative flows through it): the first-order predictor of a
@@ -538,6 +550,7 @@ def contact_path(r1: Callable, r2: Callable, asm: Assembly, mis: Misalignment, p
     ph2_0 = ref_x[-1]
     rho = asm.z1 / asm.z2
     te = asm.ratio_sign * (ph2 - ph2_0) - rho * (phi1 - phi1[mid])
+    te, ph2 = whole_turns_removed(te, ph2, asm.ratio_sign)
     if line_contact:
         a = jnp.full_like(a, jnp.inf)
     rad1 = jnp.linalg.norm(p1b[:, :2], axis=1)

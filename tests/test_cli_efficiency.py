@@ -211,3 +211,16 @@ def test_implausible_result_exits_3_with_warnings(run):
     # the module's run at steel E' is whole and plausible
     base = _strict(run[1])
     assert base["n_valid"] == len(base["valid"]) and "implausible" not in run[2]
+
+
+def test_a_packaged_involute_design_file_runs_the_loaded_chain(capsys):
+    """``gearjax efficiency example:khk_spur_12x24`` (an involute *design file*, not a
+    ``involute:`` spec): the file adapter hands the loaded chain the pair's arrays (before
+    this test: TypeError, the adapter's static split/join functions bound as methods).
+    Same program as the spur run above (tooth numbers are data); checked: exit 0, a
+    summary line and an efficiency in (0.95, 1)."""
+    rc = main(["efficiency", "example:khk_spur_12x24", "--torque-Nm", "100", "--rpm", "1000",
+               "--oil", "mineral_vg100", "--sigma-um", "0.4", "--positions", "8", "--json"])
+    out = _strict(capsys.readouterr().out)
+    assert rc == 0
+    assert 0.95 < out["mean_efficiency"] < 1.0

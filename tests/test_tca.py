@@ -657,3 +657,19 @@ def test_points_continued_from_a_failed_reference_are_not_converged(pair):
                              jnp.asarray(True), jnp.asarray(1e-13))
     np.testing.assert_array_equal(np.asarray(c), [True, False])
     np.testing.assert_array_equal(np.asarray(r), [1e-14, 1e-3])
+
+
+def test_whole_gear_turns_are_taken_out_of_the_te():
+    """A solve that lands on the gear turned by whole turns is the same contact: its TE
+    is the TE less 2 pi k and phi2 moves by ratio_sign 2 pi k (a KHK 12/24 spur pair at 8
+    steps per pitch had tip-edge contacts at 50-150 rad of TE that 'led' the mesh; the
+    end-to-end check is tests/test_cli_efficiency.py's packaged design file)."""
+    from gearjax.tca import whole_turns_removed
+    te = jnp.array([3e-5, 2 * np.pi * 8 + 3e-5, -2 * np.pi * 3 - 1e-4, np.pi - 1e-3])
+    ph2 = jnp.array([1.0, 1.0 - 16 * np.pi, 1.0 + 6 * np.pi, 0.5])
+    for sign in (1.0, -1.0):
+        t, p = whole_turns_removed(te, sign * ph2, sign)
+        np.testing.assert_allclose(np.asarray(t), [3e-5, 3e-5, -1e-4, np.pi - 1e-3], atol=1e-12)
+        k = np.array([0, 8, -3, 0])
+        np.testing.assert_allclose(np.asarray(p), sign * np.asarray(ph2) - sign * 2 * np.pi * k,
+                                   atol=1e-12)

@@ -154,8 +154,8 @@ class _FileAdapter:
 
     family = ADAPTER.family
     defaults = ADAPTER.defaults
-    split_pair = ADAPTER.split_pair
-    join_pair = ADAPTER.join_pair
+    split_pair = staticmethod(ADAPTER.split_pair)
+    join_pair = staticmethod(ADAPTER.join_pair)
 
     @staticmethod
     def _design(f):
