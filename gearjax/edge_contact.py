@@ -109,9 +109,9 @@ taken on a localised spiral-bevel pair).  A corner or tip-edge continuation that
 two grid steps in a row gives up (``CORNER_GIVE_UP``: its Newton loops would hold the
 others of the same ``vmap``; giving up on the tip edges too made the involute TCA 2.3x
 faster with results bit-identical on every packaged example and 30 crowned, shifted,
-helical and misaligned involute cases).  The selection rule is unchanged (a corner with the TE of the
-tip-edge candidate -- a spur pair in line contact, aligned -- loses the tie to the tip
-edge, which comes first).  In line-contact mode the tip edges are solved in the
+helical and misaligned involute cases).  The selection rule is unchanged (a corner
+with the TE of the tip-edge candidate -- a spur pair in line contact, aligned -- loses
+the tie to the tip edge, which comes first).  In line-contact mode the tip edges are solved in the
 section of the path, the corners are not: under a shaft-angle error the corner that
 leads is found, ahead of that section by about ``(b/2) dSigma cos(alpha)/r_b2``.
 
