@@ -409,7 +409,10 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
 
     Returns ``(path, margin, edges)``: the path with the contact made at every grid
     point (surface or edge), its margin (>= 0 on the flanks; 0 on the edge's own face
-    end), and the :class:`EdgeContact`.  The TE keeps the reference of ``path``.
+    end), and the :class:`EdgeContact`.  The TE keeps the reference of ``path``.  An
+    edge candidate counts only within half a gear pitch of that reference
+    (``|TE - TE_ref| < pi/z2``): further off, its solve converged onto a neighbouring
+    gear tooth, not a contact of tooth pair 0 (docs/reliability.md).
     """
     n = path.phi1.shape[0]
     mid = n // 2
@@ -541,6 +544,11 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
     te = (path.te[mid] + asm.ratio_sign * (ph2 - path.phi2[mid])
           - (asm.z1 / asm.z2) * (path.phi1 - path.phi1[mid])[None, :])
     te, ph2 = whole_turns_removed(te, ph2, asm.ratio_sign)
+    # a contact of tooth pair 0 lies within half a gear pitch of its reference TE: a
+    # solve that converged onto the gear turned by a whole pitch (a corner or tip edge
+    # against the neighbouring gear tooth, TE about 2 pi / z2 off) is that neighbour's
+    # contact, which the multi-pair envelope takes from pair 0 shifted by whole pitches
+    valid = valid & (jnp.abs(te - path.te[mid]) < jnp.pi / asm.z2)
     sgn = jnp.where(drive, 1.0, -1.0)
     surf_ok = (margin >= 0.0) & path.converged
     key_s = jnp.where(surf_ok, sgn * path.te, -jnp.inf)

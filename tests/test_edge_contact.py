@@ -416,6 +416,32 @@ def test_hypoid_tip_edge_function_is_the_face_cone():
     assert float(f1[0]) > 0 and float(root1[0]) > 0
 
 
+
+def test_synthesised_spiral_bevel_coast_edge_contacts_belong_to_pair_0():
+    """The coast side of the shipped synthesised spiral bevel (synthesised for drive:
+    its coast bearing runs off the face, the path is face-end contact with hundreds of
+    arc-seconds of TE).  The corner and tip-edge solves of tooth pair 0 can converge
+    onto the gear turned by whole pitches (a neighbouring gear tooth); those are not
+    contacts of pair 0.  Without the half-pitch rule of ``face_end_contact`` this grid
+    (16 steps per pitch, under the suite's XLA flags) put a contact 9.45 gear pitches
+    (408 400 arcsec) from the reference, and the CLI's 61 positions under the default
+    flags read pinion tip/toe and tip/heel corner contacts at TE 37 000 - 44 600
+    arcsec, about one pitch (2 pi / z2 = 43 200 arcsec) off (peak-to-peak 6573 arcsec).
+    Every contact of the path (a converged point on the flanks or on an edge) lies
+    within half a gear pitch of pair 0's reference TE -- independent of the edge
+    system: a whole pitch is what such a solve adds --, and the peak-to-peak is that of
+    the face-end contacts, a few hundred arc-seconds."""
+    d = gj.load_design(gj.example_path("spiral_bevel_10x30_synthesised"))
+    r = gj.run_tca(d, side="coast", steps_per_pitch=16, half_pitches=1.25, strict=False,
+                   kinematics=False)
+    te, kind = np.asarray(r.path.te), np.asarray(r.path.edge_kind)
+    used = np.asarray(r.path.converged) & (np.asarray(r.margin) >= 0.0)
+    mid = te.size // 2
+    half_pitch = np.pi / 30
+    assert used[mid] and (kind >= 0).sum() >= 10, kind
+    assert np.all(np.abs(te[used] - te[mid]) < half_pitch), te / gj.ARCSEC
+    assert float(r.ptp) < 0.1 * half_pitch, float(r.ptp) / gj.ARCSEC
+
 # -- corners: tip edge x face end under a shaft-angle error ----------------------------
 #
 # Closed form (independent of the TCA): the pinion is aligned (world = body frame turned
