@@ -129,7 +129,7 @@ import numpy as np
 from gearjax.frames import matrix_z
 from gearjax.newton import newton_solve
 from gearjax.tca import (ContactPath, contact_system, flank_at, gear_mount, relative_to_start,
-                         whole_turns_removed)
+                         whole_turns_removed, newton_work)
 
 __all__ = ["EDGE_NAMES", "FACE_END_KINDS", "TIP_KINDS", "CORNER_KINDS", "EDGE_LEAD",
            "EdgeContact", "edge_contact_system", "face_end_contact"]
@@ -484,10 +484,10 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
         conv_e, res_e = relative_to_start(
             whole(sols.converged), whole(sols.residual), ok_ref,
             jnp.maximum(sols.residual[0, k - 1], sols.residual[1, k - 1]))
-        return whole(sols.x), conv_e, res_e
+        return whole(sols.x), conv_e, res_e, sols.steps
 
     pin_np, tip_np, corner_np = _PINION[:nc], _TIP[:nc], _CORNER[:nc]
-    Z, conv, res = jax.vmap(one_edge)(*(jnp.asarray(a) for a in
+    Z, conv, res, steps = jax.vmap(one_edge)(*(jnp.asarray(a) for a in
                                         (pin_np, _END[:nc], tip_np, corner_np)))
 
     def post(z, ph1):
@@ -595,7 +595,8 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
                        radial2=jnp.linalg.norm(out.p2_body[:, :2], axis=1))
     if path.psi1 is not None:
         out = out._replace(psi1=pick(psi1, path.psi1), psi2=pick(psi2, path.psi2))
-    out = out._replace(edge_kind=kind)
+    work = newton_work(steps) if path.newton_work is None else path.newton_work + newton_work(steps)
+    out = out._replace(edge_kind=kind, newton_work=work)
     edge_margin = jnp.maximum(other[best, cols], 0.0)
     margin_out = jnp.where(use, edge_margin, margin)
     te_valid = jnp.where(valid, te, jnp.nan)

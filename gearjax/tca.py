@@ -197,6 +197,11 @@ class ContactPath(NamedTuple):
     edge_kind : (N,) int, -1 where the contact is a tangency of the two flanks, else
         the edge (face end or tip) carrying it (index into :data:`gearjax.edge_contact.EDGE_NAMES`;
         there the semi-axes are NaN: no Hertz ellipse at an edge).  ``None`` where face ends were not examined.
+    newton_work : () int, the Newton iterations the solves of this path executed, each
+        ``vmap``-ed batch counted as its number of lanes times the iterations of its
+        slowest lane (a batched ``while_loop`` runs every lane that long): the
+        computational work of the TCA, deterministic up to round-off
+        (:func:`newton_work`; the cost guard, tests/test_cost_guard.py).
     """
 
     phi1: jnp.ndarray
@@ -222,6 +227,17 @@ class ContactPath(NamedTuple):
     psi1: jnp.ndarray | None = None
     psi2: jnp.ndarray | None = None
     edge_kind: jnp.ndarray | None = None
+    newton_work: jnp.ndarray | None = None
+
+
+def newton_work(steps):
+    """Newton iterations executed by a ``vmap``-ed continuation (int scalar): ``steps``
+    (..., T) are the iterations of each lane at each of the T scanned solves; the
+    batch runs every lane as long as its slowest, so the work is the number of lanes
+    times the sum over the solves of the largest lane count."""
+    steps = jnp.asarray(steps)
+    lanes = int(np.prod(steps.shape[:-1]))
+    return lanes * jnp.sum(jnp.max(steps.reshape(lanes, -1), axis=0))
 
 
 def te_arcsec(te_rad):
@@ -557,7 +573,8 @@ def contact_path(r1: Callable, r2: Callable, asm: Assembly, mis: Misalignment, p
     rad1 = jnp.linalg.norm(p1b[:, :2], axis=1)
     rad2 = jnp.linalg.norm(p2b[:, :2], axis=1)
     return ContactPath(phi1, ph2, te, uv1, uv2, point, n, p1b, p2b, p1b[:, 2], rad1,
-                       p2b[:, 2], rad2, a, b, major, res, conv, W1, W2, psi1, psi2)
+                       p2b[:, 2], rad2, a, b, major, res, conv, W1, W2, psi1, psi2,
+                       newton_work=ref.steps + newton_work(sols.steps))
 
 
 def require_path(path: ContactPath, what: str = "tooth contact analysis") -> None:

@@ -21,6 +21,8 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
+from cost_guard import check_cost
+
 import gearjax as gj
 from gearjax import ARCSEC
 from gearjax.cli import main
@@ -417,7 +419,14 @@ def test_hypoid_tip_edge_function_is_the_face_cone():
 
 
 
-def test_synthesised_spiral_bevel_coast_edge_contacts_belong_to_pair_0():
+@pytest.fixture(scope="module")
+def bevel_coast():
+    d = gj.load_design(gj.example_path("spiral_bevel_10x30_synthesised"))
+    return gj.run_tca(d, side="coast", steps_per_pitch=16, half_pitches=1.25, strict=False,
+                      kinematics=False)
+
+
+def test_synthesised_spiral_bevel_coast_edge_contacts_belong_to_pair_0(bevel_coast):
     """The coast side of the shipped synthesised spiral bevel (synthesised for drive:
     its coast bearing runs off the face, the path is face-end contact with hundreds of
     arc-seconds of TE).  The corner and tip-edge solves of tooth pair 0 can converge
@@ -431,9 +440,7 @@ def test_synthesised_spiral_bevel_coast_edge_contacts_belong_to_pair_0():
     within half a gear pitch of pair 0's reference TE -- independent of the edge
     system: a whole pitch is what such a solve adds --, and the peak-to-peak is that of
     the face-end contacts, a few hundred arc-seconds."""
-    d = gj.load_design(gj.example_path("spiral_bevel_10x30_synthesised"))
-    r = gj.run_tca(d, side="coast", steps_per_pitch=16, half_pitches=1.25, strict=False,
-                   kinematics=False)
+    r = bevel_coast
     te, kind = np.asarray(r.path.te), np.asarray(r.path.edge_kind)
     used = np.asarray(r.path.converged) & (np.asarray(r.margin) >= 0.0)
     mid = te.size // 2
@@ -441,6 +448,12 @@ def test_synthesised_spiral_bevel_coast_edge_contacts_belong_to_pair_0():
     assert used[mid] and (kind >= 0).sum() >= 10, kind
     assert np.all(np.abs(te[used] - te[mid]) < half_pitch), te / gj.ARCSEC
     assert float(r.ptp) < 0.1 * half_pitch, float(r.ptp) / gj.ARCSEC
+
+
+def test_cost_of_the_spiral_bevel_edge_search(bevel_coast):
+    """Cost guard (tests/cost_guard.py): the Newton work of this all-edge spiral-bevel
+    TCA (surface and the ten edge candidates) against the recorded baseline."""
+    check_cost("tca_spiral_bevel_coast_edges", newton_work=int(bevel_coast.path.newton_work))
 
 # -- corners: tip edge x face end under a shaft-angle error ----------------------------
 #

@@ -13,6 +13,8 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
+from cost_guard import check_cost
+
 import gearjax as gj
 from gearjax.cli import main
 from gearjax.gears.preset_bevel import analysis as A
@@ -41,6 +43,13 @@ def runs(des):
             "mod_coast": gj.run_tca(des, side="coast", **OPTS),
             "plain_dG": gj.run_tca(plain, dg, side="drive", strict=False, **OPTS),
             "mod_dG": gj.run_tca(des, dg, side="drive", strict=False, **OPTS)}
+
+
+def test_cost_of_the_preset_bevel_tca(runs):
+    """Cost guard (tests/cost_guard.py): Newton work of the preset-TE bevel TCA with its
+    edge search (modified pair, both sides) against the recorded baseline."""
+    for case in ("mod", "mod_coast"):
+        check_cost(f"tca_preset_bevel_{case}", newton_work=int(runs[case].path.newton_work))
 
 
 @pytest.mark.parametrize("case", ["plain", "plain_coast"])

@@ -11,6 +11,8 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
+from cost_guard import check_cost
+
 from gearjax.errors import ConvergenceError
 from gearjax.gears.involute.geometry import InvolutePair, generated_flank, pair_geometry
 from gearjax.edge_contact import EDGE_NAMES
@@ -280,6 +282,16 @@ def test_transfer_points_where_shifted_parabolas_cross(pair, side):
 def crowned(pair):
     des = InvoluteTCA.create(pair, 20.0, profile_crown=0.002, lead_crown=0.001)
     return des, involute_tca(des)
+
+
+def test_cost_of_the_involute_tca(conjugate, crowned):
+    """Cost guard (tests/cost_guard.py): the Newton iterations executed by the
+    line-contact TCA of the conjugate pair and the point-contact TCA of the crowned
+    pair (the pair of benchmarks/bench_tca.py), surface and edge solves, against the
+    recorded baseline.  The edge search that made this TCA 30x slower unnoticed took
+    the point-contact count from 179 (surface solves only) to 5619."""
+    check_cost("tca_involute_line_contact", newton_work=int(conjugate[0].newton_work))
+    check_cost("tca_involute_point_contact", newton_work=int(crowned[1][0].newton_work))
 
 
 def test_point_contact_converges_and_is_localised(crowned):

@@ -14,6 +14,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
+
+from cost_guard import check_cost
 from scipy.optimize import brentq
 from scipy.special import ellipe, ellipk
 
@@ -201,6 +203,14 @@ def tca_runs(pair):
     return {"drive": gj.run_tca(pair, side="drive", **opts),
             "coast": gj.run_tca(pair, side="coast", **opts),
             "tilt": gj.run_tca(pair, gj.Misalignment.create(dSigma_deg=0.02), **opts)}
+
+
+def test_cost_of_the_vh_catt_tca(tca_runs):
+    """Cost guard (tests/cost_guard.py): Newton work of the surface-contact VH-CATT TCA
+    on both sides against the recorded baseline."""
+    for side in ("drive", "coast"):
+        check_cost(f"tca_vh_catt_{side}_surface",
+                   newton_work=int(tca_runs[side].path.newton_work))
 
 
 def test_aligned_tca_is_the_middle_section_involute_mesh(pair, tca_runs):

@@ -115,7 +115,7 @@ def add_lubricant_options(p, e_prime_help: str = E_PRIME_HELP):
 def register(sub):
     p = sub.add_parser("friction", help="mixed-lubrication friction of one contact",
                        description="Hertz contact, EHL film, asperity load sharing and friction "
-                                   "coefficient of one lubricated contact (seed 001 model).",
+                                   "coefficient of one lubricated contact (Reynolds film, Greenwood-Williamson asperities, Ree-Eyring shear).",
                        epilog=FRICTION_KEYS_DOC, formatter_class=argparse.RawDescriptionHelpFormatter)
     _add_common(p)
     p.add_argument("--ue", type=float, required=True,

@@ -31,9 +31,9 @@ def _grid(text: str):
 
 
 def register(sub):
-    p = sub.add_parser("kinematics", help="seed-000 eigenfunction kinematics of a hypoid design",
+    p = sub.add_parser("kinematics", help="eigenfunction kinematics of a hypoid design (SRR, sliding, effective radius)",
                        description="Entrainment velocity, SRR, effective radius and limit "
-                                   "checks over the working gear flank (seed 000).")
+                                   "checks over the working gear flank.")
     p.add_argument("design", help="design file path or example:NAME")
     p.add_argument("--grid", default="31x15", help="depth x face points (default 31x15)")
     p.add_argument("--flank", choices=["convex", "concave"], default="convex",
@@ -65,7 +65,7 @@ def run(args) -> int:
     design = load_design(args.design, kinds=HYPOID_KINDS)
     inp = design.blank_input()
     if inp.method == "iso23509-method0" or float(inp.offset) <= 0.0:
-        raise ValueError("blank.offset_mm must be > 0: the seed-000 model is for hypoid pairs")
+        raise ValueError("blank.offset_mm must be > 0: the eigenfunction model is for hypoid pairs (offset > 0)")
     st = hk.StudySettings.make(float(inp.cutter_radius), args.blade_angle_delta, args.cutter_shift)
     with Progress(1, "kinematics") as bar, bar.phase(f"{shape[0]}x{shape[1]} grid"):
         s, f = hk.flank_fields(inp, st, args.flank, shape)
@@ -87,7 +87,7 @@ def run(args) -> int:
     warn_nonfinite(f"stats.{k}.{kk}" for k in _FIELDS for kk, v in stats[k].items()
                    if isinstance(v, float) and not math.isfinite(v))
     w = sys.stdout.write
-    w(f"seed-000 kinematics of {out['design']}: gear {args.flank} flank, {shape[0]}x{shape[1]} "
+    w(f"hypoid kinematics of {out['design']}: gear {args.flank} flank, {shape[0]}x{shape[1]} "
       f"grid, r0 = {out['cutter_radius_mm']:g} mm, blade angle {out['blade_angle_deg']:.3f} deg\n")
     w(f"  {'field':<8s} {'mean':>12s} {'min':>12s} {'max':>12s}  unit\n")
     for k in _FIELDS:

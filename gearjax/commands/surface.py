@@ -29,7 +29,8 @@ def _grid(text: str):
 def register(sub):
     p = sub.add_parser("surface", help="flank point grid of a hypoid/bevel member",
                        description="Tooth-flank grid (toe to heel x fillet start to tip) by "
-                                   "seed 004's algorithm; every point is a converged solve.")
+                                   "the generation of the flank by its machine settings (meshing equation with the "
+                                   "face-width and face-cone conditions); every point is a converged solve.")
     p.add_argument("design", help="design file path or example:NAME")
     p.add_argument("--member", choices=["pinion", "gear"], required=True)
     p.add_argument("--flank", choices=["convex", "concave"], required=True)

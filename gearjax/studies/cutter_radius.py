@@ -419,7 +419,7 @@ def flank_fields(inp: BlankInput, settings: StudySettings, flank: str = "convex"
         raise ValueError(f"shape = {shape} must be two integers >= 2")
     s, f = _fields_jit(inp, settings, flank, shape, float(extend))
     if strict and not isinstance(f.phi, jax.core.Tracer):
-        require_converged(np.asarray(s.blank["converged"]) > 0.5, "seed-000 blank",
+        require_converged(np.asarray(s.blank["converged"]) > 0.5, "cutter-radius study blank",
                           s.blank["residual"])
         require_converged(np.all(np.asarray(f.converged)), "meshing equation (gear roll)",
                           np.max(np.asarray(f.residual)))

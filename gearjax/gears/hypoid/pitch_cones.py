@@ -274,7 +274,7 @@ def solve_pitch_cones(u, Sigma, E, de2, b2, beta, rc0, *, spiral_member="pinion"
     sol = _solve(u, Sigma, E, de2, b2, beta, rc0, r2_fixed, spiral_member, wheel_radius)
     conv = sol.converged
     if strict and not isinstance(conv, jax.core.Tracer):
-        require_converged(conv, "seed-003 pitch-cone tangency solve", sol.residual)
+        require_converged(conv, "pitch-cone tangency solve", sol.residual)
     return sol
 
 

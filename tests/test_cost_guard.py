@@ -1,0 +1,41 @@
+"""Cost guard, static part (tests/cost_guard.py): XLA's cost analysis of the lowered
+TCA programs of the involute and spiral-bevel families and of the efficiency program,
+against the recorded baseline -- the graph size, without compiling or timing anything.
+The dynamic part (Newton iterations executed) sits beside the module fixtures that
+already run those TCAs (tests/test_tca.py, test_edge_contact.py, test_vh_catt.py,
+test_preset_bevel_tca.py), so that it compiles nothing of its own.
+
+Planted regressions it catches: the edge candidates traced twice or their number
+raised (the involute TCA's flops grow 6.4x from no edge search to the ten candidates),
+a solve left out of ``vmap`` and unrolled, a second TCA traced inside the efficiency
+program."""
+
+import gearjax as gj
+from gearjax.gears.involute.geometry import InvolutePair
+from gearjax.gears.involute.tca import InvoluteTCA
+
+from cost_guard import check_cost, static_cost
+
+
+def test_cost_of_the_lowered_involute_tca():
+    """The point-contact TCA of the crowned 25/41 pair (benchmarks/bench_tca.py), with
+    its edge search (the line-contact program differs only in the contact mode)."""
+    pair = InvolutePair.create(25, 41, 2.0, 20.0)
+    crowned = InvoluteTCA.create(pair, 20.0, profile_crown=0.002, lead_crown=0.001)
+    f = gj.tca_function(crowned)
+    check_cost("lowered_tca_involute_point_contact", **static_cost(f, f.pair))
+
+
+def test_cost_of_the_lowered_spiral_bevel_tca():
+    d = gj.load_design(gj.example_path("spiral_bevel_10x30_synthesised"))
+    f = gj.tca_function(d)
+    check_cost("lowered_tca_spiral_bevel", **static_cost(f, f.pair))
+
+
+def test_cost_of_the_lowered_efficiency_program():
+    """TCA, load sharing and friction of a spur pair in one program."""
+    des = gj.InvoluteTCA.create(gj.InvolutePair.create(20, 40, 4.0, 20.0), 30.0)
+    f = gj.efficiency_function(des)
+    oil, surf = gj.get_oil(gj.OILS[0]), gj.make_surface(0.4)
+    check_cost("lowered_efficiency_spur",
+               **static_cost(lambda p: f(p, 100.0, 1000.0, oil, surf), f.pair))
