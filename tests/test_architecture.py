@@ -10,7 +10,7 @@ from pathlib import Path
 import gearjax
 
 PKG = Path(gearjax.__file__).resolve().parent
-BACKBONE = {"frames", "newton", "surfaces", "kinematics", "tca", "multi_pair", "edge_contact", "tca_result", "contact",
+BACKBONE = {"frames", "newton", "surfaces", "kinematics", "tca", "multi_pair", "edge_contact", "tca_result", "family", "contact",
             "tooth_compliance", "loaded_contact", "optimize", "io", "errors", "progress", "fields",
             "materials"}
 

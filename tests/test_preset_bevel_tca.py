@@ -122,6 +122,22 @@ def test_preset_absorbs_part_of_a_misalignment(runs):
     assert abs(steps.max() - g0) <= 2 * regular
 
 
+@pytest.mark.parametrize("fn", ["run_tca", "tca_function", "tca_sensitivity"])
+def test_options_are_checked_by_the_one_driver(des, fn):
+    """The family runs through the one TCA driver (gearjax.family): an unknown option
+    or a contact mode the family does not have is a one-line ValueError naming it,
+    before any work, in every entry point (before the driver the family's adapter
+    dropped both silently); an option given as None takes the family default."""
+    call = getattr(gj, fn)
+    with pytest.raises(ValueError, match=r"unknown TCA option 'steps'"):
+        call(des, steps=16)
+    with pytest.raises(ValueError, match=r"line_contact = True is not available for "
+                                         r"preset_bevel pairs: the profile arcs"):
+        call(des, line_contact=True)
+    with pytest.raises(ValueError, match=r"steps_per_pitch"):
+        call(des, steps_per_pitch=1)
+    assert gj.family_of(des).options({"half_pitches": None})[1]["half_pitches"] == 1.0
+
 def test_cli_tca_and_surface(des, runs, tmp_path, capsys):
     assert main(["tca", EX, "--positions", "41", "--pitches", "1", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)

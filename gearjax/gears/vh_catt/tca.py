@@ -1,4 +1,4 @@
-"""TCA of VH-CATT pairs (adapter to :mod:`gearjax.tca` and :mod:`gearjax.tca_result`).
+"""TCA of VH-CATT pairs: the family as data for the one TCA driver (:mod:`gearjax.family`).
 
 Mounting (as the involute family): pinion (member 1) about +z through the origin,
 gear (member 2) about +z through ``(0, a + dE, 0)``, ``a = r1 + r2`` (standard
@@ -32,23 +32,19 @@ Units: mm, rad.  References: [VH-CATT]; [Litvin2004] ch. 9.
 
 from __future__ import annotations
 
-from functools import partial
 
 import jax
 import jax.numpy as jnp
-import numpy as np
 
-from gearjax.edge_contact import face_end_contact
+from gearjax.family import DriverAdapter, GearFamily, tca_parts
 from gearjax.gears.vh_catt.geometry import VHCattPair, generated_flank, pair_geometry
 from gearjax.loaded_contact import TeethOf
-from gearjax.tca import (DEFAULT_APPROACH, Assembly, ContactPath, Misalignment,
-                         check_on_flank_converged, check_tca_options, contact_path, multi_pair,
-                         pinion_angle_grid)
-from gearjax.tca_result import (TCAResult, check_side, contact_kinematics, register_family,
-                                strong_float64)
+from gearjax.tca import DEFAULT_APPROACH, Assembly, ContactPath, Misalignment
+from gearjax.tca_result import TCAResult, register_family
 
 __all__ = ["vh_assembly", "vh_flanks", "reference_guess", "vh_margin", "vh_tca_traced", "margin_parts",
-           "vh_result_traced", "SUMMARY_KEYS", "tca_summary", "pair_of", "side_code", "ADAPTER"]
+           "vh_result_traced", "SUMMARY_KEYS", "tca_summary", "pair_of", "side_code",
+           "VHCattFamily", "ADAPTER"]
 
 
 def pair_of(design) -> VHCattPair:
@@ -162,76 +158,6 @@ def _face_ends(pair: VHCattPair, pinion: VHCattPair | None = None):
     return margin_parts, g, g, (t1, t2)
 
 
-def vh_tca_traced(pair: VHCattPair, mis: Misalignment, code, *, steps_per_pitch: int = 24,
-                  half_pitches: float = 1.25, n_pairs: int = 3, approach=DEFAULT_APPROACH,
-                  face_ends: bool = True, tip_edges: bool = True, corners: bool = True,
-                  pinion: VHCattPair | None = None):
-    """Traceable point-contact TCA: ``(path, margin, multi)`` on the uniform grid of
-    pinion angles ``phi1_ref + k 2 pi/(z1 steps_per_pitch)``, ``|k| <=
-    round(half_pitches steps_per_pitch)``; with ``face_ends`` the edge contacts at the
-    face ends are solved too, with ``tip_edges`` also those of the tip edges and, with
-    ``corners``, of the corners (tip edge x face end)
-    (:func:`gearjax.edge_contact.face_end_contact`).
-    ``pinion`` : cut the pinion as the pinion of this pair instead (same tooth numbers
-    and module; e.g. another blade angle: a deliberate base-pitch mismatch, whose tip
-    contacts the tests check); its own tip and form circles bound its flank."""
-    x_ref, phi1_ref = reference_guess(pair, code, pinion)
-    grid = pinion_angle_grid(phi1_ref, pair.z1, steps_per_pitch, half_pitches)
-    r1, r2 = vh_flanks(pair, code, pinion)
-    asm = vh_assembly(pair)
-    path = contact_path(r1, r2, asm, mis, grid, x_ref, line_contact=False, approach=approach)
-    margin, _ = vh_margin(pair, path, pinion)
-    if face_ends:
-        parts, g1, g2, tips = _face_ends(pair, pinion)
-        path, margin, _ = face_end_contact(r1, r2, asm, mis, path, margin, parts, g1, g2,
-                                           drive=code < 0, line_contact=False,
-                                           steps_per_pitch=steps_per_pitch,
-                                           tips=tips if tip_edges else None, corners=corners)
-    multi = multi_pair(path, margin, steps_per_pitch, pair.z1, drive=(code < 0),
-                       n_pairs=n_pairs)
-    return path, margin, multi
-
-
-def _parts(pair, mis, code, *, steps_per_pitch, half_pitches, n_pairs, approach, kinematics,
-           face_ends):
-    path, margin, multi = vh_tca_traced(pair, mis, code, steps_per_pitch=steps_per_pitch,
-                                        half_pitches=half_pitches, n_pairs=n_pairs,
-                                        approach=approach, face_ends=face_ends)
-    _, parts = vh_margin(pair, path)
-    kin = None
-    if kinematics:
-        r1, r2 = vh_flanks(pair, code)
-        kin = contact_kinematics(r1, r2, vh_assembly(pair), mis, path, line_contact=False)
-    return path, margin, multi, {"margin_parts": parts}, kin
-
-
-def vh_result_traced(pair: VHCattPair, mis: Misalignment, *, side: str = "drive",
-                     steps_per_pitch: int = 24, half_pitches: float = 1.25, n_pairs: int = 3,
-                     approach=DEFAULT_APPROACH, kinematics: bool = True,
-                     face_ends: bool = True) -> TCAResult:
-    """:func:`vh_tca_traced` as a :class:`~gearjax.tca_result.TCAResult` (traceable)."""
-    parts = _parts(pair, mis, side_code(side), steps_per_pitch=steps_per_pitch,
-                   half_pitches=half_pitches, n_pairs=n_pairs, approach=approach,
-                   kinematics=kinematics, face_ends=face_ends)
-    return TCAResult(*parts, side, "vh_catt")
-
-
-# the side code enters only as a number: drive and coast share one compiled program
-@partial(jax.jit, static_argnames=("steps_per_pitch", "half_pitches", "n_pairs", "kinematics",
-                                   "face_ends"))
-def _result_jit(pair, mis, approach, code, *, steps_per_pitch, half_pitches, n_pairs,
-                kinematics, face_ends):
-    return _parts(pair, mis, code, steps_per_pitch=steps_per_pitch, half_pitches=half_pitches,
-                  n_pairs=n_pairs, approach=approach, kinematics=kinematics,
-                  face_ends=face_ends)
-
-
-def _result(pair, mis, approach, side, **static) -> TCAResult:
-    parts = _result_jit(strong_float64(pair), strong_float64(mis), approach,
-                        side_code(side), **static)
-    return TCAResult(*parts, side, "vh_catt")
-
-
 SUMMARY_KEYS = ("ptp_rad", "phi2_ref_rad", "axial1_mm", "radial1_mm", "axial2_mm",
                 "radial2_mm", "semi_major_mm")
 
@@ -245,90 +171,117 @@ def tca_summary(path: ContactPath, multi):
                       path.axial2[mid], path.radial2[mid], path.semi_major[mid]])
 
 
-@partial(jax.jit, static_argnames=("steps_per_pitch", "half_pitches"))
-def _sensitivity_jit(pair, mis, code, steps_per_pitch, half_pitches):
-    def f(m):
-        path, _, multi = vh_tca_traced(pair, m, code, steps_per_pitch=steps_per_pitch,
-                                       half_pitches=half_pitches, face_ends=False)
-        return tca_summary(path, multi)
-    return f(mis), jax.jacfwd(f)(mis)
+class VHCattFamily(GearFamily):
+    """The VH-CATT pair for the driver (designs: :class:`VHCattPair` or the design-file
+    object of :mod:`gearjax.gears.vh_catt.design_file`).  Side code sigma = -1 drive
+    (pinion turning about +z pushes for increasing phi1: :meth:`forward` is the drive
+    side), +1 coast.  Point contact only.  The reference contact is found inside the
+    program (:func:`reference_guess`: the grid moves with the design)."""
 
-
-class _Adapter:
-    """The VH-CATT family behind :func:`gearjax.run_tca` (designs: :class:`VHCattPair` or
-    the design-file object of :mod:`gearjax.gears.vh_catt.design_file`)."""
-
-    family = "vh_catt"
+    name = "vh_catt"
     defaults = dict(steps_per_pitch=24, half_pitches=1.25, n_pairs=3)
+    line_contact_modes = (False,)
+    contact_mode_reason = "the flanks touch at a point (their traces differ by the blade offset)"
+    summary_keys = SUMMARY_KEYS
+    reference_moves_with_design = True
 
-    def run(self, des, mis=None, *, side="drive", steps_per_pitch=24, half_pitches=1.25,
-            n_pairs=3, approach=DEFAULT_APPROACH, kinematics=True, strict=True,
-            face_ends=True, line_contact=None):
-        side = check_side(side)
-        _no_line_contact(line_contact)
-        check_tca_options(steps_per_pitch, half_pitches, n_pairs, approach)
-        mis = Misalignment.zero() if mis is None else mis
-        res = _result(pair_of(des), mis, float(approach), side,
-                      steps_per_pitch=int(steps_per_pitch), half_pitches=float(half_pitches),
-                      n_pairs=int(n_pairs), kinematics=bool(kinematics),
-                      face_ends=bool(face_ends))
-        if strict:
-            check_on_flank_converged(res.path, res.margin)
-        return res
+    def pair(self, design):
+        return pair_of(design)
 
-    def traced(self, des, *, side="drive", steps_per_pitch=24, half_pitches=1.25, n_pairs=3,
-               approach=DEFAULT_APPROACH, kinematics=True, face_ends=True, line_contact=None):
-        side = check_side(side)
-        _no_line_contact(line_contact)
-        check_tca_options(steps_per_pitch, half_pitches, n_pairs, approach)
-
-        def f(pair, mis=None):
-            mis = Misalignment.zero() if mis is None else mis
-            return _result(pair_of(pair), mis, approach, side,
-                           steps_per_pitch=int(steps_per_pitch),
-                           half_pitches=float(half_pitches), n_pairs=int(n_pairs),
-                           kinematics=bool(kinematics), face_ends=bool(face_ends))
-        f.pair = pair_of(des)
-        return f
-
-    def check(self, des):
-        """The concrete pair's fields in range (:func:`~gearjax.gears.vh_catt.geometry.
-        check_pair_fields`; :func:`gearjax.tca_result.check_design`)."""
+    def check(self, pair):
+        """The fields in range (:func:`~gearjax.gears.vh_catt.geometry.check_pair_fields`)."""
         from gearjax.gears.vh_catt.geometry import check_pair_fields
-        check_pair_fields(pair_of(des))
+        check_pair_fields(pair)
 
-    def outline(self, des, side="drive"):
+    @staticmethod
+    def _code(drive):
+        return jnp.where(drive, -1.0, 1.0)
+
+    def _members(self, pair):
+        """``(pair, pinion)``: the pair, and the pinion cut as another pair's (None)."""
+        return pair, None
+
+    def reference_traced(self, pair, drive):
+        p, q = self._members(pair)
+        return reference_guess(p, self._code(drive), q)
+
+    def flanks(self, pair, drive):
+        p, q = self._members(pair)
+        return vh_flanks(p, self._code(drive), q)
+
+    def forward(self, drive):
+        # sigma = -1 (drive): the pinion turning about +z pushes for increasing phi1
+        return drive
+
+    def assembly(self, pair):
+        return vh_assembly(self._members(pair)[0])
+
+    def pinion_teeth(self, pair):
+        return self._members(pair)[0].z1
+
+    def boundaries(self, pair, path):
+        p, q = self._members(pair)
+        margin, parts = vh_margin(p, path, q)
+        return margin, {"margin_parts": parts}
+
+    def edges(self, pair):
+        return _face_ends(*self._members(pair))
+
+    def summary(self, res):
+        return tca_summary(res.path, res.multi)
+
+    def teeth(self, pair, side):
+        """The loaded-contact teeth (:mod:`gearjax.gears.vh_catt.mesh`)."""
+        from gearjax.gears.vh_catt.mesh import vh_mesh_teeth
+        return TeethOf(vh_mesh_teeth, (("drive", side == "drive"),)), pair
+
+    def outline(self, pair, side="drive"):
         """Pinion flank limits for the TCA figure (concrete floats, mm): face_half,
         root_radius (form circle of the straight blade), tip_radius."""
-        ra1, rf1, _, _, hb = _limits(pair_of(des))
+        ra1, rf1, _, _, hb = _limits(pair)
         return dict(face_half=float(hb), root_radius=float(rf1), tip_radius=float(ra1))
 
-    def mesh(self, des, *, side="drive", **_):
-        """``(teeth_of, pair, pair)`` for the loaded contact (:mod:`gearjax.gears.vh_catt.mesh`)."""
-        from gearjax.gears.vh_catt.mesh import vh_mesh_teeth
-        drive = check_side(side) == "drive"
-        pair = pair_of(des)
-        return TeethOf(vh_mesh_teeth, (("drive", drive),)), pair, pair
 
-    def sensitivity(self, des, mis=None, *, side="drive", steps_per_pitch=24,
-                    half_pitches=1.25, **_):
-        """``(values, table)``: the summary (:data:`SUMMARY_KEYS`) and its derivatives with
-        respect to dE, dP, dG (per mm) and dSigma (per rad) by ``jax.jacfwd``."""
-        side = check_side(side)
-        mis = Misalignment.zero() if mis is None else mis
-        vals, jac = _sensitivity_jit(strong_float64(pair_of(des)), strong_float64(mis),
-                                     side_code(side), int(steps_per_pitch), float(half_pitches))
-        values = {k: float(v) for k, v in zip(SUMMARY_KEYS, np.asarray(vals))}
-        table = {k: {n: float(np.asarray(getattr(jac, n))[i])
-                     for n in ("dE", "dP", "dG", "dSigma")} for i, k in enumerate(SUMMARY_KEYS)}
-        return values, table
+class _MismatchedPinion(VHCattFamily):
+    """A VH-CATT pair whose pinion is cut as the pinion of another pair (a deliberate
+    mismatch, :func:`vh_tca_traced`): ``pair = (VHCattPair, pinion VHCattPair)``."""
+
+    def _members(self, pair):
+        return pair
 
 
-def _no_line_contact(line_contact):
-    if line_contact:
-        raise ValueError("line_contact = True: a VH-CATT pair touches at a point (its traces "
-                         "differ by the blade offset); allowed: None or False")
-
-
-ADAPTER = _Adapter()
+FAMILY = VHCattFamily()
+MISMATCHED_PINION = _MismatchedPinion()
+ADAPTER = DriverAdapter(FAMILY)
 register_family(VHCattPair, ADAPTER)
+
+
+def vh_result_traced(pair: VHCattPair, mis: Misalignment, *, side: str = "drive",
+                     steps_per_pitch: int = 24, half_pitches: float = 1.25, n_pairs: int = 3,
+                     approach=DEFAULT_APPROACH, kinematics: bool = True,
+                     face_ends: bool = True) -> TCAResult:
+    """The driver's TCA of this family as a :class:`~gearjax.tca_result.TCAResult`
+    (traceable)."""
+    parts = tca_parts(FAMILY, pair, mis, None, None, jnp.asarray(side == "drive"), approach,
+                      steps_per_pitch=steps_per_pitch, half_pitches=half_pitches,
+                      n_pairs=n_pairs, kinematics=kinematics, face_ends=face_ends)
+    return TCAResult(*parts, side, FAMILY.name)
+
+
+def vh_tca_traced(pair: VHCattPair, mis: Misalignment, code, *, steps_per_pitch: int = 24,
+                  half_pitches: float = 1.25, n_pairs: int = 3, approach=DEFAULT_APPROACH,
+                  face_ends: bool = True, pinion: VHCattPair | None = None):
+    """Traceable point-contact TCA ``(path, margin, multi)`` of side ``code`` (-1 drive,
+    +1 coast; may be traced) by the one driver (:func:`gearjax.family.tca_parts`), on
+    the uniform grid of pinion angles ``phi1_ref + k 2 pi/(z1 steps_per_pitch)``,
+    ``|k| <= round(half_pitches steps_per_pitch)``; with ``face_ends`` the edge
+    contacts (face ends, tip edges, corners) are solved too.
+    ``pinion`` : cut the pinion as the pinion of this pair instead (same tooth numbers
+    and module; e.g. another blade angle: a deliberate base-pitch mismatch, whose tip
+    contacts the tests check); its own tip and form circles bound its flank."""
+    fam, p = (FAMILY, pair) if pinion is None else (MISMATCHED_PINION, (pair, pinion))
+    path, margin, multi, _, _ = tca_parts(fam, p, mis, None, None, jnp.asarray(code) < 0,
+                                          approach, steps_per_pitch=steps_per_pitch,
+                                          half_pitches=half_pitches, n_pairs=n_pairs,
+                                          kinematics=False, face_ends=face_ends)
+    return path, margin, multi

@@ -1,0 +1,290 @@
+"""A gear family as data, and the one TCA driver every ported family runs through.
+
+A family says *what* its pair is -- flanks, mounting, flank boundaries, edges,
+reference contact, summary -- by implementing :class:`GearFamily`; the driver here
+says *how* a TCA is run, once for every family: the grid of pinion angles, the
+continued contact solve (:func:`gearjax.tca.contact_path`), the edge contacts
+(:func:`gearjax.edge_contact.face_end_contact`), the consecutive tooth pairs and the
+TE envelope (:func:`gearjax.multi_pair.multi_pair`), the rolling/sliding kinematics
+(:func:`gearjax.tca_result.contact_kinematics`) and the :class:`TCAResult`.  One
+compiled program per family class and static option set serves both sides and every
+design of the family (the family object is a static argument; the pair a pytree).
+
+**Side convention** (the same in every ported family): the user names a side
+``"drive"`` or ``"coast"``; inside a program it is the traced boolean ``drive`` (True
+on the drive side), so that both sides share one program.  Which sense of rotation a
+side's flank pushes the gear for is the family's :meth:`GearFamily.forward`: True
+where the pinion flank pushes the gear for increasing ``phi1``, so that the TE
+envelope is the maximum over the tooth pairs (the ``drive`` argument of
+:func:`~gearjax.edge_contact.face_end_contact` and
+:func:`~gearjax.multi_pair.multi_pair`).
+
+**Options** (same names, meaning and checks in every family): ``steps_per_pitch``,
+``half_pitches``, ``n_pairs`` (defaults: :attr:`GearFamily.defaults`), ``approach``
+(mm, Hertz approach of the contact ellipse), ``kinematics`` (default True),
+``face_ends`` (default True: solve the edge contacts), ``strict`` (``run`` only).
+``line_contact`` is accepted where the family supports it (:attr:`GearFamily.
+line_contact_modes`) and refused in one line elsewhere; an unknown option is refused
+in one line naming it; an option given as None takes the family's default.
+
+Families still on their own adapters (involute, hypoid, VH-CATT) register those; the
+ported ones register a :class:`DriverAdapter` (issue [D], docs/architecture.md).
+"""
+
+from __future__ import annotations
+
+import functools
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from gearjax.edge_contact import face_end_contact
+from gearjax.multi_pair import multi_pair
+from gearjax.tca import (DEFAULT_APPROACH, Misalignment, check_on_flank_converged,
+                         check_tca_options, contact_path, pinion_angle_grid)
+from gearjax.tca_result import TCAResult, check_side, contact_kinematics, strong_float64
+
+__all__ = ["GearFamily", "DriverAdapter", "tca_parts", "OPTION_NAMES"]
+
+#: the TCA options every family accepts (``line_contact`` only where supported)
+OPTION_NAMES = ("steps_per_pitch", "half_pitches", "n_pairs", "approach", "kinematics",
+                "face_ends", "line_contact")
+
+
+class GearFamily:
+    """What a gear family provides to the driver (subclass and override; stateless,
+    hashable: the family object is a static argument of the compiled programs).
+
+    ``pair`` below is the family's differentiable pytree (e.g. a dataclass of floats).
+    """
+
+    #: family name (``TCAResult.family``)
+    name: str = ""
+    #: default grid of the family's TCA
+    defaults: dict = dict(steps_per_pitch=24, half_pitches=1.25, n_pairs=3)
+    #: contact modes the family supports: (False,) point contact only; why, for the
+    #: one-line refusal of the other mode
+    line_contact_modes: tuple = (False,)
+    contact_mode_reason: str = ""
+
+    # -- concrete set-up ------------------------------------------------------------
+    def pair(self, design):
+        """The differentiable pytree of ``design`` (a design-file object or the pytree)."""
+        return design
+
+    def check(self, design) -> None:
+        """One-line ValueError for a concrete field out of range (traced: skipped)."""
+
+    #: False: the reference contact is found once, concretely, by :meth:`reference`
+    #: (the grid stays where it is when the design changes); True: inside the program
+    #: by :meth:`reference_traced`, so that the grid moves with the design (its
+    #: derivative flows)
+    reference_moves_with_design: bool = False
+
+    def reference(self, pair, side: str):
+        """``(x_ref, phi1_ref)``: start of the contact solve at the middle grid point
+        (concrete; no derivative flows into it)."""
+        raise NotImplementedError
+
+    def reference_traced(self, pair, drive):
+        """``(x_ref, phi1_ref)`` inside the program (``reference_moves_with_design``)."""
+        raise NotImplementedError
+
+    # -- traceable geometry ---------------------------------------------------------
+    def flanks(self, pair, drive):
+        """``(r1, r2)``: pinion and gear flank functions ``uv -> (3,)`` (body frames, mm)
+        of the side ``drive`` (traced bool)."""
+        raise NotImplementedError
+
+    def forward(self, drive):
+        """True where the side's pinion flank pushes the gear for increasing phi1."""
+        return drive
+
+    def assembly(self, pair):
+        """The nominal mounting (:class:`gearjax.tca.Assembly`)."""
+        raise NotImplementedError
+
+    def pinion_teeth(self, pair):
+        return pair.z1
+
+    def boundaries(self, pair, path):
+        """``(margin, coords)``: boundary margin of the contact (mm, >= 0 inside both
+        flanks) and the family's flank coordinates of the contact (dict of arrays)."""
+        raise NotImplementedError
+
+    def edges(self, pair):
+        """``(margin_parts, g1, g2, tips)`` of :func:`~gearjax.edge_contact.face_end_contact`,
+        or None (no edge contact solved)."""
+        return None
+
+    # -- summaries, loaded contact, plots -------------------------------------------
+    summary_keys: tuple = ()
+
+    def summary(self, res: TCAResult):
+        raise NotImplementedError
+
+    def teeth(self, pair, side: str):
+        """``(teeth_of, pair)`` of the loaded-contact models."""
+        raise NotImplementedError
+
+    def outline(self, pair, side: str = "drive") -> dict:
+        raise NotImplementedError
+
+
+def tca_parts(fam: GearFamily, pair, mis, x_ref, phi1_ref, drive, approach, *,
+              steps_per_pitch: int, half_pitches: float, n_pairs: int, kinematics: bool,
+              face_ends: bool = True, line_contact: bool = False):
+    """The TCA of any family (traceable): ``(path, margin, multi, coords, kinematics)``.
+
+    Grid ``phi1_ref + k 2 pi/(z1 steps_per_pitch)``, ``|k| <= round(half_pitches
+    steps_per_pitch)``; the contact path continued from ``x_ref``; with ``face_ends``
+    and the family's edges, the contact made at each angle is the surface or an edge
+    contact; pair 0 shifted by whole pitches gives the neighbouring pairs and the TE
+    envelope (max where :meth:`GearFamily.forward`, else min).  ``x_ref = None``: the
+    family's :meth:`GearFamily.reference_traced` inside the program."""
+    if x_ref is None:
+        x_ref, phi1_ref = fam.reference_traced(pair, drive)
+    grid = pinion_angle_grid(phi1_ref, fam.pinion_teeth(pair), steps_per_pitch, half_pitches)
+    r1, r2 = fam.flanks(pair, drive)
+    asm = fam.assembly(pair)
+    fwd = fam.forward(drive)
+    path = contact_path(r1, r2, asm, mis, grid, x_ref, line_contact=line_contact,
+                        approach=approach)
+    margin, _ = fam.boundaries(pair, path)
+    edges = fam.edges(pair) if face_ends else None
+    if edges is not None:
+        parts, g1, g2, tips = edges
+        path, margin, _ = face_end_contact(r1, r2, asm, mis, path, margin, parts, g1, g2,
+                                           drive=fwd, tips=tips, line_contact=line_contact,
+                                           steps_per_pitch=steps_per_pitch)
+    _, coords = fam.boundaries(pair, path)
+    multi = multi_pair(path, margin, steps_per_pitch, fam.pinion_teeth(pair), drive=fwd,
+                       n_pairs=n_pairs)
+    kin = (contact_kinematics(r1, r2, asm, mis, path, line_contact=line_contact)
+           if kinematics else None)
+    return path, margin, multi, coords, kin
+
+
+_STATIC = ("fam", "steps_per_pitch", "half_pitches", "n_pairs", "kinematics", "face_ends",
+           "line_contact")
+
+
+@functools.partial(jax.jit, static_argnames=_STATIC)
+def _program(pair, mis, x_ref, phi1_ref, approach, drive, *, fam, **static):
+    return tca_parts(fam, pair, mis, x_ref, phi1_ref, drive, approach, **static)
+
+
+def _result(fam, pair, mis, x_ref, phi1_ref, approach, side, static) -> TCAResult:
+    parts = _program(strong_float64(pair), strong_float64(mis), x_ref, phi1_ref, approach,
+                     jnp.asarray(side == "drive"), fam=fam, **static)
+    return TCAResult(*parts, side, fam.name)
+
+
+class DriverAdapter:
+    """The registry entry (:func:`gearjax.tca_result.register_family`) of a family
+    ported to the driver: ``run``, ``traced``, ``sensitivity``, ``mesh``, ``outline``
+    and ``check`` written once for every family."""
+
+    def __init__(self, fam: GearFamily):
+        self.fam = fam
+        self.family = fam.name
+        self.defaults = dict(fam.defaults)
+
+    def check(self, design) -> None:
+        self.fam.check(self.fam.pair(design))
+
+    def _reference(self, pair, side):
+        # (None, None): found inside the program (the grid moves with the design)
+        if self.fam.reference_moves_with_design:
+            return None, None
+        return self.fam.reference(pair, side)
+
+    def options(self, options: dict, *, run: bool = False):
+        """``(approach, static options)`` with the family's defaults, validated: an
+        unknown option or an unsupported contact mode is a one-line ValueError."""
+        allowed = set(OPTION_NAMES) | ({"strict"} if run else set())
+        unknown = sorted(set(options) - allowed)
+        if unknown:
+            raise ValueError(f"unknown TCA option {unknown[0]!r} for {self.fam.name} pairs "
+                             f"(options: {', '.join(OPTION_NAMES)})")
+        o = {**self.defaults, "approach": DEFAULT_APPROACH, "kinematics": True,
+             "face_ends": True,
+             **{k: v for k, v in options.items() if k != "strict" and v is not None}}
+        lc = o.get("line_contact")
+        lc = self.fam.line_contact_modes[0] if lc is None else bool(lc)
+        if lc not in self.fam.line_contact_modes:
+            why = f": {self.fam.contact_mode_reason}" if self.fam.contact_mode_reason else ""
+            raise ValueError(f"line_contact = {lc} is not available for {self.fam.name} pairs"
+                             f"{why} (allowed: None or "
+                             f"{', '.join(str(m) for m in self.fam.line_contact_modes)})")
+        check_tca_options(o["steps_per_pitch"], o["half_pitches"], o["n_pairs"], o["approach"])
+        static = dict(steps_per_pitch=int(o["steps_per_pitch"]),
+                      half_pitches=float(o["half_pitches"]), n_pairs=int(o["n_pairs"]),
+                      kinematics=bool(o["kinematics"]), face_ends=bool(o["face_ends"]),
+                      line_contact=lc)
+        return float(o["approach"]), static
+
+    def run(self, design, mis=None, *, side=None, **options) -> TCAResult:
+        """Validated, jitted TCA; ``strict`` (default True) raises
+        :class:`~gearjax.errors.ConvergenceError` (``NoContactError``) when a solve
+        failed on the working flank or no grid point is on both flanks."""
+        side = check_side(side or "drive")
+        strict = options.get("strict", True)
+        approach, static = self.options(options, run=True)
+        pair = self.fam.pair(design)
+        mis = Misalignment.zero() if mis is None else mis
+        x_ref, phi1_ref = self._reference(pair, side)
+        res = _result(self.fam, pair, mis, x_ref, phi1_ref, approach, side, static)
+        if strict:
+            check_on_flank_converged(res.path, res.margin)
+        return res
+
+    def traced(self, design, *, side=None, **options):
+        """A pure ``f(pair, mis=None) -> TCAResult`` (the concrete reference contact of
+        ``design`` fixed once here); ``f.pair`` the design's pytree."""
+        side = check_side(side or "drive")
+        approach, static = self.options(options)
+        pair0 = self.fam.pair(design)
+        x_ref, phi1_ref = self._reference(pair0, side)
+        fam = self.fam
+
+        def f(pair, mis=None):
+            mis = Misalignment.zero() if mis is None else mis
+            return _result(fam, pair, mis, x_ref, phi1_ref, approach, side, static)
+        f.pair = pair0
+        return f
+
+    def sensitivity(self, design, mis=None, *, side=None, **options):
+        """``(values, table)``: the family's summary and its derivatives by dE, dP, dG
+        (per mm) and dSigma (per rad), by ``jax.jacfwd`` through every solve."""
+        side = check_side(side or "drive")
+        approach, static = self.options({**options, "kinematics": False})
+        pair = self.fam.pair(design)
+        mis = Misalignment.zero() if mis is None else mis
+        x_ref, phi1_ref = self._reference(pair, side)
+        vals, jac = _sensitivity_program(strong_float64(pair), strong_float64(mis), x_ref,
+                                         phi1_ref, approach, jnp.asarray(side == "drive"),
+                                         fam=self.fam, **static)
+        keys = self.fam.summary_keys
+        values = {k: float(v) for k, v in zip(keys, np.asarray(vals))}
+        table = {k: {n: float(np.asarray(getattr(jac, n))[i])
+                     for n in ("dE", "dP", "dG", "dSigma")} for i, k in enumerate(keys)}
+        return values, table
+
+    def mesh(self, design, *, side=None, **_):
+        """``(teeth_of, pair, design)`` of the loaded-contact models."""
+        pair = self.fam.pair(design)
+        teeth_of, p = self.fam.teeth(pair, check_side(side or "drive"))
+        return teeth_of, p, pair
+
+    def outline(self, design, side="drive"):
+        return self.fam.outline(self.fam.pair(design), side)
+
+
+@functools.partial(jax.jit, static_argnames=_STATIC)
+def _sensitivity_program(pair, mis, x_ref, phi1_ref, approach, drive, *, fam, **static):
+    def f(m):
+        parts = tca_parts(fam, pair, m, x_ref, phi1_ref, drive, approach, **static)
+        return fam.summary(TCAResult(*parts, "", fam.name))
+    return f(mis), jax.jacfwd(f)(mis)
