@@ -181,3 +181,60 @@ def test_toy_family_options_sensitivity_and_gradient():
     fd = (te_shift(jnp.asarray(h)) - te_shift(jnp.asarray(-h))) / (2 * h)
     assert float(g) == pytest.approx(float(fd), rel=1e-6)
     assert abs(float(g)) > 1e-4
+
+
+def test_driver_strict_default_and_masks():
+    """``strict`` defaults to True in the driver's ``run``: a pair with no grid point on
+    both flanks (here a negative face width: every face margin < 0) is a
+    ``NoContactError`` (a ``ConvergenceError``), and ``strict=False`` returns the result
+    with its masks instead (the same compiled program as the closed-form runs)."""
+    bad = _toy(b=-1.0)
+    with pytest.raises(gj.ConvergenceError, match="no contact inside the flank boundaries"):
+        gj.run_tca(bad, side="drive")
+    res = gj.run_tca(bad, side="drive", strict=False)
+    assert not np.any(np.asarray(res.on_flank))
+
+
+def test_driver_solves_edges_only_when_asked():
+    """``face_ends`` reaches the family: its ``edges`` are asked for exactly when the
+    option is on (traced only, nothing compiled)."""
+    from gearjax.family import tca_parts
+
+    calls = []
+
+    class Spy(ToySpur):
+        def edges(self, pair):
+            calls.append(1)
+            return None
+
+    des = _toy()
+    x_ref, phi1_ref = Spy().reference(des, "drive")
+    for flag, n in ((False, 0), (True, 1)):
+        calls.clear()
+        jax.eval_shape(lambda p: tca_parts(Spy(), p, gj.Misalignment.zero(), x_ref, phi1_ref,
+                                           jnp.asarray(True), 0.00632, steps_per_pitch=8,
+                                           half_pitches=1.25, n_pairs=3, kinematics=False,
+                                           face_ends=flag, line_contact=True), des)
+        assert len(calls) == n, flag
+
+
+def test_driver_sensitivity_table_matches_central_differences(toy_runs):
+    """``gj.tca_sensitivity`` through the driver (its own ``jacfwd`` program) against
+    central differences of the same summary from ``run_tca`` (the program of the
+    closed-form runs): the gear angle at the reference per mm of dE, and the TE p-t-p,
+    which stays 0 for the conjugate pair.  A table differentiated at the wrong point or
+    not at all (zero) fails."""
+    des = _toy()
+    values, table = gj.tca_sensitivity(des, side="drive")
+    mid = 10
+    assert values["phi2_ref_rad"] == pytest.approx(
+        float(toy_runs[(18, 31, "drive")].path.phi2[mid]), rel=1e-12)
+    h = 1e-6
+
+    def phi2(dE):
+        mis = gj.Misalignment(*(jnp.asarray(v) for v in (dE, 0.0, 0.0, 0.0)))
+        return float(gj.run_tca(des, mis, side="drive").path.phi2[mid])
+    fd = (phi2(h) - phi2(-h)) / (2 * h)
+    assert table["phi2_ref_rad"]["dE"] == pytest.approx(fd, rel=1e-6)
+    assert abs(fd) > 1e-4
+    assert abs(table["ptp_rad"]["dE"]) < 1e-9

@@ -122,6 +122,26 @@ def test_preset_absorbs_part_of_a_misalignment(runs):
     assert abs(steps.max() - g0) <= 2 * regular
 
 
+def test_summary_is_the_result_at_the_reference(runs):
+    """The summary the sensitivity table differentiates (``preset_summary``, keys
+    ``SUMMARY_KEYS``) is read off the result by name at the reference grid point: a
+    swapped or misread entry would put the wrong quantity into every sensitivity."""
+    from gearjax.gears.preset_bevel.tca import SUMMARY_KEYS, preset_summary
+    # (misaligned: aligned, the contact at the reference lies on the pitch line of both
+    # members, L1 = L2 and h1 = h2 = 0, where a swap would not show)
+    for case in ("mod_dG", "plain_dG"):
+        res = runs[case]
+        p, c = res.path, res.coords
+        mid = np.asarray(p.phi1).size // 2
+        want = {"ptp_rad": res.multi.ptp, "phi2_ref_rad": p.phi2[mid], "L1_mm": c["L1"][mid],
+                "h1_mm": c["h1"][mid], "L2_mm": c["L2"][mid], "h2_mm": c["h2"][mid],
+                "semi_major_mm": p.semi_major[mid]}
+        got = np.asarray(preset_summary(res))
+        for k, v in zip(SUMMARY_KEYS, got):
+            assert v == pytest.approx(float(want[k]), rel=0, abs=0), (case, k)
+        assert abs(got[3] - got[5]) > 1e-6 and abs(got[2] - got[4]) > 1e-6, got
+
+
 @pytest.mark.parametrize("fn", ["run_tca", "tca_function", "tca_sensitivity"])
 def test_options_are_checked_by_the_one_driver(des, fn):
     """The family runs through the one TCA driver (gearjax.family): an unknown option

@@ -205,6 +205,25 @@ def tca_runs(pair):
             "tilt": gj.run_tca(pair, gj.Misalignment.create(dSigma_deg=0.02), **opts)}
 
 
+def test_summary_is_the_result_at_the_reference(tca_runs):
+    """The summary the sensitivity table differentiates (``tca_summary``, keys
+    ``SUMMARY_KEYS``) is read off the result by name at the reference grid point (a
+    swapped entry would put the wrong quantity into every sensitivity)."""
+    from gearjax.gears.vh_catt.tca import SUMMARY_KEYS, tca_summary
+    for side in ("drive", "tilt"):
+        res = tca_runs[side]
+        p = res.path
+        mid = np.asarray(p.phi1).size // 2
+        got = np.asarray(tca_summary(p, res.multi))
+        want = {"ptp_rad": res.multi.ptp, "phi2_ref_rad": p.phi2[mid],
+                "axial1_mm": p.axial1[mid], "radial1_mm": p.radial1[mid],
+                "axial2_mm": p.axial2[mid], "radial2_mm": p.radial2[mid],
+                "semi_major_mm": p.semi_major[mid]}
+        for k, v in zip(SUMMARY_KEYS, got):
+            assert v == float(want[k]), (side, k)
+        assert got[3] != got[5]                       # pinion and gear radii differ
+
+
 def test_cost_of_the_vh_catt_tca(tca_runs):
     """Cost guard (tests/cost_guard.py): Newton work of the surface-contact VH-CATT TCA
     on both sides against the recorded baseline."""
