@@ -224,6 +224,33 @@ def test_summary_is_the_result_at_the_reference(tca_runs):
         assert got[3] != got[5]                       # pinion and gear radii differ
 
 
+def test_boundary_margins_are_the_form_and_tip_circles(pair, tca_runs):
+    """The six boundary margins of the TCA (coords["margin_parts"]) against the blank
+    read directly: tip ``r_a - r``, form circle ``r - r_F`` (on the working branch of
+    the envelope) and face ``b/2 - |z|`` of each member at its own contact radius.
+    (A gear form-circle margin computed with the pinion's radii survived the blind
+    review: on the aligned pair the gear root never bounds the path.)"""
+    geo = G.pair_geometry(pair)
+    for side in ("drive", "tilt"):
+        res = tca_runs[side]
+        p = res.path
+        parts = np.asarray(res.coords["margin_parts"])
+        ok = np.asarray(p.converged)
+        for k, (radial, axial, uv, ra, rf, rp) in enumerate((
+                (p.radial1, p.axial1, p.uv1, geo["ra1"], geo["rf1"], geo["r1"]),
+                (p.radial2, p.axial2, p.uv2, geo["ra2"], geo["rf2"], geo["r2"]))):
+            R, z, u = np.asarray(radial), np.asarray(axial), np.asarray(uv)[:, 0]
+            alpha = float(pair.pressure_angle)
+            working = ok & (u >= -float(rp) * np.sin(alpha) ** 2 / np.cos(alpha))
+            assert working.sum() >= 10
+            np.testing.assert_allclose(parts[3 * k][ok], (float(ra) - R)[ok], atol=1e-12)
+            np.testing.assert_allclose(parts[3 * k + 1][working], (R - float(rf))[working],
+                                       atol=1e-12)
+            np.testing.assert_allclose(parts[3 * k + 2][ok],
+                                       (0.5 * float(pair.face_width) - np.abs(z))[ok],
+                                       atol=1e-12)
+
+
 def test_cost_of_the_vh_catt_tca(tca_runs):
     """Cost guard (tests/cost_guard.py): Newton work of the surface-contact VH-CATT TCA
     on both sides against the recorded baseline."""
