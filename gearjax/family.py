@@ -45,7 +45,7 @@ from gearjax.tca import (DEFAULT_APPROACH, Misalignment, check_on_flank_converge
                          check_tca_options, contact_path, pinion_angle_grid)
 from gearjax.tca_result import TCAResult, check_side, contact_kinematics, strong_float64
 
-__all__ = ["GearFamily", "DriverAdapter", "tca_parts", "OPTION_NAMES"]
+__all__ = ["GearFamily", "DriverAdapter", "tca_parts", "result_traced", "OPTION_NAMES"]
 
 #: the TCA options every family accepts (``line_contact`` only where supported)
 OPTION_NAMES = ("steps_per_pitch", "half_pitches", "n_pairs", "approach", "kinematics",
@@ -151,19 +151,28 @@ def tca_parts(fam: GearFamily, pair, mis, x_ref, phi1_ref, drive, approach, *,
     fwd = fam.forward(drive)
     path = contact_path(r1, r2, asm, mis, grid, x_ref, line_contact=line_contact,
                         approach=approach)
-    margin, _ = fam.boundaries(pair, path)
+    margin, coords = fam.boundaries(pair, path)
     edges = fam.edges(pair) if face_ends else None
     if edges is not None:
         parts, g1, g2, tips = edges
         path, margin, _ = face_end_contact(r1, r2, asm, mis, path, margin, parts, g1, g2,
                                            drive=fwd, tips=tips, line_contact=line_contact,
                                            steps_per_pitch=steps_per_pitch)
-    _, coords = fam.boundaries(pair, path)
+        _, coords = fam.boundaries(pair, path)        # the coordinates of the contact made
     multi = multi_pair(path, margin, steps_per_pitch, fam.pinion_teeth(pair), drive=fwd,
                        n_pairs=n_pairs)
     kin = (contact_kinematics(r1, r2, asm, mis, path, line_contact=line_contact)
            if kinematics else None)
     return path, margin, multi, coords, kin
+
+
+def result_traced(fam: GearFamily, pair, mis, x_ref, phi1_ref, side: str,
+                  approach=DEFAULT_APPROACH, **static) -> TCAResult:
+    """:func:`tca_parts` of the named ``side`` as a :class:`TCAResult` (traceable; the
+    families' own ``*_result_traced`` entry points)."""
+    parts = tca_parts(fam, pair, mis, x_ref, phi1_ref, jnp.asarray(side == "drive"), approach,
+                      **static)
+    return TCAResult(*parts, side, fam.name)
 
 
 _STATIC = ("fam", "steps_per_pitch", "half_pitches", "n_pairs", "kinematics", "face_ends",

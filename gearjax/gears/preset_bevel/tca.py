@@ -30,7 +30,7 @@ from __future__ import annotations
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax.family import DriverAdapter, GearFamily, tca_parts
+from gearjax.family import DriverAdapter, GearFamily, result_traced
 from gearjax.gears.preset_bevel.geometry import PresetBevelDesign, cone_distances, pitch_angles
 from gearjax.gears.preset_bevel.pair import (drives_forward, preset_assembly, preset_face_ends,
                                              preset_margin, reference_contact, side_flanks)
@@ -142,10 +142,9 @@ def preset_result_traced(des: PresetBevelDesign, mis: Misalignment, x_ref, phi1_
     reference_contact` (concrete, fixed: the grid does not move with the design).
     ``face_ends``: solve the edge contacts (default; ``False``: surface contact only,
     ``path.edge_kind`` None)."""
-    parts = tca_parts(FAMILY, des, mis, x_ref, phi1_ref, jnp.asarray(side == "drive"),
-                      approach, steps_per_pitch=steps_per_pitch, half_pitches=half_pitches,
-                      n_pairs=n_pairs, kinematics=kinematics, face_ends=face_ends)
-    return TCAResult(*parts, side, FAMILY.name)
+    return result_traced(FAMILY, des, mis, x_ref, phi1_ref, side, approach,
+                         steps_per_pitch=steps_per_pitch, half_pitches=half_pitches,
+                         n_pairs=n_pairs, kinematics=kinematics, face_ends=face_ends)
 
 
 def preset_tca(des: PresetBevelDesign, mis: Misalignment | None = None, *, side="drive",

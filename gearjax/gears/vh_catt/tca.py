@@ -36,25 +36,20 @@ from __future__ import annotations
 import jax
 import jax.numpy as jnp
 
-from gearjax.family import DriverAdapter, GearFamily, tca_parts
+from gearjax.family import DriverAdapter, GearFamily, result_traced, tca_parts
 from gearjax.gears.vh_catt.geometry import VHCattPair, generated_flank, pair_geometry
 from gearjax.loaded_contact import TeethOf
 from gearjax.tca import DEFAULT_APPROACH, Assembly, ContactPath, Misalignment
 from gearjax.tca_result import TCAResult, register_family
 
 __all__ = ["vh_assembly", "vh_flanks", "reference_guess", "vh_margin", "vh_tca_traced", "margin_parts",
-           "vh_result_traced", "SUMMARY_KEYS", "tca_summary", "pair_of", "side_code",
+           "vh_result_traced", "SUMMARY_KEYS", "tca_summary", "pair_of",
            "VHCattFamily", "ADAPTER"]
 
 
 def pair_of(design) -> VHCattPair:
     """The :class:`VHCattPair` of a design-file object (``.pair``) or the pair itself."""
     return design if isinstance(design, VHCattPair) else design.pair
-
-
-def side_code(side: str) -> float:
-    """-1.0 (drive) or +1.0 (coast): the flank sign sigma of both members."""
-    return -1.0 if side == "drive" else 1.0
 
 
 def vh_assembly(pair: VHCattPair) -> Assembly:
@@ -262,10 +257,9 @@ def vh_result_traced(pair: VHCattPair, mis: Misalignment, *, side: str = "drive"
                      face_ends: bool = True) -> TCAResult:
     """The driver's TCA of this family as a :class:`~gearjax.tca_result.TCAResult`
     (traceable)."""
-    parts = tca_parts(FAMILY, pair, mis, None, None, jnp.asarray(side == "drive"), approach,
-                      steps_per_pitch=steps_per_pitch, half_pitches=half_pitches,
-                      n_pairs=n_pairs, kinematics=kinematics, face_ends=face_ends)
-    return TCAResult(*parts, side, FAMILY.name)
+    return result_traced(FAMILY, pair, mis, None, None, side, approach,
+                         steps_per_pitch=steps_per_pitch, half_pitches=half_pitches,
+                         n_pairs=n_pairs, kinematics=kinematics, face_ends=face_ends)
 
 
 def vh_tca_traced(pair: VHCattPair, mis: Misalignment, code, *, steps_per_pitch: int = 24,
