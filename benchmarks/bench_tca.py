@@ -18,10 +18,18 @@ import jax.numpy as jnp
 import numpy as np
 from scipy.optimize import fsolve
 
+import gearjax as gj
 from gearjax.gears.involute.geometry import InvolutePair, generated_flank
 from gearjax.tca import ARCSEC, Misalignment, contact_equations
 from gearjax.gears.involute.tca import (InvoluteTCA, reference_guess, crowned_pinion_flank,
-                                  involute_assembly, involute_tca, misalignment_sensitivity)
+                                  involute_assembly, misalignment_sensitivity)
+
+
+def involute_tca(des, mis, strict=True):
+    """The contact path and TE envelope, edges and tips solved, no kinematics (what the
+    SciPy loop computes, and more): the one entry point."""
+    res = gj.run_tca(des, mis, kinematics=False, strict=strict)
+    return res.path, res.margin, res.multi
 
 
 def _best(f, repeat=5):

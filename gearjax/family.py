@@ -73,6 +73,22 @@ class GearFamily:
         """The differentiable pytree of ``design`` (a design-file object or the pytree)."""
         return design
 
+    def default_options(self, pair) -> dict:
+        """The default options of the concrete ``pair`` (:attr:`defaults`; a family
+        whose grid or contact mode depends on the design overrides this)."""
+        return dict(self.defaults)
+
+    def split(self, pair):
+        """``(blank, extra)``: the pair with its static fields that only enter arithmetic
+        (e.g. tooth numbers) taken out as a traced array ``extra``, so that one compiled
+        program serves every pair of the same options; :meth:`join` puts them back
+        inside the trace.  Default: nothing static, ``(pair, None)``."""
+        return pair, None
+
+    def join(self, blank, extra):
+        """The pair of :meth:`split` (inside a trace)."""
+        return blank
+
     def check(self, design) -> None:
         """One-line ValueError for a concrete field out of range (traced: skipped)."""
 
@@ -87,14 +103,17 @@ class GearFamily:
         (concrete; no derivative flows into it)."""
         raise NotImplementedError
 
-    def reference_traced(self, pair, drive):
-        """``(x_ref, phi1_ref)`` inside the program (``reference_moves_with_design``)."""
+    def reference_traced(self, pair, drive, line_contact=False):
+        """``(x_ref, phi1_ref, ok)`` inside the program (``reference_moves_with_design``);
+        ``ok`` (bool) False where the reference itself could not be found (every point
+        of the path is then marked not converged), or None (always found)."""
         raise NotImplementedError
 
     # -- traceable geometry ---------------------------------------------------------
-    def flanks(self, pair, drive):
+    def flanks(self, pair, drive, line_contact=False):
         """``(r1, r2)``: pinion and gear flank functions ``uv -> (3,)`` (body frames, mm)
-        of the side ``drive`` (traced bool)."""
+        of the side ``drive`` (traced bool); with ``line_contact`` parametrised so that
+        the solved contact line's section is ``uv[1] = 0`` (:mod:`gearjax.tca`)."""
         raise NotImplementedError
 
     def forward(self, drive):
@@ -113,6 +132,11 @@ class GearFamily:
         flanks) and the family's flank coordinates of the contact (dict of arrays)."""
         raise NotImplementedError
 
+    def line_coords(self, pair, path, r1) -> dict:
+        """Coordinates a line contact adds to :meth:`boundaries`' (e.g. the overlap
+        ratio), from the path and the pinion flank ``r1``; default none."""
+        return {}
+
     def edges(self, pair):
         """``(margin_parts, g1, g2, tips)`` of :func:`~gearjax.edge_contact.face_end_contact`,
         or None (no edge contact solved)."""
@@ -124,8 +148,9 @@ class GearFamily:
     def summary(self, res: TCAResult):
         raise NotImplementedError
 
-    def teeth(self, pair, side: str):
-        """``(teeth_of, pair)`` of the loaded-contact models."""
+    def teeth(self, pair, side: str, line_contact: bool = False):
+        """``(teeth_of, pair)`` of the loaded-contact models (ValueError where the
+        family's loaded contact does not cover the pair)."""
         raise NotImplementedError
 
     def outline(self, pair, side: str = "drive") -> dict:
@@ -143,14 +168,17 @@ def tca_parts(fam: GearFamily, pair, mis, x_ref, phi1_ref, drive, approach, *,
     contact; pair 0 shifted by whole pitches gives the neighbouring pairs and the TE
     envelope (max where :meth:`GearFamily.forward`, else min).  ``x_ref = None``: the
     family's :meth:`GearFamily.reference_traced` inside the program."""
+    ok = None
     if x_ref is None:
-        x_ref, phi1_ref = fam.reference_traced(pair, drive)
+        x_ref, phi1_ref, ok = fam.reference_traced(pair, drive, line_contact)
     grid = pinion_angle_grid(phi1_ref, fam.pinion_teeth(pair), steps_per_pitch, half_pitches)
-    r1, r2 = fam.flanks(pair, drive)
+    r1, r2 = fam.flanks(pair, drive, line_contact)
     asm = fam.assembly(pair)
     fwd = fam.forward(drive)
     path = contact_path(r1, r2, asm, mis, grid, x_ref, line_contact=line_contact,
                         approach=approach)
+    if ok is not None:
+        path = path._replace(converged=path.converged & ok)
     margin, coords = fam.boundaries(pair, path)
     edges = fam.edges(pair) if face_ends else None
     if edges is not None:
@@ -159,6 +187,8 @@ def tca_parts(fam: GearFamily, pair, mis, x_ref, phi1_ref, drive, approach, *,
                                            drive=fwd, tips=tips, line_contact=line_contact,
                                            steps_per_pitch=steps_per_pitch)
         _, coords = fam.boundaries(pair, path)        # the coordinates of the contact made
+    if line_contact:
+        coords = {**coords, **fam.line_coords(pair, path, r1)}
     multi = multi_pair(path, margin, steps_per_pitch, fam.pinion_teeth(pair), drive=fwd,
                        n_pairs=n_pairs)
     kin = (contact_kinematics(r1, r2, asm, mis, path, line_contact=line_contact)
@@ -180,13 +210,14 @@ _STATIC = ("fam", "steps_per_pitch", "half_pitches", "n_pairs", "kinematics", "f
 
 
 @functools.partial(jax.jit, static_argnames=_STATIC)
-def _program(pair, mis, x_ref, phi1_ref, approach, drive, *, fam, **static):
-    return tca_parts(fam, pair, mis, x_ref, phi1_ref, drive, approach, **static)
+def _program(blank, extra, mis, x_ref, phi1_ref, approach, drive, *, fam, **static):
+    return tca_parts(fam, fam.join(blank, extra), mis, x_ref, phi1_ref, drive, approach,
+                     **static)
 
 
 def _result(fam, pair, mis, x_ref, phi1_ref, approach, side, static) -> TCAResult:
-    parts = _program(strong_float64(pair), strong_float64(mis), x_ref, phi1_ref, approach,
-                     jnp.asarray(side == "drive"), fam=fam, **static)
+    parts = _program(*fam.split(strong_float64(pair)), strong_float64(mis), x_ref, phi1_ref,
+                     approach, jnp.asarray(side == "drive"), fam=fam, **static)
     return TCAResult(*parts, side, fam.name)
 
 
@@ -199,6 +230,10 @@ class DriverAdapter:
         self.fam = fam
         self.family = fam.name
         self.defaults = dict(fam.defaults)
+        # the loaded chain's program takes the pair split the same way (one program for
+        # every pair of the family)
+        self.split_pair = fam.split
+        self.join_pair = fam.join
 
     def check(self, design) -> None:
         self.fam.check(self.fam.pair(design))
@@ -209,19 +244,20 @@ class DriverAdapter:
             return None, None
         return self.fam.reference(pair, side)
 
-    def options(self, options: dict, *, run: bool = False):
-        """``(approach, static options)`` with the family's defaults, validated: an
-        unknown option or an unsupported contact mode is a one-line ValueError."""
+    def options(self, options: dict, pair, *, run: bool = False):
+        """``(approach, static options)`` with the family's defaults for the concrete
+        ``pair`` (:meth:`GearFamily.default_options`), validated: an unknown option or
+        an unsupported contact mode is a one-line ValueError."""
         allowed = set(OPTION_NAMES) | ({"strict"} if run else set())
         unknown = sorted(set(options) - allowed)
         if unknown:
             raise ValueError(f"unknown TCA option {unknown[0]!r} for {self.fam.name} pairs "
                              f"(options: {', '.join(OPTION_NAMES)})")
-        o = {**self.defaults, "approach": DEFAULT_APPROACH, "kinematics": True,
-             "face_ends": True,
+        o = {"line_contact": self.fam.line_contact_modes[0],
+             **self.fam.default_options(pair), "approach": DEFAULT_APPROACH,
+             "kinematics": True, "face_ends": True,
              **{k: v for k, v in options.items() if k != "strict" and v is not None}}
-        lc = o.get("line_contact")
-        lc = self.fam.line_contact_modes[0] if lc is None else bool(lc)
+        lc = bool(o["line_contact"])
         if lc not in self.fam.line_contact_modes:
             why = f": {self.fam.contact_mode_reason}" if self.fam.contact_mode_reason else ""
             raise ValueError(f"line_contact = {lc} is not available for {self.fam.name} pairs"
@@ -234,14 +270,19 @@ class DriverAdapter:
                       line_contact=lc)
         return float(o["approach"]), static
 
+    def resolve(self, design, options: dict) -> dict:
+        """The static options (grid, contact mode, ...) a TCA of ``design`` with
+        ``options`` runs with, the family's defaults filled in."""
+        return self.options(options, self.fam.pair(design))[1]
+
     def run(self, design, mis=None, *, side=None, **options) -> TCAResult:
         """Validated, jitted TCA; ``strict`` (default True) raises
         :class:`~gearjax.errors.ConvergenceError` (``NoContactError``) when a solve
         failed on the working flank or no grid point is on both flanks."""
-        side = check_side(side or "drive")
+        side = check_side("drive" if side is None else side)
         strict = options.get("strict", True)
-        approach, static = self.options(options, run=True)
         pair = self.fam.pair(design)
+        approach, static = self.options(options, pair, run=True)
         mis = Misalignment.zero() if mis is None else mis
         x_ref, phi1_ref = self._reference(pair, side)
         res = _result(self.fam, pair, mis, x_ref, phi1_ref, approach, side, static)
@@ -252,9 +293,9 @@ class DriverAdapter:
     def traced(self, design, *, side=None, **options):
         """A pure ``f(pair, mis=None) -> TCAResult`` (the concrete reference contact of
         ``design`` fixed once here); ``f.pair`` the design's pytree."""
-        side = check_side(side or "drive")
-        approach, static = self.options(options)
+        side = check_side("drive" if side is None else side)
         pair0 = self.fam.pair(design)
+        approach, static = self.options(options, pair0)
         x_ref, phi1_ref = self._reference(pair0, side)
         fam = self.fam
 
@@ -267,24 +308,27 @@ class DriverAdapter:
     def sensitivity(self, design, mis=None, *, side=None, **options):
         """``(values, table)``: the family's summary and its derivatives by dE, dP, dG
         (per mm) and dSigma (per rad), by ``jax.jacfwd`` through every solve."""
-        side = check_side(side or "drive")
-        approach, static = self.options({**options, "kinematics": False})
+        side = check_side("drive" if side is None else side)
         pair = self.fam.pair(design)
+        approach, static = self.options({**options, "kinematics": False}, pair)
         mis = Misalignment.zero() if mis is None else mis
         x_ref, phi1_ref = self._reference(pair, side)
-        vals, jac = _sensitivity_program(strong_float64(pair), strong_float64(mis), x_ref,
-                                         phi1_ref, approach, jnp.asarray(side == "drive"),
-                                         fam=self.fam, **static)
+        vals, jac = _sensitivity_program(*self.fam.split(strong_float64(pair)),
+                                         strong_float64(mis), x_ref, phi1_ref, approach,
+                                         jnp.asarray(side == "drive"), fam=self.fam, **static)
         keys = self.fam.summary_keys
         values = {k: float(v) for k, v in zip(keys, np.asarray(vals))}
         table = {k: {n: float(np.asarray(getattr(jac, n))[i])
                      for n in ("dE", "dP", "dG", "dSigma")} for i, k in enumerate(keys)}
         return values, table
 
-    def mesh(self, design, *, side=None, **_):
-        """``(teeth_of, pair, design)`` of the loaded-contact models."""
+    def mesh(self, design, *, side=None, **options):
+        """``(teeth_of, pair, design)`` of the loaded-contact models (``options`` those of
+        the TCA: the contact mode decides the teeth)."""
         pair = self.fam.pair(design)
-        teeth_of, p = self.fam.teeth(pair, check_side(side or "drive"))
+        lc = self.options({k: v for k, v in options.items() if k != "strict"},
+                          pair)[1]["line_contact"]
+        teeth_of, p = self.fam.teeth(pair, check_side("drive" if side is None else side), line_contact=lc)
         return teeth_of, p, pair
 
     def outline(self, design, side="drive"):
@@ -292,7 +336,10 @@ class DriverAdapter:
 
 
 @functools.partial(jax.jit, static_argnames=_STATIC)
-def _sensitivity_program(pair, mis, x_ref, phi1_ref, approach, drive, *, fam, **static):
+def _sensitivity_program(blank, extra, mis, x_ref, phi1_ref, approach, drive, *, fam,
+                         **static):
+    pair = fam.join(blank, extra)
+
     def f(m):
         parts = tca_parts(fam, pair, m, x_ref, phi1_ref, drive, approach, **static)
         return fam.summary(TCAResult(*parts, "", fam.name))

@@ -447,6 +447,17 @@ def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, pinion_r
                           edge_loaded, degenerate, sm.n_valid, sm.te_loaded_ptp)
 
 
+def _grid_options(ad, design, tca_options: dict) -> dict:
+    """The TCA options of the loaded chain: the family's defaults for ``design`` filled
+    in (grid, contact mode; a family on the one driver resolves them for the design),
+    without ``kinematics`` (the chain always needs them)."""
+    resolve = getattr(ad, "resolve", None)
+    opts = ({**ad.defaults, **tca_options} if resolve is None
+            else {**tca_options, **resolve(design, tca_options)})
+    opts.pop("kinematics", None)
+    return opts
+
+
 def efficiency_function(design, *, side=None, compliance: str = DEFAULT_COMPLIANCE,
                         E_prime=None, viscosity_model: str = "roelands",
                         film_method: str = "auto", **tca_options):
@@ -477,8 +488,7 @@ def efficiency_function(design, *, side=None, compliance: str = DEFAULT_COMPLIAN
     check_models(compliance, viscosity_model, film_method)
     check_design(design)
     ad = family_of(design)
-    opts = {**ad.defaults, **tca_options}
-    opts.pop("kinematics", None)
+    opts = _grid_options(ad, design, tca_options)
     kw = {} if side is None else {"side": side}
     # the concrete set-up once (a hypoid design is prepared -- reference search --
     # by ``mesh``; the TCA then runs on the prepared pair)
@@ -544,8 +554,7 @@ def mesh_efficiency(design, torque_Nm, pinion_rpm, oil: Oil, surface: Surface, *
     T, n = float(torque_Nm), float(pinion_rpm)
     check_design(design)
     ad = family_of(design)
-    opts = {**ad.defaults, **tca_options}
-    opts.pop("kinematics", None)
+    opts = _grid_options(ad, design, tca_options)
     kw = {} if side is None else {"side": side}
     teeth_of, pair, run_design = ad.mesh(design, **kw, **opts)
     res = ad.run(run_design, misalignment, **kw, **opts, kinematics=True, strict=strict)

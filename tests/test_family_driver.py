@@ -69,7 +69,7 @@ class ToySpur(GearFamily):
     def _sig(drive):
         return jnp.where(drive, 1.0, -1.0)
 
-    def flanks(self, pair, drive):
+    def flanks(self, pair, drive, line_contact=False):
         s = self._sig(drive)
 
         def flank(i):

@@ -156,7 +156,7 @@ def test_options_are_checked_by_the_one_driver(des, fn):
         call(des, line_contact=True)
     with pytest.raises(ValueError, match=r"steps_per_pitch"):
         call(des, steps_per_pitch=1)
-    assert gj.family_of(des).options({"half_pitches": None})[1]["half_pitches"] == 1.0
+    assert gj.family_of(des).resolve(des, {"half_pitches": None})["half_pitches"] == 1.0
 
 def test_cli_tca_and_surface(des, runs, tmp_path, capsys):
     assert main(["tca", EX, "--positions", "41", "--pitches", "1", "--json"]) == 0

@@ -91,15 +91,6 @@ def _nan_list(a):
     return [None if not np.isfinite(x) else float(x) for x in a.ravel()]
 
 
-def _involute_side(des, mis, m, side_name, half, kin):
-    """An involute pair (inline or a design file): the family's grid (``n_pairs`` and,
-    when ``half`` is None, the pitches of :func:`default_grid`)."""
-    import gearjax as gj
-    res = gj.run_tca(des, mis, side=side_name, steps_per_pitch=m, half_pitches=half,
-                     kinematics=kin)
-    return res, gj.involute_limits(getattr(des, "design", des), side_name)
-
-
 def _hypoid_side(design, mis, m, side_name, half, kin):
     import gearjax as gj
     prep = gj.prepare_hypoid(gj.pair_flanks(design, side_name))
@@ -109,12 +100,12 @@ def _hypoid_side(design, mis, m, side_name, half, kin):
 
 
 def _family_side(design, mis, m, side_name, half, kin):
-    """Any other registered family's design file: its adapter picks the flanks of the
-    side; the pinion flank outline for the plot comes from the adapter's ``outline``
-    method when it has one."""
+    """Any other registered family's design: its adapter picks the flanks of the side
+    and the tooth pairs (``half`` None: its grid too); the pinion flank outline for the
+    plot comes from the adapter's ``outline`` method when it has one."""
     import gearjax as gj
     res = gj.run_tca(design, mis, side=side_name, steps_per_pitch=m, half_pitches=half,
-                     n_pairs=3, kinematics=kin)
+                     kinematics=kin)
     outline = getattr(gj.family_of(design), "outline", None)
     return res, (outline(design, side_name) if outline is not None else None)
 
@@ -226,8 +217,7 @@ def run(args) -> int:
     # default grid (wider for a path of contact that reaches further)
     half = (None if involute and args.pitches is None
             else 1.25 if args.pitches is None else float(args.pitches))
-    side_of = (_involute_side if involute else
-               _hypoid_side if isinstance(design, HypoidDesign) else _family_side)
+    side_of = _hypoid_side if isinstance(design, HypoidDesign) else _family_side
     solve = lambda side: side_of(design, mis, m, side, half, args.kinematics)  # noqa: E731
     results, failed = {}, {}
     what = "contact solve" + (" + kinematics" if args.kinematics else "")

@@ -148,36 +148,5 @@ def read_involute(data: dict) -> InvoluteFile:
     return InvoluteFile(data, tca)
 
 
-class _FileAdapter:
-    """The involute adapter for :class:`InvoluteFile` (the pytree is ``.design``; the
-    loaded chain passes the pytree itself back, which is taken as is)."""
-
-    family = ADAPTER.family
-    defaults = ADAPTER.defaults
-    split_pair = staticmethod(ADAPTER.split_pair)
-    join_pair = staticmethod(ADAPTER.join_pair)
-
-    @staticmethod
-    def _design(f):
-        return getattr(f, "design", f)
-
-    def run(self, f, *a, **kw):
-        return ADAPTER.run(self._design(f), *a, **kw)
-
-    def traced(self, f, **kw):
-        fn = ADAPTER.traced(self._design(f), **kw)
-        fn.pair = self._design(f)
-        return fn
-
-    def mesh(self, f, **kw):
-        return ADAPTER.mesh(self._design(f), **kw)
-
-    def check(self, f):
-        return ADAPTER.check(self._design(f))
-
-    def sensitivity(self, f, *a, **kw):
-        return ADAPTER.sensitivity(self._design(f), *a, **kw)
-
-
 register_design_kind(KIND, read_involute)
-register_family(InvoluteFile, _FileAdapter())
+register_family(InvoluteFile, ADAPTER)   # the family's pair() takes .design

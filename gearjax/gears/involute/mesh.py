@@ -21,14 +21,13 @@ from __future__ import annotations
 import jax.numpy as jnp
 
 from gearjax.gears.involute.geometry import pair_geometry
-from gearjax.gears.involute.tca import InvoluteTCA
 from gearjax.loaded_contact import MeshTeeth
 from gearjax.tca_result import TCAResult
 
 __all__ = ["involute_mesh_teeth", "check_mesh_supported", "ohlendorf_loss_factor"]
 
 
-def check_mesh_supported(des: InvoluteTCA, line_contact: bool) -> None:
+def check_mesh_supported(des, line_contact: bool) -> None:
     """Refuse a helical pair in line contact (concrete; module docstring)."""
     if line_contact and float(des.pair.helix) != 0.0:
         raise ValueError(f"helix = {float(des.pair.helix) * 180 / jnp.pi:g} deg in line contact: "
@@ -36,7 +35,7 @@ def check_mesh_supported(des: InvoluteTCA, line_contact: bool) -> None:
                          "(give the pinion a lead crown, e.g. lead_crown=1e-4 1/mm)")
 
 
-def involute_mesh_teeth(des: InvoluteTCA, res: TCAResult, line_contact: bool,
+def involute_mesh_teeth(des, res: TCAResult, line_contact: bool,
                         drive: bool) -> MeshTeeth:
     """:class:`~gearjax.loaded_contact.MeshTeeth` of the involute pair along the path of
     ``res`` (traceable; module docstring)."""

@@ -98,7 +98,7 @@ class PresetBevelFamily(GearFamily):
     def reference(self, pair, side):
         return reference_contact(pair, side)
 
-    def flanks(self, pair, drive):
+    def flanks(self, pair, drive, line_contact=False):
         # the side code of the family's flank functions: +1 drive (concave), -1 coast
         return side_flanks(pair, jnp.where(drive, 1.0, -1.0))
 
@@ -118,7 +118,7 @@ class PresetBevelFamily(GearFamily):
     def summary(self, res):
         return preset_summary(res)
 
-    def teeth(self, pair, side):
+    def teeth(self, pair, side, line_contact=False):
         """ISO 10300 virtual cylindrical teeth (:mod:`gearjax.gears.preset_bevel.mesh`)."""
         from gearjax.gears.preset_bevel.mesh import preset_mesh_teeth
         return TeethOf(preset_mesh_teeth, (("drive", drives_forward(side)),)), pair

@@ -196,11 +196,11 @@ class VHCattFamily(GearFamily):
         """``(pair, pinion)``: the pair, and the pinion cut as another pair's (None)."""
         return pair, None
 
-    def reference_traced(self, pair, drive):
+    def reference_traced(self, pair, drive, line_contact=False):
         p, q = self._members(pair)
-        return reference_guess(p, self._code(drive), q)
+        return (*reference_guess(p, self._code(drive), q), None)
 
-    def flanks(self, pair, drive):
+    def flanks(self, pair, drive, line_contact=False):
         p, q = self._members(pair)
         return vh_flanks(p, self._code(drive), q)
 
@@ -225,7 +225,7 @@ class VHCattFamily(GearFamily):
     def summary(self, res):
         return tca_summary(res.path, res.multi)
 
-    def teeth(self, pair, side):
+    def teeth(self, pair, side, line_contact=False):
         """The loaded-contact teeth (:mod:`gearjax.gears.vh_catt.mesh`)."""
         from gearjax.gears.vh_catt.mesh import vh_mesh_teeth
         return TeethOf(vh_mesh_teeth, (("drive", side == "drive"),)), pair
