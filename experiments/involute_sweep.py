@@ -136,7 +136,7 @@ def check_pair(d, sides=("drive", "coast")):
     with ``status`` ("refused: ..." / "accepted"), ``expected`` (the closed forms'
     status) and per side the measured values and the list of failed checks."""
     import gearjax as gj
-    from gearjax.gears.involute.tca import flank_limits, signed_roll
+    from gearjax.gears.involute.limits import flank_limits, signed_roll
 
     ref = iso21771(d["z1"], d["z2"], d["m"], d["alpha"], d["helix"], d["x1"], d["x2"], d["b"])
     row = {"design": d, "expected": ref["status"]}
@@ -235,7 +235,7 @@ def _crowned_run(d, pair, a, side, lim1, slope_icpt=None):
     """TCA of the pinion crowned by ``a``: (result, conjugate roll distance of each grid
     point, on-flank mask)."""
     import gearjax as gj
-    from gearjax.gears.involute.tca import signed_roll
+    from gearjax.gears.involute.limits import signed_roll
     res = gj.run_tca(gj.InvoluteTCA.create(pair, d["b"], profile_crown=a), side=side,
                      strict=False)
     slope, icpt = slope_icpt
@@ -261,7 +261,7 @@ def _crown_check(d, ref, pair, lim1, res, side, fails):
     pairs' flanks; the TCA at the full crown must show no tip or edge contact there.
     """
     import gearjax as gj
-    from gearjax.gears.involute.tca import signed_roll
+    from gearjax.gears.involute.limits import signed_roll
     a = d["crown"]
     an, at = math.radians(d["alpha"]), ref["alpha_t"]
     sgn = 1.0 if side == "coast" else -1.0        # drive: the gear lags; coast: it leads

@@ -400,14 +400,14 @@ def test_cache_switched_off(tmp_path, monkeypatch):
 
 def _fail_side(monkeypatch, bad_side, exc):
     import gearjax.commands.tca as cmd
-    real = cmd._involute_side
+    real = cmd._family_side
 
-    def side(args, mis, m, side_name, half, kin):
+    def side(design, mis, m, side_name, *grid):
         if side_name == bad_side:
             raise exc
-        return real(args, mis, m, side_name, half, kin)
+        return real(design, mis, m, side_name, *grid)
 
-    monkeypatch.setattr(cmd, "_involute_side", side)
+    monkeypatch.setattr(cmd, "_family_side", side)
 
 
 def test_failed_side_alone_gives_one_actionable_line(capsys, monkeypatch):

@@ -114,7 +114,7 @@ def test_signed_roll_derivative_is_finite_at_and_inside_the_base_circle():
     x1 into NaN), and outside the derivative is the closed form ``R/rho dR``."""
     import jax
     import jax.numpy as jnp
-    from gearjax.gears.involute.tca import flank_limits, signed_roll
+    from gearjax.gears.involute.limits import flank_limits, signed_roll
     des = gj.InvoluteTCA.create(gj.InvolutePair.create(25, 41, 2.0, 20.0), 20.0)
     lim, _, _ = flank_limits(des)
     rb = float(lim.rb)
