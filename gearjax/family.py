@@ -27,8 +27,8 @@ envelope is the maximum over the tooth pairs (the ``drive`` argument of
 line_contact_modes`) and refused in one line elsewhere; an unknown option is refused
 in one line naming it; an option given as None takes the family's default.
 
-Families still on their own adapters (involute, hypoid, VH-CATT) register those; the
-ported ones register a :class:`DriverAdapter` (issue [D], docs/architecture.md).
+Every family registers a :class:`DriverAdapter` of its :class:`GearFamily`
+(docs/architecture.md, "Where a new gear family goes").
 """
 
 from __future__ import annotations
@@ -56,7 +56,9 @@ class GearFamily:
     """What a gear family provides to the driver (subclass and override; stateless,
     hashable: the family object is a static argument of the compiled programs).
 
-    ``pair`` below is the family's differentiable pytree (e.g. a dataclass of floats).
+    ``pair`` below is the pytree a compiled program runs on (e.g. a dataclass of
+    floats); ``setup`` the concrete set-up of a design for one side (:meth:`setup`: the
+    pair itself in most families).
     """
 
     #: family name (``TCAResult.family``)
@@ -72,6 +74,24 @@ class GearFamily:
     def pair(self, design):
         """The differentiable pytree of ``design`` (a design-file object or the pytree)."""
         return design
+
+    def setup(self, design, side):
+        """``(setup, side)``: the concrete set-up of ``design`` for ``side`` ("drive",
+        "coast" or None: the family's choice, "drive" by default) -- the pair itself
+        by default; a family that prepares a pair (a reference search, the flanks of
+        the side) returns what it found, and the side its flanks decide.  Taking its
+        own result back unchanged (``setup(setup, side)``)."""
+        return self.pair(design), side or "drive"
+
+    def user_pair(self, setup):
+        """The differentiable pair of a set-up: what ``tca_function``'s ``f`` takes and
+        the loaded chain differentiates (default: the set-up itself)."""
+        return setup
+
+    def program_pair(self, pair, setup):
+        """The pytree the program runs on, from a user's differentiable ``pair`` and the
+        concrete ``setup`` (default: ``pair``)."""
+        return pair
 
     def default_options(self, pair) -> dict:
         """The default options of the concrete ``pair`` (:attr:`defaults`; a family
@@ -98,9 +118,9 @@ class GearFamily:
     #: derivative flows)
     reference_moves_with_design: bool = False
 
-    def reference(self, pair, side: str):
+    def reference(self, setup, side: str):
         """``(x_ref, phi1_ref)``: start of the contact solve at the middle grid point
-        (concrete; no derivative flows into it)."""
+        (concrete, from the set-up; no derivative flows into it)."""
         raise NotImplementedError
 
     def reference_traced(self, pair, drive, line_contact=False):
@@ -116,7 +136,13 @@ class GearFamily:
         the solved contact line's section is ``uv[1] = 0`` (:mod:`gearjax.tca`)."""
         raise NotImplementedError
 
-    def forward(self, drive):
+    def refine_reference(self, pair, mis, r1, r2, x_ref, phi1_ref, line_contact):
+        """``(x_ref, phi1_ref)`` refined inside the program before the grid is laid
+        (traceable; e.g. the contact of the pinion's mean point under the
+        misalignment ``mis``); default: unchanged."""
+        return x_ref, phi1_ref
+
+    def forward(self, pair, drive):
         """True where the side's pinion flank pushes the gear for increasing phi1."""
         return drive
 
@@ -132,6 +158,13 @@ class GearFamily:
         flanks) and the family's flank coordinates of the contact (dict of arrays)."""
         raise NotImplementedError
 
+    def path_position(self, pair, path, coords):
+        """(N,) the position of the contact along its path in the family's own
+        coordinate (``coords["path_position"]``, the objective of the same name of
+        :meth:`~gearjax.tca_result.TCAResult.objectives`): by default the radius on the
+        pinion (mm)."""
+        return path.radial1
+
     def line_coords(self, pair, path, r1) -> dict:
         """Coordinates a line contact adds to :meth:`boundaries`' (e.g. the overlap
         ratio), from the path and the pinion flank ``r1``; default none."""
@@ -145,15 +178,18 @@ class GearFamily:
     # -- summaries, loaded contact, plots -------------------------------------------
     summary_keys: tuple = ()
 
-    def summary(self, res: TCAResult):
+    def summary(self, pair, res: TCAResult):
         raise NotImplementedError
 
-    def teeth(self, pair, side: str, line_contact: bool = False):
-        """``(teeth_of, pair)`` of the loaded-contact models (ValueError where the
-        family's loaded contact does not cover the pair)."""
+    def teeth(self, setup, side: str, line_contact: bool = False):
+        """``(teeth_of, pair)`` of the loaded-contact models for the set-up of ``side``:
+        ``teeth_of(pair, res)`` and the differentiable pair it takes (ValueError where
+        the family's loaded contact does not cover the pair)."""
         raise NotImplementedError
 
     def outline(self, pair, side: str = "drive") -> dict:
+        """The pinion flank's outline for the TCA figure (concrete; ``pair`` of
+        :meth:`pair`)."""
         raise NotImplementedError
 
 
@@ -167,14 +203,16 @@ def tca_parts(fam: GearFamily, pair, mis, x_ref, phi1_ref, drive, approach, *,
     and the family's edges, the contact made at each angle is the surface or an edge
     contact; pair 0 shifted by whole pitches gives the neighbouring pairs and the TE
     envelope (max where :meth:`GearFamily.forward`, else min).  ``x_ref = None``: the
-    family's :meth:`GearFamily.reference_traced` inside the program."""
+    family's :meth:`GearFamily.reference_traced` inside the program; the reference is
+    then refined by :meth:`GearFamily.refine_reference` before the grid is laid."""
     ok = None
     if x_ref is None:
         x_ref, phi1_ref, ok = fam.reference_traced(pair, drive, line_contact)
-    grid = pinion_angle_grid(phi1_ref, fam.pinion_teeth(pair), steps_per_pitch, half_pitches)
     r1, r2 = fam.flanks(pair, drive, line_contact)
+    x_ref, phi1_ref = fam.refine_reference(pair, mis, r1, r2, x_ref, phi1_ref, line_contact)
+    grid = pinion_angle_grid(phi1_ref, fam.pinion_teeth(pair), steps_per_pitch, half_pitches)
     asm = fam.assembly(pair)
-    fwd = fam.forward(drive)
+    fwd = fam.forward(pair, drive)
     path = contact_path(r1, r2, asm, mis, grid, x_ref, line_contact=line_contact,
                         approach=approach)
     if ok is not None:
@@ -189,6 +227,7 @@ def tca_parts(fam: GearFamily, pair, mis, x_ref, phi1_ref, drive, approach, *,
         _, coords = fam.boundaries(pair, path)        # the coordinates of the contact made
     if line_contact:
         coords = {**coords, **fam.line_coords(pair, path, r1)}
+    coords = {**coords, "path_position": fam.path_position(pair, path, coords)}
     multi = multi_pair(path, margin, steps_per_pitch, fam.pinion_teeth(pair), drive=fwd,
                        n_pairs=n_pairs)
     kin = (contact_kinematics(r1, r2, asm, mis, path, line_contact=line_contact)
@@ -275,44 +314,49 @@ class DriverAdapter:
         ``options`` runs with, the family's defaults filled in."""
         return self.options(options, self.fam.pair(design))[1]
 
+    def _setup(self, design, side):
+        """``(setup, side)`` of :meth:`GearFamily.setup` (``side`` checked first)."""
+        return self.fam.setup(design, None if side is None else check_side(side))
+
     def run(self, design, mis=None, *, side=None, **options) -> TCAResult:
         """Validated, jitted TCA; ``strict`` (default True) raises
         :class:`~gearjax.errors.ConvergenceError` (``NoContactError``) when a solve
         failed on the working flank or no grid point is on both flanks."""
-        side = check_side("drive" if side is None else side)
         strict = options.get("strict", True)
-        pair = self.fam.pair(design)
-        approach, static = self.options(options, pair, run=True)
+        setup, side = self._setup(design, side)
+        approach, static = self.options(options, setup, run=True)
         mis = Misalignment.zero() if mis is None else mis
-        x_ref, phi1_ref = self._reference(pair, side)
+        x_ref, phi1_ref = self._reference(setup, side)
+        pair = self.fam.program_pair(self.fam.user_pair(setup), setup)
         res = _result(self.fam, pair, mis, x_ref, phi1_ref, approach, side, static)
         if strict:
             check_on_flank_converged(res.path, res.margin)
         return res
 
     def traced(self, design, *, side=None, **options):
-        """A pure ``f(pair, mis=None) -> TCAResult`` (the concrete reference contact of
-        ``design`` fixed once here); ``f.pair`` the design's pytree."""
-        side = check_side("drive" if side is None else side)
-        pair0 = self.fam.pair(design)
-        approach, static = self.options(options, pair0)
-        x_ref, phi1_ref = self._reference(pair0, side)
+        """A pure ``f(pair, mis=None) -> TCAResult`` (the concrete set-up and reference
+        contact of ``design`` fixed once here); ``f.pair`` the design's differentiable
+        pair."""
+        setup, side = self._setup(design, side)
+        approach, static = self.options(options, setup)
+        x_ref, phi1_ref = self._reference(setup, side)
         fam = self.fam
 
         def f(pair, mis=None):
             mis = Misalignment.zero() if mis is None else mis
-            return _result(fam, pair, mis, x_ref, phi1_ref, approach, side, static)
-        f.pair = pair0
+            return _result(fam, fam.program_pair(pair, setup), mis, x_ref, phi1_ref,
+                           approach, side, static)
+        f.pair = fam.user_pair(setup)
         return f
 
     def sensitivity(self, design, mis=None, *, side=None, **options):
         """``(values, table)``: the family's summary and its derivatives by dE, dP, dG
         (per mm) and dSigma (per rad), by ``jax.jacfwd`` through every solve."""
-        side = check_side("drive" if side is None else side)
-        pair = self.fam.pair(design)
-        approach, static = self.options({**options, "kinematics": False}, pair)
+        setup, side = self._setup(design, side)
+        approach, static = self.options({**options, "kinematics": False}, setup)
         mis = Misalignment.zero() if mis is None else mis
-        x_ref, phi1_ref = self._reference(pair, side)
+        x_ref, phi1_ref = self._reference(setup, side)
+        pair = self.fam.program_pair(self.fam.user_pair(setup), setup)
         vals, jac = _sensitivity_program(*self.fam.split(strong_float64(pair)),
                                          strong_float64(mis), x_ref, phi1_ref, approach,
                                          jnp.asarray(side == "drive"), fam=self.fam, **static)
@@ -323,13 +367,14 @@ class DriverAdapter:
         return values, table
 
     def mesh(self, design, *, side=None, **options):
-        """``(teeth_of, pair, design)`` of the loaded-contact models (``options`` those of
-        the TCA: the contact mode decides the teeth)."""
-        pair = self.fam.pair(design)
+        """``(teeth_of, pair, setup)`` of the loaded-contact models: the teeth, the
+        differentiable pair and the set-up to run the TCA of (``options`` those of the
+        TCA: the contact mode decides the teeth)."""
+        setup, side = self._setup(design, side)
         lc = self.options({k: v for k, v in options.items() if k != "strict"},
-                          pair)[1]["line_contact"]
-        teeth_of, p = self.fam.teeth(pair, check_side("drive" if side is None else side), line_contact=lc)
-        return teeth_of, p, pair
+                          setup)[1]["line_contact"]
+        teeth_of, p = self.fam.teeth(setup, side, line_contact=lc)
+        return teeth_of, p, setup
 
     def outline(self, design, side="drive"):
         return self.fam.outline(self.fam.pair(design), side)
@@ -342,5 +387,5 @@ def _sensitivity_program(blank, extra, mis, x_ref, phi1_ref, approach, drive, *,
 
     def f(m):
         parts = tca_parts(fam, pair, m, x_ref, phi1_ref, drive, approach, **static)
-        return fam.summary(TCAResult(*parts, "", fam.name))
+        return fam.summary(pair, TCAResult(*parts, "", fam.name))
     return f(mis), jax.jacfwd(f)(mis)

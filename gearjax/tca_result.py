@@ -11,11 +11,14 @@ the kinematics at its contact points.
 * ``multi`` -- :class:`~gearjax.tca.MultiPair`: TE of the neighbouring pairs, the
   unloaded TE envelope, its peak-to-peak, the transfer points, the contact ratio;
 * ``coords`` -- family-specific coordinates of the contact on the flanks (hypoid:
-  ``xi1, h1, xi2, h2``; involute: roll distance and axial position), a dict;
+  ``xi1, h1, xi2, h2``; involute: the six boundary margins, and the overlap ratio in
+  line contact; ...), a dict, and in every family ``path_position`` (the contact's
+  position along its path in the family's own coordinate, :mod:`gearjax.family`);
 * ``kinematics`` -- :class:`ContactKinematics` at every point of the path, or
   ``None`` when not requested;
 * ``side`` (static) -- ``"drive"`` or ``"coast"``, the one side convention of
-  every family; ``family`` (static) -- ``"involute"`` or ``"hypoid"``.
+  every family; ``family`` (static) -- the family's name (``"involute"``,
+  ``"hypoid"``, ``"vh_catt"``, ``"preset_bevel"``).
 
 :meth:`TCAResult.flags` gives the contact-quality flags on concrete results
 (converged, reference on the flank, edge contact -- at a flank boundary or a
@@ -301,15 +304,16 @@ class TCAResult:
         points selected by the boolean mask ``on`` (fixed, e.g. the nominal design's
         :attr:`on_flank`, so that every objective is smooth in the design): TE
         peak-to-peak (arcsec), mean and max |SRR|, min R_x (mm), and the contact
-        position at the reference (hypoid: face-width position ``xi1``; otherwise the
-        radius on the pinion, mm).  Order: :attr:`OBJECTIVES`.  A mask point that
+        position at the reference (``coords["path_position"]``, the family's own
+        coordinate: the face-width position ``xi1`` of a bevel/hypoid pinion, the radius
+        on the pinion in mm otherwise).  Order: :attr:`OBJECTIVES`.  A mask point that
         leaves the flank still enters (extrapolated): check :meth:`mask_check` --
         an optimisation is an improvement only with ``n_off == 0`` at its end."""
         on = np.asarray(on)
         mid = on.shape[0] // 2
         k = self.kinematics
         srr = jnp.abs(jnp.where(on, k.srr, 0.0))
-        pos = self.coords["xi1"][mid] if self.family == "hypoid" else self.path.radial1[mid]
+        pos = self.coords["path_position"][mid]
         return jnp.stack([self.multi.ptp / ARCSEC, jnp.sum(srr) / on.sum(), jnp.max(srr),
                           jnp.min(jnp.where(on, k.r_x, jnp.inf)), pos])
 

@@ -106,7 +106,7 @@ class ToySpur(GearFamily):
         parts.append(0.5 * pair.b - jnp.abs(path.axial1))
         return jnp.min(jnp.stack(parts), axis=0), {}
 
-    def summary(self, res):
+    def summary(self, pair, res):
         mid = res.path.phi1.shape[0] // 2
         return jnp.stack([res.multi.ptp, res.path.phi2[mid]])
 

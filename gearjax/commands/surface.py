@@ -44,7 +44,7 @@ def register(sub):
 
 
 def run(args) -> int:
-    from gearjax import HypoidDesign, flank_surface, load_design
+    from gearjax import load_design
     from gearjax.io import check_output_path, write_flank, write_stl_tooth
     from gearjax.progress import Progress
     n_xi, n_s = _grid(args.grid)
@@ -56,8 +56,8 @@ def run(args) -> int:
         if plot.resolve() == out.resolve():
             raise ValueError(f"--plot = {args.plot!r} is the same file as --out")
     design = load_design(args.design)
-    hypoid = isinstance(design, HypoidDesign)
-    if args.plot is not None and not hypoid:
+    # the axial-plane figure needs the member's blank (cone distances, cone angles)
+    if args.plot is not None and not hasattr(design, "member_blank"):
         raise ValueError(f"--plot: the axial-plane figure is drawn for hypoid and spiral-bevel "
                          f"designs only, not for [design] kind = {design.data['design']['kind']!r}")
     from gearjax.io import check_grid_converged
@@ -66,14 +66,12 @@ def run(args) -> int:
     with Progress(len(flanks), f"surface {args.member}") as bar:
         for f in flanks:
             with bar.phase(f"{f}: {n_xi}x{n_s} points"):
-                grids[f] = (flank_surface(design.flank(args.member, f), n_xi, n_s) if hypoid
-                            else design.surface_grid(args.member, f, n_xi, n_s))
+                grids[f] = design.surface_grid(args.member, f, n_xi, n_s)
             bar.update()
     for f, g in grids.items():      # before any file is written (plot included)
         check_grid_converged(g, f"{design.name} {args.member} {f} flank")
     if args.tooth:
-        teeth = (design.member_blank(args.member).teeth if hypoid
-                 else int(design.teeth(args.member)))
+        teeth = int(design.teeth(args.member))
         write_stl_tooth(out, grids["convex"], grids["concave"], teeth,
                         name=f"{design.name}_{args.member}_tooth")
     else:

@@ -91,21 +91,13 @@ def _nan_list(a):
     return [None if not np.isfinite(x) else float(x) for x in a.ravel()]
 
 
-def _hypoid_side(design, mis, m, side_name, half, kin):
-    import gearjax as gj
-    prep = gj.prepare_hypoid(gj.pair_flanks(design, side_name))
-    res = gj.run_tca(prep, mis, steps_per_pitch=m, half_pitches=half, n_pairs=3,
-                     kinematics=kin)
-    return res, gj.pinion_outline(prep.pair)
-
-
-def _family_side(design, mis, m, side_name, half, kin):
-    """Any other registered family's design: its adapter picks the flanks of the side
-    and the tooth pairs (``half`` None: its grid too); the pinion flank outline for the
-    plot comes from the adapter's ``outline`` method when it has one."""
+def _family_side(design, mis, m, side_name, half, pairs, kin):
+    """The TCA of one side of any registered family's design: its adapter picks the
+    flanks of the side (``half``, ``pairs`` None: the family's grid); the pinion flank
+    outline for the plot comes from the adapter's ``outline`` method when it has one."""
     import gearjax as gj
     res = gj.run_tca(design, mis, side=side_name, steps_per_pitch=m, half_pitches=half,
-                     kinematics=kin)
+                     n_pairs=pairs, kinematics=kin)
     outline = getattr(gj.family_of(design), "outline", None)
     return res, (outline(design, side_name) if outline is not None else None)
 
@@ -126,7 +118,7 @@ def _side_json(res):
     touched = lambda a: _nan_list(np.where(touch, np.asarray(a, float), np.nan))  # noqa: E731
     pth = {k: touched(getattr(path, k[:-3])) for k in
            ("axial1_mm", "radial1_mm", "axial2_mm", "radial2_mm")}
-    if res.family == "hypoid":
+    if "xi1" in res.coords:                   # face-width positions (bevel/hypoid)
         pth.update({k: touched(res.coords[c]) for k, c in
                     (("xi1", "xi1"), ("h1_mm", "h1"), ("xi2", "xi2"), ("h2_mm", "h2"))})
     out = {
@@ -207,18 +199,18 @@ def run(args) -> int:
     if args.plot:
         check_output_path(args.plot, "--plot", (".png",))
     sides = ["drive", "coast"] if args.side == "both" else [args.side]
-    from gearjax import HypoidDesign, InvoluteFile, load_design
+    from gearjax import InvoluteFile, load_design
     # validated before any tracing
     design = (involute_design(args.design)[1] if args.design.startswith("involute:")
               else load_design(args.design))
-    involute = not isinstance(design, (HypoidDesign,)) and (
-        args.design.startswith("involute:") or isinstance(design, InvoluteFile))
-    # default: 1.25 pitches; an involute pair without --pitches gets the family's
-    # default grid (wider for a path of contact that reaches further)
+    involute = args.design.startswith("involute:") or isinstance(design, InvoluteFile)
+    # default: 1.25 pitches and 3 tooth pairs; an involute pair gets the family's
+    # default grid and pairs (wider for a path of contact that reaches further)
     half = (None if involute and args.pitches is None
             else 1.25 if args.pitches is None else float(args.pitches))
-    side_of = _hypoid_side if isinstance(design, HypoidDesign) else _family_side
-    solve = lambda side: side_of(design, mis, m, side, half, args.kinematics)  # noqa: E731
+    pairs = None if involute else 3
+    solve = lambda side: _family_side(design, mis, m, side, half, pairs,  # noqa: E731
+                                      args.kinematics)
     results, failed = {}, {}
     what = "contact solve" + (" + kinematics" if args.kinematics else "")
     with Progress(len(sides), "tca") as bar:    # stderr, terminals only

@@ -258,6 +258,18 @@ class HypoidDesign:
         return FlankSpec(self.cutter(member, flank), self.machine(member, flank),
                          self.member_blank(member))
 
+    def surface_grid(self, member: str, flank: str, n_u: int, n_v: int):
+        """Grid of ``flank`` of tooth 0 of ``member`` (a :class:`gearjax.io.FlankGrid`,
+        :func:`~gearjax.gears.hypoid.flank.flank_surface`: ``n_u`` face-width positions
+        by ``n_v`` points along the blade) -- the ``gearjax surface`` method of every
+        design file."""
+        from gearjax.gears.hypoid.flank import flank_surface
+        return flank_surface(self.flank(member, flank), n_u, n_v)
+
+    def teeth(self, member: str) -> int:
+        """Number of teeth of ``member``."""
+        return int(self.member_blank(member).teeth)
+
     def blank_input(self):
         """The ``[blank]`` table as :class:`BlankInput` (blank-design module)."""
         from gearjax.gears.hypoid.blank import BlankInput

@@ -1,4 +1,5 @@
-"""Tooth contact analysis of face-milled hypoid and spiral-bevel pairs (family adapter).
+"""Tooth contact analysis of face-milled hypoid and spiral-bevel pairs: the family for the
+one driver (:mod:`gearjax.family`).
 
 Builds, for a pinion flank and a gear flank of :mod:`gearjax.gears.hypoid.flank`
 (:class:`~gearjax.gears.hypoid.flank.FlankSpec`: cutter blade, machine settings, blank),
@@ -19,59 +20,34 @@ Units: mm, rad inside; arc-seconds at the output boundary.
 
 from __future__ import annotations
 
-import functools
 import math
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import NamedTuple
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 
+from gearjax.family import DriverAdapter, GearFamily, tca_parts
 from gearjax.gears.hypoid.design_file import HypoidDesign
 from gearjax.gears.hypoid.flank import face_apex_offset, root_apex_offset
 from gearjax.gears.hypoid.pair import (SIDES, HypoidPair, complementary_pinion, flank_coordinates,
-                                       program_pair,
                                        flank_function, hypoid_assembly, hypoid_face_ends,
-                                       hypoid_margin,
-                                       mean_dedendum, mean_point, pair_flanks, with_point_radius)
-from gearjax.edge_contact import face_end_contact
+                                       hypoid_margin, mean_dedendum, mean_point, pair_flanks,
+                                       program_pair, with_point_radius)
+from gearjax.loaded_contact import TeethOf
 from gearjax.newton import newton_solve
 from gearjax.surfaces import GeneratedSurface
-from gearjax.loaded_contact import TeethOf
-from gearjax.tca_result import (TCAResult, check_side, contact_kinematics, register_family,
-                                strong_float64)
 from gearjax.tca import (DEFAULT_APPROACH, ContactPath, Misalignment, MultiPair,
-                         NoContactError, check_on_flank_converged, check_tca_options,
-                         contact_path, contact_system, multi_pair, pinion_angle_grid)
+                         NoContactError, contact_system)
+from gearjax.tca_result import register_family
 
 __all__ = ["mean_dedendum", "HypoidPair", "pair_flanks", "complementary_pinion",
            "hypoid_assembly", "flank_function", "reference_guess", "hypoid_margin",
            "flank_coordinates", "hypoid_tca_traced", "hypoid_tca", "SIDES", "HypoidTCA",
            "Prepared", "prepare", "with_point_radius", "pinion_outline",
            "misalignment_sensitivity", "reference_contact", "tca_summary", "SUMMARY_KEYS",
-           "hypoid_result_traced"]
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
+           "HypoidFamily", "SensedPair", "FAMILY", "ADAPTER"]
 
 
 def reference_guess(pair: HypoidPair, n_search: int = 181):
@@ -114,12 +90,6 @@ def _search(pair: HypoidPair, n_search: int):
 def _rotz_np(a, v):
     c, s = np.cos(a), np.sin(a)
     return np.stack([c * v[0] - s * v[1], s * v[0] + c * v[1], np.broadcast_to(v[2], np.shape(a))])
-
-
-
-
-
-
 
 
 def _mean_point_contact(r1, r2, pair: HypoidPair, mis: Misalignment, x_guess, phi1_guess):
@@ -227,94 +197,6 @@ def prepare(pair: HypoidPair, n_search: int = 181) -> Prepared:
     return Prepared(pair, x_ref, phi1_ref, drive, (gap, ang))
 
 
-def hypoid_tca_traced(pair: HypoidPair, mis: Misalignment, x_ref, phi1_ref, *,
-                      steps_per_pitch: int = 16, half_pitches: float = 2.0,
-                      line_contact: bool = False, n_pairs: int = 5, drive: bool = True,
-                      approach=DEFAULT_APPROACH, face_ends: bool = True,
-                      tip_edges: bool = True) -> HypoidTCA:
-    """Traceable TCA of a hypoid/spiral-bevel flank pair (see :func:`hypoid_tca`).
-
-    Point contact: the reference contact is refined near the pinion's mean point
-    (:func:`reference_contact`) and the grid is centred on its pinion angle.  Line
-    contact (conjugate pairs): the grid is centred on ``phi1_ref`` and the pinion
-    blade position ``s`` stays at ``x_ref[1]``.  With ``face_ends`` (default) the
-    contact at the toe and heel of both members is solved too, with ``tip_edges``
-    (default) also the contact of each member's tip edge (on its face cone) with the
-    mating flank, and the contact made at each pinion angle is the surface or the edge
-    contact
-    (:func:`gearjax.edge_contact.face_end_contact`; ``path.edge_kind``).
-    """
-    r1 = flank_function(pair.pinion, pair.pinion_crossing)
-    r2 = flank_function(pair.gear, pair.gear_crossing)
-    if not line_contact:
-        # step 1 of reference_contact: where the pinion's mean point meets the gear
-        # flank.  Its step 2 (the 5x5 point contact at that pinion angle, from step
-        # 1's solution) is exactly the path's first solve (the middle grid point is
-        # that angle): solving it here too would put a third contact Newton into the
-        # program.  Where step 1 fails the reference stays at the guess; the path's
-        # own solves carry the convergence flags.
-        x_guess = jax.lax.stop_gradient(jnp.asarray(x_ref, float))
-        s1, _, x1 = _mean_point_contact(r1, r2, pair, mis, x_guess, phi1_ref)
-        x_ref = jnp.where(s1.converged, jax.lax.stop_gradient(x1), x_guess)
-        phi1_ref = jnp.where(s1.converged, s1.x[0],
-                             jax.lax.stop_gradient(jnp.asarray(phi1_ref, float)))
-    grid = pinion_angle_grid(phi1_ref, pair.z1, steps_per_pitch, half_pitches)
-    asm = hypoid_assembly(pair)
-    path = contact_path(r1, r2, asm, mis, grid, x_ref,
-                        line_contact=line_contact, approach=approach)
-    margin, coords = hypoid_margin(pair, path)
-    if face_ends:
-        parts, g1, g2, tips = hypoid_face_ends(pair)
-        path, margin, _ = face_end_contact(r1, r2, asm, mis, path, margin, parts, g1, g2,
-                                           drive=drive, line_contact=line_contact,
-                                           steps_per_pitch=steps_per_pitch,
-                                           tips=tips if tip_edges else None)
-        _, coords = hypoid_margin(pair, path)
-    multi = multi_pair(path, margin, steps_per_pitch, pair.z1, drive=drive, n_pairs=n_pairs)
-    return HypoidTCA(path, margin, multi, coords)
-
-
-# ``drive`` (the sense of rotation) is a traced argument of the programs, ``side`` a label
-# put on the result outside them: the drive and coast flanks share one program
-_STATIC = ("steps_per_pitch", "half_pitches", "line_contact", "n_pairs")
-
-
-@functools.partial(jax.jit, static_argnames=_STATIC)
-def _tca_jit(pair, mis, x_ref, phi1_ref, approach, drive, *, steps_per_pitch, half_pitches,
-             line_contact, n_pairs):
-    return hypoid_tca_traced(pair, mis, x_ref, phi1_ref, steps_per_pitch=steps_per_pitch,
-                             half_pitches=half_pitches, line_contact=line_contact,
-                             n_pairs=n_pairs, drive=drive, approach=approach)
-
-
-def hypoid_tca(pair: HypoidPair | Prepared, mis: Misalignment | None = None, *,
-               steps_per_pitch: int = 16, half_pitches: float = 2.0,
-               line_contact: bool = False, n_pairs: int = 5,
-               approach: float = DEFAULT_APPROACH, strict: bool = True) -> HypoidTCA:
-    """Jitted TCA of a hypoid/spiral-bevel flank pair with validation.
-
-    ``pair`` : a :class:`HypoidPair` (prepared here) or a :class:`Prepared`.
-    The grid of pinion angles is uniform with ``steps_per_pitch`` steps per angular
-    pitch ``2 pi/z1``, ``half_pitches`` pitches each side of the reference.
-    ``line_contact=True`` for conjugate pairs (the 5x5 point-contact system is
-    singular there).  ``strict`` raises :class:`~gearjax.errors.ConvergenceError`
-    when a contact solve failed between the first and last on-flank grid points
-    (or at the reference) and :class:`~gearjax.tca.NoContactError` when no grid
-    point is on both flanks; ``strict=False`` returns the masks.
-    """
-    check_tca_options(steps_per_pitch, half_pitches, n_pairs, approach)
-    prep = pair if isinstance(pair, Prepared) else prepare(pair)
-    if mis is None:
-        mis = Misalignment.zero()
-    out = _tca_jit(program_pair(prep.pair), strong_float64(mis), jnp.asarray(prep.x_ref),
-                   jnp.asarray(prep.phi1_ref), float(approach), jnp.asarray(bool(prep.drive)),
-                   steps_per_pitch=int(steps_per_pitch), half_pitches=float(half_pitches),
-                   line_contact=bool(line_contact), n_pairs=int(n_pairs))
-    if strict:
-        check_on_flank_converged(out.path, out.margin)
-    return out
-
-
 SUMMARY_KEYS = ("ptp_rad", "phi2_ref_rad", "xi1", "h1_mm", "xi2", "h2_mm", "semi_major_mm",
                 "path_angle_rad")
 
@@ -338,44 +220,6 @@ def tca_summary(pair: HypoidPair, res: HypoidTCA):
     ang = jnp.arctan2(dh, dxi * 0.5 * pair.pinion.blank.face_width)
     return jnp.stack([res.multi.ptp, p.phi2[mid], c["xi1"][mid], c["h1"][mid], c["xi2"][mid],
                       c["h2"][mid], p.semi_major[mid], ang])
-
-
-@functools.partial(jax.jit, static_argnames=_STATIC)
-def _sensitivity_jit(pair, mis, x_ref, phi1_ref, approach, drive, *, steps_per_pitch,
-                     half_pitches, line_contact, n_pairs):
-    def f(m):
-        res = hypoid_tca_traced(pair, m, x_ref, phi1_ref, steps_per_pitch=steps_per_pitch,
-                                half_pitches=half_pitches, line_contact=line_contact,
-                                n_pairs=n_pairs, drive=drive, approach=approach)
-        return tca_summary(pair, res)
-    return f(mis), jax.jacfwd(f)(mis)
-
-
-def misalignment_sensitivity(prep: Prepared, mis: Misalignment | None = None, *,
-                             steps_per_pitch: int = 16, half_pitches: float = 2.0,
-                             n_pairs: int = 5, approach: float = DEFAULT_APPROACH):
-    """The V-H check by ``jax.jacfwd``: derivatives of the :func:`tca_summary` values
-    (TE peak-to-peak, gear angle at the reference = TE shift, bearing position on
-    both flanks, ellipse length, path angle) with respect to dE, dP, dG (per mm) and
-    dSigma (per rad), exact through every contact solve (point contact).
-
-    Returns ``(values, table)``: dicts keyed by :data:`SUMMARY_KEYS`; ``table[key]``
-    is ``{"dE": .., "dP": .., "dG": .., "dSigma": ..}``.
-    """
-    check_tca_options(steps_per_pitch, half_pitches, n_pairs, approach)
-    if mis is None:
-        mis = Misalignment.zero()
-    vals, jac = _sensitivity_jit(program_pair(prep.pair), strong_float64(mis),
-                                 jnp.asarray(prep.x_ref),
-                                 jnp.asarray(prep.phi1_ref), float(approach),
-                                 jnp.asarray(bool(prep.drive)),
-                                 steps_per_pitch=int(steps_per_pitch),
-                                 half_pitches=float(half_pitches), line_contact=False,
-                                 n_pairs=int(n_pairs))
-    values = {k: float(v) for k, v in zip(SUMMARY_KEYS, np.asarray(vals))}
-    table = {k: {name: float(np.asarray(getattr(jac, name))[i])
-                 for name in ("dE", "dP", "dG", "dSigma")} for i, k in enumerate(SUMMARY_KEYS)}
-    return values, table
 
 
 def pinion_outline(pair: HypoidPair) -> dict:
@@ -402,144 +246,171 @@ def pinion_outline(pair: HypoidPair) -> dict:
     return {"outline": np.array(pts + [pts[0]])}
 
 
-# -- the common TCA interface (gearjax.tca_result) --------------------------------------
+# -- the family for the one driver (gearjax.family) -------------------------------------
 
-def hypoid_result_traced(pair: HypoidPair, mis: Misalignment, x_ref, phi1_ref, *,
-                         side: str, drive: bool, steps_per_pitch: int = 16, half_pitches: float = 2.0,
-                         line_contact: bool = False, n_pairs: int = 5,
-                         approach=DEFAULT_APPROACH, kinematics: bool = True) -> TCAResult:
-    """:func:`hypoid_tca_traced` as a :class:`~gearjax.tca_result.TCAResult` with the
-    kinematics at the contact points (traceable).  ``side`` "drive"/"coast" labels the
-    flank pair (drive = pinion concave on gear convex); ``drive`` is the sense of
-    rotation found by :func:`prepare` (True: the pinion flank pushes the gear for
-    increasing ``phi1``), which picks the max or min TE envelope."""
-    res = hypoid_tca_traced(pair, mis, x_ref, phi1_ref, steps_per_pitch=steps_per_pitch,
-                            half_pitches=half_pitches, line_contact=line_contact,
-                            n_pairs=n_pairs, drive=drive, approach=approach)
-    kin = None
-    if kinematics:
-        kin = contact_kinematics(flank_function(pair.pinion, pair.pinion_crossing),
-                                 flank_function(pair.gear, pair.gear_crossing),
-                                 hypoid_assembly(pair), mis, res.path, line_contact=line_contact)
-    return TCAResult(res.path, res.margin, res.multi, res.coords, kin, side, "hypoid")
+@jax.tree_util.register_dataclass
+@dataclass(frozen=True)
+class SensedPair:
+    """The driver's pair of this family: the flank pair and the sense of rotation its
+    pinion flank pushes the gear for (``forward``, a boolean array: True for increasing
+    ``phi1``, found by :func:`prepare`; traced, so that both senses share a program)."""
+
+    pair: HypoidPair
+    forward: jax.Array
 
 
-_RSTATIC = ("steps_per_pitch", "half_pitches", "line_contact", "n_pairs", "kinematics")
+def _prepared(design, side):
+    """``(Prepared, side)`` of a design file (``side`` picks the flanks: drive = pinion
+    concave on gear convex; None: drive), a :class:`HypoidPair` or a :class:`Prepared`
+    (their flanks fix the side; a ``side`` that contradicts them is a ValueError)."""
+    if isinstance(design, (Prepared, HypoidPair)):
+        pair = design.pair if isinstance(design, Prepared) else design
+        # drive = pinion concave (outside blade, sign -1) on gear convex (SIDES)
+        found = "drive" if pair.pinion.cutter.sign == -1 else "coast"
+        if side is not None and side != found:
+            raise ValueError(f"side = {side!r}: the pinion flank of this pair is "
+                             f"{SIDES[found][0]}, i.e. the {found} side (build the pair "
+                             "of the other side from the design)")
+        prep = design if isinstance(design, Prepared) else prepare(design)
+        return prep, found
+    side = side or "drive"
+    return prepare(pair_flanks(design, side)), side
 
 
-@functools.partial(jax.jit, static_argnames=_RSTATIC)
-def _result_program(pair, mis, x_ref, phi1_ref, approach, drive, *, steps_per_pitch,
-                    half_pitches, line_contact, n_pairs, kinematics):
-    return hypoid_result_traced(pair, mis, x_ref, phi1_ref, side="", drive=drive,
-                                steps_per_pitch=steps_per_pitch, half_pitches=half_pitches,
-                                line_contact=line_contact, n_pairs=n_pairs, approach=approach,
-                                kinematics=kinematics)
+class HypoidFamily(GearFamily):
+    """Face-milled spiral-bevel and hypoid pairs for the driver.  Designs: a loaded
+    design file (:class:`~gearjax.gears.hypoid.design_file.HypoidDesign`, ``side``
+    picks the flanks), a :class:`HypoidPair` or a :class:`Prepared` pair (its flanks
+    fix the side).  Set-up: :func:`prepare` (reference search, hand of the mounting,
+    sense of rotation), concrete; inside the program the reference is refined to the
+    contact of the pinion's mean point under the misalignment (point contact,
+    :meth:`refine_reference`), so the grid moves with the settings.  Point contact by
+    default; line contact for conjugate pairs (the 5x5 point-contact system is
+    singular there).  Pairs pass :func:`~gearjax.gears.hypoid.pair.program_pair`
+    (tooth numbers, hands and blade signs traced: one program for every pair)."""
 
-
-def _result_jit(pair, mis, x_ref, phi1_ref, approach, *, side, drive, **static):
-    """The compiled TCA-result program (one for both sides and every tooth number and
-    hand: ``pair`` through :func:`program_pair`, ``drive`` traced) with ``side`` put
-    on the result."""
-    res = _result_program(program_pair(pair), mis, x_ref, phi1_ref, approach,
-                          jnp.asarray(drive), **static)
-    return replace(res, side=side)
-
-
-def _join_unchanged(pair, _extra):
-    """The loaded chain's ``join_pair`` of this family: the pair needs nothing back."""
-    return pair
-
-
-class _Adapter:
-    """The spiral-bevel/hypoid family behind :func:`gearjax.run_tca`.  Designs: a
-    loaded design file (``side`` picks the flanks: drive = pinion concave on gear
-    convex), a :class:`HypoidPair` or a :class:`Prepared` pair (its flanks fix the
-    side; a ``side`` that contradicts them raises ValueError)."""
-
-    family = "hypoid"
+    name = "hypoid"
     defaults = dict(steps_per_pitch=16, half_pitches=2.0, n_pairs=5)
-    # the loaded chain's program takes the pair through program_pair (one program for
-    # every tooth number and hand)
-    split_pair = staticmethod(lambda pair: (program_pair(pair), None))
-    join_pair = staticmethod(_join_unchanged)
-
-    @staticmethod
-    def _prepared(design, side):
-        side = check_side(side) if side is not None else None
-        if isinstance(design, (Prepared, HypoidPair)):
-            pair = design.pair if isinstance(design, Prepared) else design
-            # drive = pinion concave (outside blade, sign -1) on gear convex (SIDES)
-            found = "drive" if pair.pinion.cutter.sign == -1 else "coast"
-            if side is not None and side != found:
-                raise ValueError(f"side = {side!r}: the pinion flank of this pair is "
-                                 f"{SIDES[found][0]}, i.e. the {found} side (build the pair "
-                                 "of the other side from the design)")
-            prep = design if isinstance(design, Prepared) else prepare(design)
-            return prep, found
-        side = side or "drive"                  # a design file: side picks the flanks
-        return prepare(pair_flanks(design, side)), side
+    line_contact_modes = (False, True)
+    summary_keys = SUMMARY_KEYS
 
     def check(self, design):
         """A hand-built :class:`HypoidPair` (or a prepared one) in the ranges of the
         cutter and machine constructors, in mm and rad
-        (:func:`~gearjax.gears.hypoid.pair.check_pair_fields`;
-        :func:`gearjax.tca_result.check_design`); a design file is validated by its
-        loader."""
+        (:func:`~gearjax.gears.hypoid.pair.check_pair_fields`); a design file is
+        validated by its loader."""
         from gearjax.gears.hypoid.pair import check_pair_fields
         if isinstance(design, (Prepared, HypoidPair)):
             check_pair_fields(design.pair if isinstance(design, Prepared) else design)
 
-    def run(self, design, mis=None, *, side=None, steps_per_pitch=16, half_pitches=2.0,
-            n_pairs=5, line_contact=False, approach=DEFAULT_APPROACH, kinematics=True,
-            strict=True):
-        check_tca_options(steps_per_pitch, half_pitches, n_pairs, approach)
-        prep, side = self._prepared(design, side)
-        mis = Misalignment.zero() if mis is None else mis
-        res = _result_jit(prep.pair, strong_float64(mis), jnp.asarray(prep.x_ref),
-                          jnp.asarray(prep.phi1_ref),
-                          float(approach), side=side, drive=bool(prep.drive),
-                          steps_per_pitch=int(steps_per_pitch),
-                          half_pitches=float(half_pitches), line_contact=bool(line_contact),
-                          n_pairs=int(n_pairs), kinematics=bool(kinematics))
-        if strict:
-            check_on_flank_converged(res.path, res.margin)
-        return res
+    def setup(self, design, side):
+        return _prepared(design, side)
 
-    def traced(self, design, *, side=None, steps_per_pitch=16, half_pitches=2.0, n_pairs=5,
-               line_contact=False, approach=DEFAULT_APPROACH, kinematics=True):
-        check_tca_options(steps_per_pitch, half_pitches, n_pairs, approach)
-        prep, side = self._prepared(design, side)
-        x_ref, phi1_ref = jnp.asarray(prep.x_ref), jnp.asarray(prep.phi1_ref)
-        hand, drive = prep.pair.hand, bool(prep.drive)
+    def user_pair(self, prep):
+        return prep.pair
 
-        def f(pair: HypoidPair, mis=None):
-            # the jitted program of ``run`` (composable: inside a user's jit/grad/vmap
-            # it is traced once and inlined; called eagerly it runs compiled, not op
-            # by op)
-            mis = Misalignment.zero() if mis is None else mis
-            return _result_jit(replace(pair, hand=hand), strong_float64(mis),
-                               x_ref, phi1_ref, approach,
-                               side=side, drive=drive, steps_per_pitch=int(steps_per_pitch),
-                               half_pitches=float(half_pitches), line_contact=bool(line_contact),
-                               n_pairs=int(n_pairs), kinematics=bool(kinematics))
-        f.pair = prep.pair
-        return f
+    def program_pair(self, pair, prep):
+        # the hand of the mounting found by the set-up
+        return SensedPair(replace(pair, hand=prep.pair.hand), jnp.asarray(bool(prep.drive)))
 
-    def mesh(self, design, *, side=None, **_):
-        """``(teeth_of, pair, prepared)`` of the loaded-contact models (concrete
-        set-up): ``teeth_of(pair, res) -> MeshTeeth``, the differentiable pair and the
-        prepared pair to run the TCA of."""
+    def split(self, tree):
+        return program_pair(tree), None
+
+    def reference(self, prep, side):
+        return jnp.asarray(prep.x_ref), jnp.asarray(prep.phi1_ref)
+
+    def refine_reference(self, sp, mis, r1, r2, x_ref, phi1_ref, line_contact):
+        """Point contact: step 1 of :func:`reference_contact`, where the pinion's mean
+        point meets the gear flank; its step 2 (the 5x5 point contact at that pinion
+        angle) is exactly the path's first solve (the middle grid point is that angle).
+        Where step 1 fails the reference stays at the guess; the path's own solves
+        carry the convergence flags.  Line contact: the grid stays on ``phi1_ref`` and
+        the blade position ``s`` at ``x_ref[1]``."""
+        if line_contact:
+            return x_ref, phi1_ref
+        x_guess = jax.lax.stop_gradient(jnp.asarray(x_ref, float))
+        s1, _, x1 = _mean_point_contact(r1, r2, sp.pair, mis, x_guess, phi1_ref)
+        x_ref = jnp.where(s1.converged, jax.lax.stop_gradient(x1), x_guess)
+        phi1_ref = jnp.where(s1.converged, s1.x[0],
+                             jax.lax.stop_gradient(jnp.asarray(phi1_ref, float)))
+        return x_ref, phi1_ref
+
+    def flanks(self, sp, drive, line_contact=False):
+        p = sp.pair
+        return (flank_function(p.pinion, p.pinion_crossing),
+                flank_function(p.gear, p.gear_crossing))
+
+    def forward(self, sp, drive):
+        return sp.forward
+
+    def assembly(self, sp):
+        return hypoid_assembly(sp.pair)
+
+    def pinion_teeth(self, sp):
+        return sp.pair.z1
+
+    def boundaries(self, sp, path):
+        return hypoid_margin(sp.pair, path)
+
+    def path_position(self, sp, path, coords):
+        # the face-width position on the pinion (-1 toe .. +1 heel)
+        return coords["xi1"]
+
+    def edges(self, sp):
+        return hypoid_face_ends(sp.pair)
+
+    def summary(self, sp, res):
+        return tca_summary(sp.pair, res)
+
+    def teeth(self, prep, side, line_contact=False):
+        """The loaded-contact teeth (:mod:`gearjax.gears.hypoid.mesh`)."""
         from gearjax.gears.hypoid.mesh import hypoid_mesh_teeth
-        prep, _ = self._prepared(design, side)
-        return TeethOf(hypoid_mesh_teeth, (("drive", bool(prep.drive)),)), prep.pair, prep
+        return TeethOf(hypoid_mesh_teeth, (("drive", bool(prep.drive)),)), prep.pair
 
-    def sensitivity(self, design, mis=None, *, side=None, steps_per_pitch=16, half_pitches=2.0,
-                    n_pairs=5, approach=DEFAULT_APPROACH, **_):
-        prep, _ = self._prepared(design, side)
-        return misalignment_sensitivity(prep, mis, steps_per_pitch=steps_per_pitch,
-                                        half_pitches=half_pitches, n_pairs=n_pairs,
-                                        approach=approach)
+    def outline(self, design, side="drive"):
+        pair = design.pair if isinstance(design, Prepared) else design
+        if not isinstance(pair, HypoidPair):
+            pair = pair_flanks(design, side)
+        return pinion_outline(pair)
 
 
+FAMILY = HypoidFamily()
+ADAPTER = DriverAdapter(FAMILY)
 for _t in (HypoidDesign, HypoidPair, Prepared):
-    register_family(_t, _Adapter())
+    register_family(_t, ADAPTER)
+
+
+def hypoid_tca_traced(pair: HypoidPair, mis: Misalignment, x_ref, phi1_ref, *,
+                      steps_per_pitch: int = 16, half_pitches: float = 2.0,
+                      line_contact: bool = False, n_pairs: int = 5, drive=True,
+                      approach=DEFAULT_APPROACH, face_ends: bool = True) -> HypoidTCA:
+    """Traceable TCA of a flank pair by the one driver (:func:`gearjax.family.tca_parts`;
+    see :class:`HypoidFamily`): ``x_ref, phi1_ref`` from :func:`prepare`, ``drive`` its
+    sense of rotation.  With ``face_ends`` (default) the contacts at the toe and heel,
+    the tip edges and their corners are solved too, and the contact made at each
+    pinion angle is the surface or an edge contact (``path.edge_kind``)."""
+    path, margin, multi, coords, _ = tca_parts(
+        FAMILY, SensedPair(pair, jnp.asarray(drive)), mis, x_ref, phi1_ref, jnp.asarray(True),
+        approach, steps_per_pitch=steps_per_pitch, half_pitches=half_pitches,
+        n_pairs=n_pairs, kinematics=False, face_ends=face_ends, line_contact=line_contact)
+    return HypoidTCA(path, margin, multi, coords)
+
+
+def hypoid_tca(pair: HypoidPair | Prepared, mis: Misalignment | None = None, *,
+               strict: bool = True, **options) -> HypoidTCA:
+    """Jitted TCA of a flank pair (``pair`` a :class:`HypoidPair`, prepared here, or a
+    :class:`Prepared`) without the kinematics, as a :class:`HypoidTCA`: the program of
+    :func:`gearjax.run_tca` (options and ``strict`` as there)."""
+    res = ADAPTER.run(pair, mis, strict=strict, **{**options, "kinematics": False})
+    return HypoidTCA(res.path, res.margin, res.multi, res.coords)
+
+
+def misalignment_sensitivity(prep: Prepared, mis: Misalignment | None = None, **options):
+    """The V-H check by ``jax.jacfwd``: derivatives of the :func:`tca_summary` values
+    (TE peak-to-peak, gear angle at the reference = TE shift, bearing position on
+    both flanks, ellipse length, path angle) with respect to dE, dP, dG (per mm) and
+    dSigma (per rad), exact through every contact solve (point contact):
+    :func:`gearjax.tca_sensitivity` of the prepared pair.  Returns ``(values, table)``:
+    dicts keyed by :data:`SUMMARY_KEYS`; ``table[key]`` is ``{"dE": .., "dP": ..,
+    "dG": .., "dSigma": ..}``."""
+    return ADAPTER.sensitivity(prep, mis, **options)

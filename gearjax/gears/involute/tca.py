@@ -331,7 +331,7 @@ class InvoluteFamily(GearFamily):
         return (crowned_pinion_flank(des, code, line_contact),
                 generated_flank(p.module, p.pressure_angle, -p.helix, p.x2, p.z2, code))
 
-    def forward(self, drive):
+    def forward(self, pair, drive):
         # code -1 (drive): the pinion turning about +z pushes for increasing phi1
         return drive
 
@@ -351,7 +351,7 @@ class InvoluteFamily(GearFamily):
     def edges(self, des):
         return involute_face_ends(des)
 
-    def summary(self, res):
+    def summary(self, pair, res):
         return tca_summary(res.path, res.multi)
 
     def teeth(self, des, side, line_contact=False):

@@ -102,7 +102,7 @@ class PresetBevelFamily(GearFamily):
         # the side code of the family's flank functions: +1 drive (concave), -1 coast
         return side_flanks(pair, jnp.where(drive, 1.0, -1.0))
 
-    def forward(self, drive):
+    def forward(self, pair, drive):
         return jnp.logical_not(drive)
 
     def assembly(self, pair):
@@ -115,7 +115,7 @@ class PresetBevelFamily(GearFamily):
     def edges(self, pair):
         return preset_face_ends(pair)
 
-    def summary(self, res):
+    def summary(self, pair, res):
         return preset_summary(res)
 
     def teeth(self, pair, side, line_contact=False):

@@ -204,7 +204,7 @@ class VHCattFamily(GearFamily):
         p, q = self._members(pair)
         return vh_flanks(p, self._code(drive), q)
 
-    def forward(self, drive):
+    def forward(self, pair, drive):
         # sigma = -1 (drive): the pinion turning about +z pushes for increasing phi1
         return drive
 
@@ -222,7 +222,7 @@ class VHCattFamily(GearFamily):
     def edges(self, pair):
         return _face_ends(*self._members(pair))
 
-    def summary(self, res):
+    def summary(self, pair, res):
         return tca_summary(res.path, res.multi)
 
     def teeth(self, pair, side, line_contact=False):
