@@ -104,7 +104,7 @@ def _family_side(design, mis, m, side_name, half, pairs, kin):
 
 def _side_json(res):
     from gearjax import ARCSEC
-    path, margin, multi = res.path, res.margin, res.multi
+    path, multi = res.path, res.multi
     from gearjax import EDGE_NAMES
     conv = np.asarray(path.converged)
     on = np.asarray(res.on_flank)
