@@ -65,6 +65,9 @@ class GearFamily:
     name: str = ""
     #: default grid of the family's TCA
     defaults: dict = dict(steps_per_pitch=24, half_pitches=1.25, n_pairs=3)
+    #: True where :meth:`default_options` picks the grid for the design (the command
+    #: line then leaves the grid to the family unless ``--pitches`` is given)
+    grid_from_design: bool = False
     #: contact modes the family supports: (False,) point contact only; why, for the
     #: one-line refusal of the other mode
     line_contact_modes: tuple = (False,)
@@ -269,6 +272,7 @@ class DriverAdapter:
         self.fam = fam
         self.family = fam.name
         self.defaults = dict(fam.defaults)
+        self.grid_from_design = fam.grid_from_design
         # the loaded chain's program takes the pair split the same way (one program for
         # every pair of the family)
         self.split_pair = fam.split

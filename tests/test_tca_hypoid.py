@@ -150,6 +150,30 @@ def _check_envelope(res, drive, z1):
     assert (n_on - 1) / STEPS <= float(m.contact_ratio) <= (n_on + 1) / STEPS
 
 
+def test_a_prepared_pair_is_labelled_by_its_flanks(conjugate, coast):
+    """Drive side = pinion concave (blade sign -1) on gear convex: a hand-built or
+    prepared pair's own flanks decide its side -- the result is labelled by them, and a
+    side that contradicts them is a one-line ValueError before any work -- while a
+    design file's ``side`` picks the flanks (drive by default)."""
+    import gearjax as gj
+    for prep, side, other in ((conjugate, "drive", "coast"), (coast, "coast", "drive")):
+        with pytest.raises(ValueError, match=f"pinion flank of this pair is .*the {side} side"):
+            gj.run_tca(prep, side=other)
+        with pytest.raises(ValueError, match=f"the {side} side"):
+            gj.run_tca(prep.pair, side=other)
+        # the program of th.hypoid_tca (no kinematics), compiled by the tests above
+        res = gj.run_tca(prep, line_contact=True, steps_per_pitch=STEPS, half_pitches=HALF,
+                         n_pairs=3, kinematics=False, strict=False)
+        assert res.side == side and res.family == "hypoid"
+    d = load_design("example:spiral_bevel_10x30")
+    fam = gj.family_of(d).fam
+    for side in ("drive", "coast"):
+        prep, found = fam.setup(d, side)
+        assert found == side
+        assert int(prep.pair.pinion.cutter.sign) == (-1 if side == "drive" else 1)
+    assert fam.setup(d, None)[1] == "drive"
+
+
 @pytest.fixture(scope="module")
 def coast_point_tca(coast):
     f = jax.jit(partial(th.hypoid_tca_traced, line_contact=False, steps_per_pitch=STEPS,
@@ -258,6 +282,15 @@ def test_misaligned_contact_points_coincide_in_the_fixed_frame(conjugate, point_
         np.testing.assert_allclose(p1, p2, rtol=0, atol=1e-9)
         assert np.linalg.norm(np.cross(R1 @ m1, R2 @ m2)) < 1e-9
         np.testing.assert_allclose(np.asarray(p.point[i]), p1, rtol=0, atol=1e-9)
+    # the grid is centred where the pinion's mean point meets the gear flank of the
+    # *misaligned* pair (th.reference_contact), not of the aligned one
+    ref = jax.jit(th.reference_contact)
+    mis = Misalignment(*(jnp.asarray(v, float) for v in vals))
+    x0, ph0 = jnp.asarray(conjugate.x_ref), jnp.asarray(conjugate.phi1_ref)
+    phi_mis = float(ref(pair, mis, x0, ph0)[1])
+    phi_aligned = float(ref(pair, Misalignment.zero(), x0, ph0)[1])
+    assert abs(phi_mis - phi_aligned) > 1e-5
+    assert abs(float(p.phi1[MID]) - phi_mis) < 1e-12
 
 
 def test_augmented_contact_system_equals_the_nested_solve(conjugate, point_tca):

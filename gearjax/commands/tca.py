@@ -199,16 +199,17 @@ def run(args) -> int:
     if args.plot:
         check_output_path(args.plot, "--plot", (".png",))
     sides = ["drive", "coast"] if args.side == "both" else [args.side]
-    from gearjax import InvoluteFile, load_design
+    from gearjax import family_of, load_design
     # validated before any tracing
     design = (involute_design(args.design)[1] if args.design.startswith("involute:")
               else load_design(args.design))
-    involute = args.design.startswith("involute:") or isinstance(design, InvoluteFile)
-    # default: 1.25 pitches and 3 tooth pairs; an involute pair gets the family's
-    # default grid and pairs (wider for a path of contact that reaches further)
-    half = (None if involute and args.pitches is None
+    # default: 1.25 pitches and 3 tooth pairs; a family that picks the grid for the
+    # design (involute: wider for a path of contact that reaches further) gets its
+    # default grid and pairs
+    own = getattr(family_of(design), "grid_from_design", False)
+    half = (None if own and args.pitches is None
             else 1.25 if args.pitches is None else float(args.pitches))
-    pairs = None if involute else 3
+    pairs = None if own else 3
     solve = lambda side: _family_side(design, mis, m, side, half, pairs,  # noqa: E731
                                       args.kinematics)
     results, failed = {}, {}

@@ -293,6 +293,7 @@ class InvoluteFamily(GearFamily):
     name = "involute"
     defaults = dict(steps_per_pitch=24, half_pitches=1.25, n_pairs=3)
     line_contact_modes = (True, False)
+    grid_from_design = True
     summary_keys = SUMMARY_KEYS
     reference_moves_with_design = True
 
