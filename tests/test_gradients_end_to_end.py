@@ -78,6 +78,18 @@ def test_involute_chain():
     _check_mask_gaming(f, des)
 
 
+def _check_objectives_by_definition(res, on, position):
+    """``TCAResult.objectives`` against its definition, by NumPy: TE p-t-p in arcsec,
+    mean and max |SRR| and min R_x over the mask, and the bearing position at the
+    reference in the family's own coordinate (``position``: the pinion radius of an
+    involute pair, the face-width position xi1 of a bevel/hypoid pinion)."""
+    obj = np.asarray(res.objectives(on))
+    srr = np.abs(np.asarray(res.kinematics.srr))[on]
+    want = [float(res.multi.ptp) / gj.ARCSEC, srr.mean(), srr.max(),
+            np.asarray(res.kinematics.r_x)[on].min(), position[on.shape[0] // 2]]
+    np.testing.assert_allclose(obj, want, rtol=1e-12, atol=1e-15)
+
+
 def _check_mask_gaming(f, des):
     """The end point of a "gaming" run (20 Adam steps, learning rate 0.05, on
     ``pair.x1`` minimising mean |SRR| over the nominal mask: x1 0 -> 0.958) --
@@ -92,6 +104,7 @@ def _check_mask_gaming(f, des):
     on = np.asarray(nom.on_flank)
     c0 = nom.mask_check(on)
     assert int(c0.n_off) == 0 and float(c0.penalty) == 0.0
+    _check_objectives_by_definition(nom, on, np.asarray(nom.path.radial1))
     end = f(gj.with_fields(des, {"pair.x1": jnp.asarray(0.958)}), mis)
     c = end.mask_check(on)
     assert float(end.objectives(on)[1]) < float(nom.objectives(on)[1])   # the "improvement"
@@ -148,6 +161,7 @@ def _check_mask_gaming_hypoid(f):
     nom = f(f.pair)
     on = np.asarray(nom.on_flank)
     assert int(nom.mask_check(on).n_off) == 0 and float(nom.mask_check(on).penalty) == 0.0
+    _check_objectives_by_definition(nom, on, np.asarray(nom.coords["xi1"]))
     end = f(gj.with_fields(f.pair, {"pinion.cutter.point_radius":
                                     jnp.asarray(GAMING_POINT_RADIUS)}))
     c = end.mask_check(on)

@@ -542,3 +542,12 @@ def test_efficiency_function_is_mesh_efficiency_as_a_pure_function(spur, oil_sur
     np.testing.assert_allclose(np.asarray(res.path.te), np.asarray(res_w.path.te), atol=1e-14)
     with pytest.raises(ValueError, match="torque"):
         f(f.pair, -5.0, RPM, oil, surf)
+    # the loaded chain runs on the grid the family picks for the design (no compile
+    # here): a 40/80, 14.5 deg pair (contact ratio 2.16, its path reaching 1.1 pitches
+    # from the pitch point) gets 2 pitches and 5 pairs, as in gearjax.run_tca
+    high = gj.InvoluteTCA.create(gj.InvolutePair.create(40, 80, 1.5, 14.5), 20.0)
+    g = gj.efficiency_function(high)
+    assert (g.options["half_pitches"], g.options["n_pairs"]) == (2.0, 5)
+    assert g.options["line_contact"] is True
+    for k in ("steps_per_pitch", "half_pitches", "n_pairs", "line_contact"):
+        assert g.options[k] == gj.family_of(high).resolve(high, {})[k], k
