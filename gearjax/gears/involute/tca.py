@@ -252,6 +252,17 @@ def tca_summary(path: ContactPath, multi: MultiPair):
 DEFAULT_GRIDS = ((1.25, 3), (2.0, 5), (3.0, 7), (4.0, 9))
 
 
+@jax.jit
+def _reach(blank, teeth):
+    """Pitches from the pitch point to the further end of the path of contact (one small
+    compiled program for every pair: :func:`default_grid` runs on every TCA call, and
+    the eager operations of the centre-distance solve took ~80 ms there)."""
+    des = join_teeth(blank, teeth)
+    geo = pair_geometry(des.pair)
+    p_bt = 2.0 * jnp.pi * geo["rb1"] / des.pair.z1
+    return jnp.maximum(geo["rho_P"] - geo["rho_A"], geo["rho_E"] - geo["rho_P"]) / p_bt
+
+
 def default_grid(des: InvoluteTCA) -> tuple[float, int]:
     """``(half_pitches, n_pairs)`` of the default grid of a concrete design: the first of
     :data:`DEFAULT_GRIDS` that spans the path of contact from the start of active
@@ -259,15 +270,11 @@ def default_grid(des: InvoluteTCA) -> tuple[float, int]:
     a quarter pitch to spare (ISO 21771 roll distances; conjugate pair).  Most pairs
     (contact ratio below about 2) keep ``(1.25, 3)``; high-contact-ratio pairs get a
     wider grid instead of a contact ratio cut off by the grid's end."""
-    geo = pair_geometry(des.pair)
-    p_bt = float(2.0 * jnp.pi * geo["rb1"] / des.pair.z1)
-    reach = max(float(geo["rho_P"] - geo["rho_A"]), float(geo["rho_E"] - geo["rho_P"])) / p_bt
+    reach = float(_reach(*split_teeth(strong_float64(des))))
     for half, pairs in DEFAULT_GRIDS:
         if reach + 0.25 <= half:
             return half, pairs
     return DEFAULT_GRIDS[-1]
-
-
 
 
 # -- the family for the one driver (gearjax.family) -------------------------------------
