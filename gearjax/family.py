@@ -45,7 +45,8 @@ from gearjax.tca import (DEFAULT_APPROACH, Misalignment, check_on_flank_converge
                          check_tca_options, contact_path, pinion_angle_grid)
 from gearjax.tca_result import TCAResult, check_side, contact_kinematics, strong_float64
 
-__all__ = ["GearFamily", "DriverAdapter", "tca_parts", "result_traced", "OPTION_NAMES"]
+__all__ = ["GearFamily", "DriverAdapter", "tca_parts", "result_traced", "sensitivity_table",
+           "OPTION_NAMES"]
 
 #: the TCA options every family accepts (``line_contact`` only where supported)
 OPTION_NAMES = ("steps_per_pitch", "half_pitches", "n_pairs", "approach", "kinematics",
@@ -263,6 +264,16 @@ def _result(fam, pair, mis, x_ref, phi1_ref, approach, side, static) -> TCAResul
     return TCAResult(*parts, side, fam.name)
 
 
+def sensitivity_table(keys, vals, jac):
+    """``(values, table)`` of concrete summary values ``vals`` and their derivatives by
+    the misalignment (``jac``, a :class:`~gearjax.tca.Misalignment` of arrays):
+    ``values[key]``, ``table[key] = {"dE": .., "dP": .., "dG": .., "dSigma": ..}``."""
+    values = {k: float(v) for k, v in zip(keys, np.asarray(vals))}
+    table = {k: {n: float(np.asarray(getattr(jac, n))[i]) for n in ("dE", "dP", "dG", "dSigma")}
+             for i, k in enumerate(keys)}
+    return values, table
+
+
 class DriverAdapter:
     """The registry entry (:func:`gearjax.tca_result.register_family`) of a family
     ported to the driver: ``run``, ``traced``, ``sensitivity``, ``mesh``, ``outline``
@@ -364,11 +375,7 @@ class DriverAdapter:
         vals, jac = _sensitivity_program(*self.fam.split(strong_float64(pair)),
                                          strong_float64(mis), x_ref, phi1_ref, approach,
                                          jnp.asarray(side == "drive"), fam=self.fam, **static)
-        keys = self.fam.summary_keys
-        values = {k: float(v) for k, v in zip(keys, np.asarray(vals))}
-        table = {k: {n: float(np.asarray(getattr(jac, n))[i])
-                     for n in ("dE", "dP", "dG", "dSigma")} for i, k in enumerate(keys)}
-        return values, table
+        return sensitivity_table(self.fam.summary_keys, vals, jac)
 
     def mesh(self, design, *, side=None, **options):
         """``(teeth_of, pair, setup)`` of the loaded-contact models: the teeth, the

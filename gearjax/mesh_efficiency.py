@@ -451,9 +451,7 @@ def _grid_options(ad, design, tca_options: dict) -> dict:
     """The TCA options of the loaded chain: the family's defaults for ``design`` filled
     in (grid, contact mode; a family on the one driver resolves them for the design),
     without ``kinematics`` (the chain always needs them)."""
-    resolve = getattr(ad, "resolve", None)
-    opts = ({**ad.defaults, **tca_options} if resolve is None
-            else {**tca_options, **resolve(design, tca_options)})
+    opts = {**tca_options, **ad.resolve(design, tca_options)}
     opts.pop("kinematics", None)
     return opts
 
@@ -561,9 +559,8 @@ def mesh_efficiency(design, torque_Nm, pinion_rpm, oil: Oil, surface: Surface, *
     oil = dataclasses.replace(oil, name="")
     # a family whose pair has static fields that only enter arithmetic (the tooth
     # numbers of an involute pair) passes them traced: one program for every pair
-    split = getattr(ad, "split_pair", None)
-    blank, extra, join = ((*split(pair), ad.join_pair) if split is not None
-                          else (pair, None, None))
+    blank, extra = ad.split_pair(pair)
+    join = ad.join_pair
     eff = _post_jit(res, blank, extra, jnp.asarray(T, float), jnp.asarray(n, float), oil,
                     surface, jnp.asarray(Ep, float), jnp.asarray(nu, float), teeth_of=teeth_of,
                     join=join, steps_per_pitch=int(opts["steps_per_pitch"]),
@@ -576,7 +573,7 @@ def mesh_efficiency(design, torque_Nm, pinion_rpm, oil: Oil, surface: Surface, *
                                              "compliance", "viscosity_model", "film_method"))
 def _post_jit(res, pair, extra, T, n, oil, surface, E_prime, poisson, *, teeth_of, join,
               steps_per_pitch, n_pairs, compliance, viscosity_model, film_method):
-    pair = pair if join is None else join(pair, extra)
+    pair = join(pair, extra)
     return mesh_efficiency_traced(res, teeth_of(pair, res), T, n, oil, surface,
                                   steps_per_pitch=steps_per_pitch, n_pairs=n_pairs,
                                   E_prime=E_prime, poisson=poisson, compliance=compliance,

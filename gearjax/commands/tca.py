@@ -206,7 +206,7 @@ def run(args) -> int:
     # default: 1.25 pitches and 3 tooth pairs; a family that picks the grid for the
     # design (involute: wider for a path of contact that reaches further) gets its
     # default grid and pairs
-    own = getattr(family_of(design), "grid_from_design", False)
+    own = family_of(design).grid_from_design
     half = (None if own and args.pitches is None
             else 1.25 if args.pitches is None else float(args.pitches))
     pairs = None if own else 3

@@ -49,7 +49,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from gearjax.errors import check_range, is_traced
-from gearjax.family import DriverAdapter, GearFamily, tca_parts
+from gearjax.family import DriverAdapter, GearFamily, sensitivity_table, tca_parts
 from gearjax.fields import float64_array
 from gearjax.gears.involute.geometry import (InvolutePair, generated_flank, pair_geometry,
                                              rack_family, rack_family_data, rack_psi0)
@@ -428,8 +428,6 @@ def misalignment_sensitivity(des: InvoluteTCA, mis: Misalignment | None = None, 
     mis = Misalignment.zero() if mis is None else mis
     vals, (jac_des, jac) = _sensitivity_program(*split_teeth(pair), strong_float64(mis),
                                                 jnp.asarray(side == "drive"), **static)
-    values = {k: float(v) for k, v in zip(SUMMARY_KEYS, np.asarray(vals))}
-    table = {k: {name: float(np.asarray(getattr(jac, name))[i])
-                 for name in ("dE", "dP", "dG", "dSigma")} for i, k in enumerate(SUMMARY_KEYS)}
+    values, table = sensitivity_table(SUMMARY_KEYS, vals, jac)
     jac_des = replace(jac_des, pair=replace(jac_des.pair, z1=des.pair.z1, z2=des.pair.z2))
     return values, table, jac_des
