@@ -22,7 +22,7 @@ import jax.numpy as jnp
 import numpy as np
 
 import gearjax as gj
-from gearjax.mesh_efficiency import efficiency_function
+from gearjax.loading.mesh_efficiency import efficiency_function
 
 
 def main():
@@ -32,8 +32,8 @@ def main():
     args = ap.parse_args()
     design = gj.load_design(f"example:{args.design}")
     f = efficiency_function(design)
-    oil = dataclasses.replace(gj.get_oil(gj.OILS[0]), name="")
-    surf = gj.make_surface(0.4)
+    oil = dataclasses.replace(gj.tribology.get_oil(gj.tribology.OILS[0]), name="")
+    surf = gj.tribology.make_surface(0.4)
     names = [n for n in gj.field_names(f.pair) if ".machine." in n or ".cutter." in n]
     d0 = gj.get_fields(f.pair, names)
     x0 = jnp.stack([jnp.asarray(d0[n], float) for n in names])

@@ -141,7 +141,8 @@ def main():
     import jax.numpy as jnp
 
     import gearjax  # noqa: F401
-    from gearjax.tribology import friction_traced, get_oil, make_surface
+    from gearjax.tribology import get_oil, make_surface
+    from gearjax.tribology.friction import friction_traced
 
     n = args.points
     rng = np.random.default_rng(0)

@@ -104,7 +104,7 @@ def _py_job(name):
 
     from gearjax.gears.hypoid import tca as th
     from gearjax.gears.hypoid.design_file import load_design
-    from gearjax.tca import Misalignment
+    from gearjax.tca.assembly import Misalignment
 
     if name == "tca":
         def run():

@@ -20,15 +20,16 @@ from scipy.optimize import fsolve
 
 import gearjax as gj
 from gearjax.gears.involute.geometry import InvolutePair, generated_flank
-from gearjax.tca import ARCSEC, Misalignment, contact_equations
+from gearjax.tca.path import ARCSEC, contact_equations
+from gearjax.tca.assembly import Misalignment
 from gearjax.gears.involute.tca import (InvoluteTCA, reference_guess, crowned_pinion_flank,
                                   involute_assembly, misalignment_sensitivity)
 
 
-def involute_tca(des, mis, strict=True):
+def involute_tca(des, mis, throw=True):
     """The contact path and TE envelope, edges and tips solved, no kinematics (what the
     SciPy loop computes, and more): the one entry point."""
-    res = gj.run_tca(des, mis, kinematics=False, strict=strict)
+    res = gj.run_tca(des, mis, kinematics=False, throw=throw)
     return res.path, res.margin, res.multi
 
 
@@ -49,7 +50,7 @@ def main():
     t0 = time.perf_counter()
     path, margin, multi = involute_tca(des, mis)
     t_first = time.perf_counter() - t0
-    t_fwd = _best(lambda: involute_tca(des, mis, strict=False))
+    t_fwd = _best(lambda: involute_tca(des, mis, throw=False))
 
     # SciPy: same equations, jitted residual and Jacobian, one fsolve per position,
     # previous solution as the start, from the reference outwards

@@ -20,7 +20,7 @@ Pipeline (one design):
 
 1. **blank**: :class:`gearjax.gears.hypoid.blank.BlankInput` ``from_dict`` (validation:
    ``ValueError`` naming the field) and :func:`~gearjax.gears.hypoid.blank.blank_geometry`
-   (``strict=True``: ``ValueError`` / ``ConvergenceError`` on an undefined blank).
+   (``throw=True``: ``ValueError`` / ``ConvergenceError`` on an undefined blank).
 2. **flanks**: :func:`gearjax.studies.cutter_radius_pair.study_pair`: the gear flank is
    the face-mill cone of radius ``r_c0`` tangent to the lengthwise direction at the
    pitch point, with the blank's generated pressure angle as blade angle, placed as a
@@ -39,7 +39,7 @@ Pipeline (one design):
    example script).
 4. **TCA**: :func:`gearjax.gears.hypoid.synthesis.verify` (independent full TCA, 16
    steps per pitch, +-2 pitches, 5 pairs) and the contact-quality flags of
-   :meth:`gearjax.tca_result.TCAResult.flags` of that TCA.
+   :meth:`gearjax.tca.result.TCAResult.flags` of that TCA.
 
 Outcome of each side: ``blank refused`` (the parameter and message), ``flanks
 refused`` (exception), ``synthesis not converged`` (status), ``TCA failed``
@@ -93,8 +93,8 @@ from gearjax.gears.hypoid.blank import BlankInput, blank_geometry  # noqa: E402
 from gearjax.gears.hypoid.flank import flank_surface  # noqa: E402
 from gearjax.studies.cutter_radius import StudySettings  # noqa: E402
 from gearjax.studies.cutter_radius_pair import study_pair  # noqa: E402
-from gearjax.tca import ARCSEC  # noqa: E402
-from gearjax.tca_result import TCAResult  # noqa: E402
+from gearjax.tca.path import ARCSEC  # noqa: E402
+from gearjax.tca.result import TCAResult  # noqa: E402
 
 #: tooth-number pool: ratios 1, 2.5, 4.44, 8 (static fields: one structure each)
 #: side -> (gear flank of study_pair, path-angle target (deg), start d_radius (mm))
@@ -195,7 +195,7 @@ def measured_hand(fl) -> str:
     """Hand of spiral measured on a flank grid (the definition of
     tests/test_hypoid_surface.py): right hand when, going toe -> heel at mid height,
     the tooth turns positively about the work axis (apex -> heel)."""
-    g = flank_surface(fl, 9, 5, strict=False)
+    g = flank_surface(fl, 9, 5, throw=False)
     P = np.asarray(g.points)
     j = P.shape[1] // 2
     # the mid-height row is what is measured (a generated pinion's root row may not
@@ -234,7 +234,7 @@ def synthesise_side(st, side: str):
     for sign in (1.0, -1.0):
         v0 = np.array([sign * dr, 0.02, 0, 0, 0, 0, 0], float)
         try:
-            res = sy.synthesise(st, tg, v0=v0, strict=False)
+            res = sy.synthesise(st, tg, v0=v0, throw=False)
         except ConvergenceError as exc:         # the start's TCA failed: the other sign
             err = exc
             continue
@@ -247,11 +247,11 @@ def synthesise_side(st, side: str):
     res, v, route = first
     for a in np.arange(65.0, abs(angle) - 1e-9, -5.0):
         r = sy.synthesise(st, sy.Targets(path_angle_deg=float(np.sign(angle) * a)), v0=v,
-                          strict=False)
+                          throw=False)
         if not r.converged:
             return res, f"continuation stopped at {np.sign(angle) * a:+.0f} deg"
         v = r.v
-    res2 = sy.synthesise(st, tg, v0=v, strict=False)
+    res2 = sy.synthesise(st, tg, v0=v, throw=False)
     return (res2, "continuation") if res2.converged else (res, "continuation failed at target")
 
 

@@ -47,7 +47,7 @@ from gearjax.gears.hypoid.flank import mid_estimate, solve_tip
 from gearjax.studies.cutter_radius_pair import study_pair, study_uv
 from gearjax.io import atomic_write
 from gearjax.plot.kinematics import save_figure
-from gearjax.tca import ARCSEC
+from gearjax.tca.path import ARCSEC
 
 OUT = Path(__file__).resolve().parent / "results"
 FIELDS = ("u_e", "u_s", "srr", "r_eff")
@@ -77,7 +77,7 @@ def conjugate_sweep(sp):
         x_ref[1] = frac * s_tip
         p = prep._replace(x_ref=x_ref)
         out = th.hypoid_tca(p, line_contact=True, steps_per_pitch=8, half_pitches=1.5,
-                            n_pairs=3, strict=False)
+                            n_pairs=3, throw=False)
         ok = np.asarray(out.path.converged) & (np.asarray(out.margin) >= 0.0)
         te_max = max(te_max, float(np.max(np.abs(np.asarray(out.path.te)[ok]))) / ARCSEC)
         k = path_kinematics(prep.pair, out.path, line_contact=True)
@@ -113,7 +113,7 @@ def localised(sp, d_radius=2.0, c2=0.02):
     p2 = th.with_point_radius(sp.pair.pinion, d_radius, float(prep0.x_ref[0]))
     pin = replace(p2, machine=replace(p2.machine, modified_roll_2c=jnp.asarray(c2)))
     prep = th.prepare(replace(sp.pair, pinion=pin))
-    out = th.hypoid_tca(prep, steps_per_pitch=16, half_pitches=1.0, n_pairs=3, strict=False)
+    out = th.hypoid_tca(prep, steps_per_pitch=16, half_pitches=1.0, n_pairs=3, throw=False)
     k = path_kinematics(prep.pair, out.path, line_contact=False)
     _, f = _seed_fields(sp, out.path.p2_body)
     ok = (np.asarray(out.path.converged) & (np.asarray(out.margin) >= 0.0)

@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from gearjax.studies import cutter_radius as hk
+from gearjax.studies import cutter_radius_optimize as hko
 from gearjax.gears.hypoid.blank import blank_geometry
 from gearjax.io import atomic_write
 from gearjax.plot.kinematics import field_maps, save_figure, trend_plot
@@ -155,7 +156,7 @@ def main(argv=None):
     log("gradients")
 
     # optimisation and full re-check
-    opt, best = hk.optimise_design(inp, st, steps=steps)
+    opt, best = hko.optimise_design(inp, st, steps=steps)
     final = {"cutter_radius_mm": float(best.cutter_radius),
              "blade_angle_delta_deg": math.degrees(float(best.blade_angle_delta)),
              "cutter_shift_mm": float(best.cutter_shift)}
@@ -165,7 +166,7 @@ def main(argv=None):
     res["optimisation"] = {
         "objective": "J = max|SRR| - min R_eff / 20 mm + 10 (relu(1 - min Phi_I)^2 + "
                      "relu(1 - min Phi_II)^2), optimisation grid 9x7, Adam lr 0.05",
-        "bounds": hk.OPT_BOUNDS, "steps": steps,
+        "bounds": hko.OPT_BOUNDS, "steps": steps,
         "history": np.asarray(opt.history).tolist(), "final_value": float(opt.value),
         "projected_grad_norm": float(opt.grad_norm), "start": {"cutter_radius_mm": 95.25,
                                                               "blade_angle_delta_deg": 0.0,

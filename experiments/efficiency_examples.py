@@ -28,8 +28,9 @@ import gearjax as gj
 from gearjax.gears.involute.geometry import pair_geometry
 from gearjax.gears.involute.mesh import ohlendorf_loss_factor
 from gearjax.io import atomic_write
-from gearjax.mesh_efficiency import efficiency_warnings, mesh_efficiency
-from gearjax.tooth_compliance import iso6336_mesh_stiffness, iso6336_single_stiffness
+from gearjax.loading.efficiency_checks import efficiency_warnings
+from gearjax.loading.mesh_efficiency import mesh_efficiency
+from gearjax.loading.pair_stiffness import iso6336_mesh_stiffness, iso6336_single_stiffness
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "experiments" / "results"
@@ -58,11 +59,11 @@ def row(eff, res):
 
 
 def main():
-    oil, surf = gj.get_oil(OIL), gj.make_surface(SIGMA_UM)
+    oil, surf = gj.tribology.get_oil(OIL), gj.tribology.make_surface(SIGMA_UM)
     out = {"oil": OIL, "sigma_um": SIGMA_UM, "cases": {}}
     for name, helix, crown in CYLINDRICAL:
-        pair = gj.InvolutePair.create(20, 40, 4.0, 20.0, helix)
-        des = gj.InvoluteTCA.create(pair, 30.0, lead_crown=crown)
+        pair = gj.involute.InvolutePair.create(20, 40, 4.0, 20.0, helix)
+        des = gj.involute.InvoluteTCA.create(pair, 30.0, lead_crown=crown)
         geo = pair_geometry(pair)
         for comp in ("weber", "iso6336"):
             log(f"{name}, {comp}")
@@ -85,7 +86,7 @@ def main():
     for name in BEVEL:
         log(name)
         eff, res = mesh_efficiency(gj.load_design(f"example:{name}"), 200.0, 1000.0, oil, surf,
-                                   side="drive", strict=False)
+                                   side="drive", throw=False)
         r = row(eff, res)
         r.update(torque_Nm=200.0, rpm=1000.0, compliance="weber")
         out["cases"][name] = r

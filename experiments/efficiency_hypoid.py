@@ -47,13 +47,14 @@ jax.config.update("jax_compilation_cache_dir", str(Path(__file__).resolve().pare
 jax.config.update("jax_persistent_cache_min_compile_time_secs", 5.0)
 from gearjax.gears.hypoid.synthesis import synthesised_design
 from gearjax.io import atomic_write, dumps_toml
-from gearjax.mesh_efficiency import efficiency_function, efficiency_warnings, mesh_efficiency
+from gearjax.loading.mesh_efficiency import efficiency_function, mesh_efficiency
+from gearjax.loading.efficiency_checks import efficiency_warnings
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "experiments" / "results"
 DESIGN = "hypoid_iso_10x41_synthesised"
 TORQUE, RPM, SIGMA_UM = 200.0, 1000.0, 0.4
-OIL = gj.OILS[0]
+OIL = gj.tribology.OILS[0]
 PTP_MAX, MARGIN_MIN, XI_MAX, CR_MIN, EDGE_MARGIN = 15.0, 1.0, 0.5, 1.2, 0.3
 Z1 = 10
 #: (field, scale): one unit of the optimiser's variable
@@ -78,8 +79,8 @@ def chain(names=None):
     fields ``names`` (default: every machine setting and cutter parameter)."""
     design = gj.load_design(f"example:{DESIGN}")
     f = efficiency_function(design, side="drive")
-    oil = dataclasses.replace(gj.get_oil(OIL), name="")
-    surf = gj.make_surface(SIGMA_UM)
+    oil = dataclasses.replace(gj.tribology.get_oil(OIL), name="")
+    surf = gj.tribology.make_surface(SIGMA_UM)
     if names is None:
         names = [n for n in gj.field_names(f.pair) if ".machine." in n or ".cutter." in n]
     d0 = gj.get_fields(f.pair, names)
@@ -191,8 +192,8 @@ def main(argv=None):
         description=f"pinion drive-flank settings optimised for mesh power loss at {TORQUE:g} N m, "
                     f"{RPM:g} rpm ({OIL}, sigma {SIGMA_UM:g} um)",
         source="experiments/efficiency_hypoid.py")
-    oil, surf = gj.get_oil(OIL), gj.make_surface(SIGMA_UM)
-    eff1, res1 = mesh_efficiency(end_design, TORQUE, RPM, oil, surf, side="drive", strict=False)
+    oil, surf = gj.tribology.get_oil(OIL), gj.tribology.make_surface(SIGMA_UM)
+    eff1, res1 = mesh_efficiency(end_design, TORQUE, RPM, oil, surf, side="drive", throw=False)
     end = summary(eff1, res1)
     eff_b, res_b = jax.jit(evaluate)(u_best)
     end["objective_terms"] = [float(t) for t in terms(eff_b, res_b, p0)]

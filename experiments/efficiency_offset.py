@@ -27,12 +27,12 @@ in mm so the bearing length does not grow with the pinion face width).  The coas
 pinion flank is the conjugate coast pinion with the drive corrections (NOT
 synthesised, not used here).
 
-Operating point: pinion torque 200 N m, 1000 rpm, oil ``mineral_vg100`` (gearjax.OILS),
+Operating point: pinion torque 200 N m, 1000 rpm, oil ``mineral_vg100`` (gearjax.tribology.OILS),
 composite roughness sigma 0.4 um, Weber compliance; TCA 16 steps per pitch, 5 pairs
 (the hypoid defaults; one compiled program for every member).
 
 Sliding split: the sliding vector in the tangent plane ``S = u_s t + u_s_side e_major``
-(:class:`gearjax.tca_result.ContactKinematics`) is split into the lengthwise direction of
+(:class:`gearjax.tca.result.ContactKinematics`) is split into the lengthwise direction of
 the pinion flank (tangent of the curve of constant height above the root cone, i.e.
 along the tooth) and the profile direction (the tangent-plane gradient of that height).
 
@@ -65,8 +65,9 @@ from gearjax.gears.hypoid import tca as th  # noqa: E402
 from gearjax.gears.hypoid.blank import BlankInput, blank_geometry  # noqa: E402
 from gearjax.gears.hypoid.design_file import design_from_dict, load_design  # noqa: E402
 from gearjax.io import atomic_write, dumps_toml  # noqa: E402
-from gearjax.loaded_contact import pair_arrays  # noqa: E402
-from gearjax.mesh_efficiency import cycle_window, efficiency_warnings, mesh_efficiency  # noqa: E402
+from gearjax.loading.loaded_contact import pair_arrays  # noqa: E402
+from gearjax.loading.mesh_efficiency import cycle_window, mesh_efficiency  # noqa: E402
+from gearjax.loading.efficiency_checks import efficiency_warnings
 
 RESULTS = ROOT / "experiments" / "results"
 FAMILY_DIR = RESULTS / "offset_family"
@@ -384,8 +385,8 @@ def main(argv=None):
     ap.add_argument("--reuse", action="store_true", help="load the design files already written")
     a = ap.parse_args(argv)
     t_all = time.perf_counter()
-    oil = gearjax.get_oil(OPERATING["oil"])
-    surface = gearjax.make_surface(OPERATING["sigma_um"])
+    oil = gearjax.tribology.get_oil(OPERATING["oil"])
+    surface = gearjax.tribology.make_surface(OPERATING["sigma_um"])
     rows, failed = [], {}
     for E in a.offsets:
         path = FAMILY_DIR / f"offset_E{E:g}.toml"

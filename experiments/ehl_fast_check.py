@@ -71,7 +71,7 @@ def run_point(lam, pmax, ryrx, n, oil):
         fr = friction_coefficient(np.full(srr.shape, F), U_E, srr * U_E, RX, Ry, oil, surf, E)
     t = time.time()
     res, case, grid = solve_ehl(F, U_E, 0.0, RX, Ry, ETA0, ALPHA, sigma_um=sigma_um, n=n,
-                                strict=False)
+                                throw=False)
     dt = time.time() - t
     mu_num, mub_num = [], []
     for s in srr:

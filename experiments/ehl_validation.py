@@ -57,7 +57,7 @@ def case_for(M, L, Ry=RX):
 def run_case(F, u_e, Ry, n, angle=0.0, srr=0.2, **kw):
     t = time.time()
     res, case, grid = solve_ehl(F, u_e, srr * u_e, RX, Ry, ETA0, ALPHA, n=n, angle_deg=angle,
-                                strict=False, **kw)
+                                throw=False, **kw)
     dt = time.time() - t
     sc = scales(case)
     p_max = float(np.max(ehl_fields(res, case, grid, bool(res.x.shape[0] > grid.nx * grid.ny + 1))["p"]))
@@ -242,7 +242,7 @@ def part_fast(results):
         sigma_um = float(hc) * 1e3 / lam
         t = time.time()
         res, case, grid = solve_ehl(F, u_e, srr * u_e, RX, Ry, ETA0, ALPHA, sigma_um=sigma_um,
-                                    n=64, strict=False)
+                                    n=64, throw=False)
         dt = time.time() - t
         surf = make_surface(sigma_um)
         fr = friction_coefficient(F, u_e, srr * u_e, RX, Ry, oil, surf, E)

@@ -91,8 +91,8 @@ def check(name, f, design, mis, fields, family, step=1e-4):
 
 
 def involute_case(quick):
-    pair = gj.InvolutePair.create(25, 41, 2.0, 20.0, helix_deg=15.0)
-    des = gj.InvoluteTCA.create(pair, 20.0, dalpha_deg=0.02, profile_crown=2e-4, lead_crown=1e-3)
+    pair = gj.involute.InvolutePair.create(25, 41, 2.0, 20.0, helix_deg=15.0)
+    des = gj.involute.InvoluteTCA.create(pair, 20.0, dalpha_deg=0.02, profile_crown=2e-4, lead_crown=1e-3)
     f = gj.tca_function(des, side="drive", steps_per_pitch=8 if quick else 24)
     fields = ["dalpha", "profile_crown", "lead_crown", "face_width", "pair.module",
               "pair.pressure_angle", "pair.helix", "pair.x1", "pair.x2", "mis.dE", "mis.dP",
@@ -156,7 +156,7 @@ def main(argv=None):
         done = {t["example"] for t in timing}
         rows = [r for r in old["rows"] if r["example"] not in done] + rows
         timing = [t for t in old["timing"] if t["example"] not in done] + timing
-    gj.atomic_write(out, json.dumps(dict(rows=rows, timing=timing), indent=1))
+    gj.io.atomic_write(out, json.dumps(dict(rows=rows, timing=timing), indent=1))
     return 0
 
 

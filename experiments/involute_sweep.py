@@ -141,9 +141,9 @@ def check_pair(d, sides=("drive", "coast")):
     ref = iso21771(d["z1"], d["z2"], d["m"], d["alpha"], d["helix"], d["x1"], d["x2"], d["b"])
     row = {"design": d, "expected": ref["status"]}
     try:
-        pair = gj.InvolutePair.create(d["z1"], d["z2"], d["m"], d["alpha"], d["helix"],
+        pair = gj.involute.InvolutePair.create(d["z1"], d["z2"], d["m"], d["alpha"], d["helix"],
                                       d["x1"], d["x2"])
-        des = gj.InvoluteTCA.create(pair, d["b"], profile_crown=d["crown"])
+        des = gj.involute.InvoluteTCA.create(pair, d["b"], profile_crown=d["crown"])
     except ValueError as exc:
         row["status"] = "refused"
         row["reason"] = str(exc)
@@ -153,7 +153,7 @@ def check_pair(d, sides=("drive", "coast")):
     row["fails"] = [] if ref["status"] == "valid" else [f"accepted a pair with {ref['status']}"]
     lim1, _, _ = flank_limits(des)
     for side in sides:
-        res = gj.run_tca(des, side=side, strict=False)
+        res = gj.run_tca(des, side=side, throw=False)
         p = res.path
         fails = []
         on = np.asarray(res.on_flank)
@@ -236,8 +236,8 @@ def _crowned_run(d, pair, a, side, lim1, slope_icpt=None):
     point, on-flank mask)."""
     import gearjax as gj
     from gearjax.gears.involute.limits import signed_roll
-    res = gj.run_tca(gj.InvoluteTCA.create(pair, d["b"], profile_crown=a), side=side,
-                     strict=False)
+    res = gj.run_tca(gj.involute.InvoluteTCA.create(pair, d["b"], profile_crown=a), side=side,
+                     throw=False)
     slope, icpt = slope_icpt
     return res, slope * np.asarray(res.phi1) + icpt, np.asarray(res.on_flank)
 
@@ -265,7 +265,7 @@ def _crown_check(d, ref, pair, lim1, res, side, fails):
     a = d["crown"]
     an, at = math.radians(d["alpha"]), ref["alpha_t"]
     sgn = 1.0 if side == "coast" else -1.0        # drive: the gear lags; coast: it leads
-    twin = gj.run_tca(gj.InvoluteTCA.create(pair, d["b"]), side=side, strict=False)
+    twin = gj.run_tca(gj.involute.InvoluteTCA.create(pair, d["b"]), side=side, throw=False)
     t_on = np.asarray(twin.on_flank)
     rho_t = np.asarray(signed_roll(lim1, twin.path.p1_body, twin.path.uv1[:, 0]))
     lin = np.polyfit(np.asarray(twin.phi1)[t_on], rho_t[t_on], 1)

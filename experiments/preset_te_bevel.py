@@ -8,8 +8,8 @@ Parts (``python experiments/preset_te_bevel.py [part ...]``, default all):
   Gamma1;
 * ``preset``    -- the seed's example (36 arc-seconds): TE against the preset
   parabola, transfer points, contact ends against the unmodified pair, the loaded TE
-  at a stated torque (load sharing of gearjax.loaded_contact through
-  ``gearjax.mesh_efficiency``);
+  at a stated torque (load sharing of gearjax.loading.loaded_contact through
+  ``gearjax.loading.mesh_efficiency``);
 * ``robust``    -- assembly errors dE, dP, dG, dSigma: TE peak-to-peak and the TE jump
   at the transfer, unmodified and modified (table + figure);
 * ``gradients`` -- d(TE p-t-p)/d(kappa, rho1, rho2) and d(largest transfer jump)/d(...)
@@ -56,8 +56,8 @@ def plain(des):
     return dataclasses.replace(des, kappa=jnp.asarray(0.0))
 
 
-def tca(des, mis=None, side="drive", kinematics=False, strict=False):
-    return gj.run_tca(des, mis, side=side, kinematics=kinematics, strict=strict, **OPTS)
+def tca(des, mis=None, side="drive", kinematics=False, throw=False):
+    return gj.run_tca(des, mis, side=side, kinematics=kinematics, throw=throw, **OPTS)
 
 
 def gaps_arcsec(res):
@@ -71,7 +71,7 @@ def part_rolling():
     out = {}
     for side in ("drive", "coast"):
         t = time.perf_counter()
-        res = tca(des, side=side, kinematics=True, strict=True)
+        res = tca(des, side=side, kinematics=True, throw=True)
         sec = time.perf_counter() - t
         on = np.asarray(res.on_flank)
         p = res.path
@@ -109,8 +109,8 @@ def part_preset():
     des = design()
     out = {"kappa_rad": float(des.kappa), "preset_pinion_arcsec": 36.0,
            "preset_gear_arcsec": 36.0 * des.z1 / des.z2}
-    res_m = tca(des, kinematics=True, strict=True)
-    res_0 = tca(plain(des), kinematics=True, strict=True)
+    res_m = tca(des, kinematics=True, throw=True)
+    res_0 = tca(plain(des), kinematics=True, throw=True)
     on = np.asarray(res_m.on_flank)
     pre = np.asarray(A.preset_te(des, res_m))
     dev = np.abs(np.asarray(res_m.path.te) - pre)[on]
@@ -130,7 +130,7 @@ def part_preset():
         "max_sliding_over_pitch_speed_on_flank": float(np.asarray(A.sliding_ratio(res_m))[on].max()),
     }
     # loaded TE through the loaded-contact models (mesh_efficiency runs the load sharing)
-    oil, surf = gj.get_oil("mineral_vg100"), gj.make_surface(0.4)
+    oil, surf = gj.tribology.get_oil("mineral_vg100"), gj.tribology.make_surface(0.4)
     out["loaded"] = []
     curves = {}
     for T in TORQUES_NM:

@@ -27,7 +27,8 @@ from gearjax.io import atomic_write
 from gearjax.gears.hypoid.design_file import load_design
 from gearjax.newton import newton_solve
 from gearjax.plot.tca import save_tca_plot
-from gearjax.tca import ARCSEC, Misalignment, contact_equations
+from gearjax.tca.path import ARCSEC, contact_equations
+from gearjax.tca.assembly import Misalignment
 
 OUT = Path(__file__).parent / "results"
 
@@ -47,7 +48,7 @@ def main():
     prep = th.prepare(replace(pair, pinion=p_fl, gear=g_fl))
     t = time.perf_counter()
     conj = th.hypoid_tca(prep, line_contact=True, steps_per_pitch=8, half_pitches=1.5,
-                         n_pairs=3, strict=False)
+                         n_pairs=3, throw=False)
     ok = np.asarray(conj.path.converged)
     on = ok & (np.asarray(conj.margin) >= 0.0)
     out["conjugate"] = {"max_abs_te_arcsec_converged": float(np.abs(np.asarray(conj.path.te)[ok]).max() / ARCSEC),
@@ -104,7 +105,7 @@ def main():
             x1 = jnp.concatenate([uv1, s.x[1:]])
             return s.converged, F(x1, s.x[0])[4], s.x
         ok, n_eq, y = step1(jnp.concatenate([jnp.array([pr.phi1_ref]), jnp.asarray(pr.x_ref[2:])]))
-        full = th.hypoid_tca(pr, n_pairs=3, strict=False)
+        full = th.hypoid_tca(pr, n_pairs=3, throw=False)
         rep[side] = {"hand": pair.hand, "mean_point_gap_mm": pr.mismatch[0],
                      "mean_point_normal_angle_deg": pr.mismatch[1],
                      "step1_converged": bool(ok),

@@ -83,7 +83,7 @@ def main():
                        ("dSigma 0.01 deg", gj.Misalignment.create(dSigma_deg=0.01)),
                        ("dSigma 0.02 deg", gj.Misalignment.create(dSigma_deg=0.02))):
         for side in ("drive", "coast"):
-            r = gj.run_tca(design, mis, side=side, strict=False)
+            r = gj.run_tca(design, mis, side=side, throw=False)
             mid = r.phi1.shape[0] // 2
             on = np.asarray(r.on_flank)
             tca.append(dict(misalignment=label, side=side,
@@ -99,8 +99,8 @@ def main():
 
     # -- loaded mesh at the base point --------------------------------------------------
     def run(torque=BASE["torque"], rpm=BASE["rpm"], oil=None, sigma=BASE["sigma"]):
-        oil = gj.get_oil(BASE["oil"]) if oil is None else oil
-        return gj.mesh_efficiency(design, torque, rpm, oil, gj.make_surface(sigma), E_prime=Ep)
+        oil = gj.tribology.get_oil(BASE["oil"]) if oil is None else oil
+        return gj.mesh_efficiency(design, torque, rpm, oil, gj.tribology.make_surface(sigma), E_prime=Ep)
 
     t0 = time.time()
     eff, r = run()
@@ -147,7 +147,7 @@ def main():
                1e-12, 1 - 1e-15, xtol=1e-16, rtol=1e-15)
     ka = (2 * ellipe(m) / (math.pi * (1 - m))) ** (1 / 3)
     base = (3 * F / (2 * Ep * (A + B))) ** (1 / 3)
-    hz = gj.hertz_point(F, Rx, Ry, Ep)
+    hz = gj.tribology.hertz_point(F, Rx, Ry, Ep)
     res["hertz"] = dict(F_N=F, r_x_mm=Rx, r_y_mm=Ry, k_a=ka, k_b=ka * math.sqrt(1 - m),
                         seed_a_mm=ka * base, seed_b_mm=ka * math.sqrt(1 - m) * base,
                         gearjax_a_mm=float(hz.a), gearjax_b_mm=float(hz.b),
@@ -155,10 +155,10 @@ def main():
                         face_half_width_mm=0.5 * float(pair.face_width))
 
     # -- trends ------------------------------------------------------------------------
-    oil0 = gj.get_oil(BASE["oil"])
+    oil0 = gj.tribology.get_oil(BASE["oil"])
 
     def oil_eta(f):
-        return gj.make_oil(float(oil0.eta0) * f, alpha_per_GPa=22.0, tau0_MPa=5.0, rho0=880.0,
+        return gj.tribology.make_oil(float(oil0.eta0) * f, alpha_per_GPa=22.0, tau0_MPa=5.0, rho0=880.0,
                            name="scaled")
 
     def summary(e, rr):
@@ -221,7 +221,7 @@ def main():
         for name, p in strib.items()}
     res["seconds_total"] = time.time() - t_all
     OUT.mkdir(exist_ok=True)
-    gj.atomic_write(OUT / "vh_catt_friction.json", json.dumps(res, indent=1, default=float))
+    gj.io.atomic_write(OUT / "vh_catt_friction.json", json.dumps(res, indent=1, default=float))
     write_markdown(res)
     figures(res)
 
@@ -296,7 +296,7 @@ def write_markdown(res):
         L.append(f"| {k} | {v['param_at_lambda_1']:.3e} | {v['param_at_lambda_3']:.3e} | "
                  f"{v['mu_min']:.5f} | {v['param_at_mu_min']:.3e} |")
     L += ["", f"Total run time {res['seconds_total']:.0f} s (2 shared CPU cores)."]
-    gj.atomic_write(OUT / "vh_catt_friction.md", "\n".join(L) + "\n")
+    gj.io.atomic_write(OUT / "vh_catt_friction.md", "\n".join(L) + "\n")
 
 
 def figures(res):

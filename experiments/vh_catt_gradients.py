@@ -47,8 +47,8 @@ FIELDS = ("cutter_radius1", "cutter_radius2", "blade_offset", "pressure_angle", 
 def main(maxiter: int = 40, opt_only: bool = False):
     design = gj.load_design("example:vh_catt_17x23")
     pair0 = design.pair
-    oil = gj.get_oil("mineral_vg100")
-    surf = gj.make_surface(SIGMA_UM)
+    oil = gj.tribology.get_oil("mineral_vg100")
+    surf = gj.tribology.make_surface(SIGMA_UM)
     w = RPM                # f takes the pinion speed in rpm
     Ep = design.e_prime_MPa()
     f = gj.efficiency_function(pair0, E_prime=Ep)
@@ -137,7 +137,7 @@ def main(maxiter: int = 40, opt_only: bool = False):
                eta_bar=e0, seconds_forward_first=t_fwd, seconds_gradient_first=t_grad,
                gradients=rows, optimisation=opt)
     OUT.mkdir(exist_ok=True)
-    gj.atomic_write(OUT / "vh_catt_gradients.json", json.dumps(out, indent=1))
+    gj.io.atomic_write(OUT / "vh_catt_gradients.json", json.dumps(out, indent=1))
     md = ["# VH-CATT 17x23: gradients of the mesh efficiency and optimisation of R_T, e", "",
           f"Operating point: {TORQUE_NM} N m, {RPM} rpm, mineral_vg100, sigma {SIGMA_UM} um, "
           f"E' {Ep:.0f} MPa; eta_bar = {e0:.8f}.", "",
@@ -161,7 +161,7 @@ def main(maxiter: int = 40, opt_only: bool = False):
            f"{o['bearing_reach_mm']:.3f} | {o['ptp_misaligned_arcsec']:.3f} |",
            "", f"Timings (this machine, 2 shared CPU cores): first forward {t_fwd:.0f} s, "
            f"first gradient {t_grad:.0f} s, optimisation {t_opt:.0f} s (including compilation)."]
-    gj.atomic_write(OUT / "vh_catt_gradients.md", "\n".join(md) + "\n")
+    gj.io.atomic_write(OUT / "vh_catt_gradients.md", "\n".join(md) + "\n")
     print("\n".join(md))
 
 

@@ -6,29 +6,21 @@ geometry on 100 mm parts and arc-second transmission errors need float64.
 The chain (docs/architecture.md), each step a pure JAX function so that
 ``jax.grad`` runs from any design field to any result::
 
-    design (pytree)  -> cutter + machine -> tooth flanks      gearjax.gears.<family>
-                     -> tooth contact analysis (TCAResult)     gearjax.tca, gearjax.tca_result
-                     -> kinematics at the contact points       gearjax.tca_result, gearjax.kinematics
-                     -> Hertz load, film, friction, losses     gearjax.contact, gearjax.tribology
-                     -> load sharing, mesh efficiency          gearjax.loaded_contact, gearjax.mesh_efficiency
-                     -> objective -> gradient -> optimiser     gearjax.optimize
+    design (pytree)  -> cutter + machine -> tooth flanks      gearjax.<family>
+                     -> tooth contact analysis (TCAResult)     run_tca, tca_function
+                     -> kinematics at the contact points       TCAResult.kinematics
+                     -> Hertz load, film, friction, losses     gearjax.tribology
+                     -> load sharing, mesh efficiency          mesh_efficiency, efficiency_function
+                     -> objective -> gradient -> optimiser     minimize_optax, minimize_lbfgsb, ...
 
-Backbone (top level): ``frames`` (4x4 transforms), ``newton`` (implicit-differentiated
-Newton), ``surfaces`` (autodiff differential geometry, envelopes), ``kinematics``
-(eigenfunction kinematics of conjugate surfaces), ``tca`` (contact of two flanks:
-paths, TE, ellipses, tooth pairs), ``tca_result`` (the one TCA result type, the
-kinematics at its contact points, the family registry), ``contact`` (Hertz),
-``optimize`` (the optimisation layer), ``fields`` (design fields by dotted name),
-``io`` (file formats, atomic writes), ``errors``, ``progress``.  Families: ``gears.involute`` (rack-generated spur and
-helical pairs) and ``gears.hypoid`` (face-milled spiral-bevel and hypoid pairs:
-cutter, machine, blank design, flank, pair, design file, TCA, formate pinions,
-local synthesis, contact kinematics).  ``tribology`` (lubricant, film, asperities,
-friction, losses, numerical EHL), ``studies`` (the cutter-radius study), ``plot``
-(figures), ``cli``/``commands`` (the ``gearjax`` command).
-
-The names below are the public API (``gearjax.__all__``); docs/architecture.md
-lists them by step of the chain.  Units inside: mm, N, s, rad; degrees only at the
-boundary (design files, CLI flags, printed tables).
+The public face is the ~40 names of ``gearjax.__all__`` (verbs and types of the chain,
+one per job), four family namespaces -- ``gearjax.hypoid``, ``gearjax.involute``,
+``gearjax.vh_catt``, ``gearjax.preset_bevel`` -- and ``gearjax.tribology`` (oils,
+surfaces, friction, losses, Hertz, the numerical EHL reference).  The modules behind
+them (``gearjax.tca``, ``gearjax.loading``, ``gearjax.io``, ``gearjax.frames``,
+``gearjax.kinematics``, ...) are importable for research code; docs/architecture.md
+says what each holds.  Units inside: mm, N, s, rad; degrees only at the boundary
+(design files, CLI flags, printed tables).
 """
 
 import jax as _jax
@@ -37,62 +29,25 @@ _jax.config.update("jax_enable_x64", True)
 
 __version__ = "0.1.0"
 
-# -- backbone ------------------------------------------------------------------------
+# -- the verbs and types of the chain -------------------------------------------------
 from gearjax.errors import ConvergenceError  # noqa: E402
 from gearjax.fields import field_names, get_fields, with_fields  # noqa: E402
-from gearjax.frames import rot_axis, rot_x, rot_y, rot_z, translate  # noqa: E402
 from gearjax.newton import NewtonResult, newton_solve  # noqa: E402
-from gearjax.surfaces import GeneratedSurface, local_geometry  # noqa: E402
-from gearjax.kinematics import (Kinematics, Mesh, crossed_axes, eigen_kinematics,  # noqa: E402
-                                parallel_axes)
-from gearjax.edge_contact import EDGE_NAMES  # noqa: E402
-from gearjax.tca import ARCSEC, ContactPath, Misalignment, MultiPair, NoContactError  # noqa: E402
-from gearjax.tca_result import (SIDES, ContactKinematics, TCAResult,  # noqa: E402
+from gearjax.tca.path import ARCSEC, ContactPath, NoContactError  # noqa: E402
+from gearjax.tca.assembly import Misalignment  # noqa: E402
+from gearjax.tca.result import (SIDES, ContactKinematics, TCAResult, check_design,  # noqa: E402
                                 contact_kinematics, family_of)
-from gearjax.contact import HertzResult, hertz_line, hertz_point  # noqa: E402
 from gearjax.optimize import (LMResult, OptResult, least_squares_lm, minimize_lbfgsb,  # noqa: E402
                               minimize_optax, status_message)
-from gearjax.io import atomic_write, example_path, list_examples  # noqa: E402
-# -- gear families (importing them registers their TCA adapters) -----------------------
-from gearjax.gears.involute.geometry import InvolutePair, generated_flank, pair_geometry  # noqa: E402
-from gearjax.gears.involute.geometry import path_kinematics as involute_path_kinematics  # noqa: E402
-from gearjax.gears.involute.geometry import path_table as involute_path_table  # noqa: E402
-from gearjax.gears.involute.tca import InvoluteTCA, involute_limits  # noqa: E402
-from gearjax.gears.involute.design_file import InvoluteFile  # noqa: E402
-from gearjax.gears.hypoid.blank import BlankInput, blank_geometry, blank_sensitivity  # noqa: E402
-from gearjax.gears.hypoid.cutter import FaceMillCutter, make_cutter  # noqa: E402
-from gearjax.gears.hypoid.machine import MachineSettings  # noqa: E402
-from gearjax.gears.hypoid.flank import FlankSpec, MemberBlank, flank_surface  # noqa: E402
-from gearjax.gears.hypoid.pair import HypoidPair, complementary_pinion, pair_flanks  # noqa: E402
-from gearjax.gears.hypoid.design_file import HypoidDesign, save_design  # noqa: E402
-from gearjax.gears.hypoid.design_file import KINDS as HYPOID_KINDS  # noqa: E402
-from gearjax.io import design_from_dict, load_design  # noqa: E402  (any family, by [design] kind)
-from gearjax.gears.hypoid.tca import pinion_outline  # noqa: E402
-from gearjax.gears.hypoid.tca import prepare as prepare_hypoid  # noqa: E402
-from gearjax.gears.hypoid import synthesis  # noqa: E402
-from gearjax.gears.hypoid.synthesis import Targets, synthesise  # noqa: E402
-from gearjax.gears.hypoid.synthesis import start as synthesis_start  # noqa: E402
-from gearjax.gears.preset_bevel.geometry import PresetBevelDesign  # noqa: E402
-from gearjax.gears.preset_bevel.design_file import PresetBevelFile  # noqa: E402
-from gearjax.gears.preset_bevel.design_file import flank_grid as preset_bevel_flank_grid  # noqa: E402
-from gearjax.gears.preset_bevel import analysis as preset_bevel_analysis  # noqa: E402
-from gearjax.gears.vh_catt.geometry import VHCattPair  # noqa: E402
-from gearjax.gears.vh_catt.design_file import VHCattDesign  # noqa: E402  (registers kind "vh_catt")
-# -- lubrication and friction --------------------------------------------------------
-from gearjax.tribology import (OILS, FrictionResult, Oil, Surface, friction_coefficient,  # noqa: E402
-                               friction_traced, get_oil, make_oil, make_surface, mesh_losses,
-                               mesh_losses_traced, stribeck_curve)
-from gearjax.tribology.ehl import solve_ehl  # noqa: E402
-# -- loaded contact and mesh efficiency ---------------------------------------------
-from gearjax.loaded_contact import COMPLIANCE_MODELS, LoadedContact  # noqa: E402
-from gearjax.mesh_efficiency import (COMPLIANCE_HELP, DEFAULT_COMPLIANCE,  # noqa: E402
-                                     RPM_RANGE, TORQUE_RANGE_NM, MeshEfficiency, check_operating_point,
-                                     efficiency_function, efficiency_guard, efficiency_warnings,
-                                     mesh_efficiency)
-from gearjax.materials import E_PRIME_RANGE_MPA, Material, pair_material  # noqa: E402
-from gearjax.materials import STEEL as STEEL_MATERIAL  # noqa: E402
-from gearjax.tca_result import check_design  # noqa: E402
-
+from gearjax.io import design_from_dict, example_path, list_examples, load_design  # noqa: E402
+from gearjax.loading.loaded_contact import LoadedContact  # noqa: E402
+from gearjax.loading.mesh_efficiency import (MeshEfficiency, check_operating_point,  # noqa: E402
+                                             efficiency_function, efficiency_guard,
+                                             efficiency_warnings, mesh_efficiency)
+from gearjax.loading.materials import Material, pair_material  # noqa: E402
+# -- namespaces (importing the families registers their design kinds and TCA) --------
+from gearjax import hypoid, involute, preset_bevel, vh_catt  # noqa: E402
+from gearjax import tribology  # noqa: E402
 
 def run_tca(design, misalignment=None, *, side=None, **options) -> TCAResult:
     """Tooth contact analysis of any family: the one entry point.
@@ -104,7 +59,7 @@ def run_tca(design, misalignment=None, *, side=None, **options) -> TCAResult:
     "drive" (default) or "coast" (for a :class:`HypoidPair` its flanks decide).
     Options: ``steps_per_pitch``, ``half_pitches``, ``n_pairs``, ``line_contact``,
     ``approach`` (mm), ``kinematics`` (default True: :class:`ContactKinematics` at
-    every contact point), ``strict`` (default True: raise
+    every contact point), ``throw`` (default True: raise
     :class:`ConvergenceError` when a contact solve fails on the working flank).
 
     Returns a :class:`TCAResult`; ``result.flags()`` gives the contact-quality flags.
@@ -129,7 +84,7 @@ def tca_function(design, *, side=None, **options):
     an :class:`InvoluteTCA` for involute pairs, a :class:`HypoidPair` for
     spiral-bevel/hypoid pairs (``f.pair`` is the prepared pair of the design, the
     natural point to differentiate at).  Options as for :func:`run_tca` (no
-    ``strict``: check ``result.path.converged`` and ``result.on_flank``).
+    ``throw``: check ``result.path.converged`` and ``result.on_flank``).
     """
     check_design(design)
     kw = dict(options)
@@ -159,43 +114,19 @@ def tca_sensitivity(design, misalignment=None, *, side=None, **options):
 
 __all__ = [
     "__version__",
-    # designs and files
-    "load_design", "save_design", "design_from_dict", "HypoidDesign", "HYPOID_KINDS", "list_examples",
-    "example_path", "atomic_write",
-    # pairs and blanks
-    "InvolutePair", "InvoluteTCA", "InvoluteFile", "pair_geometry", "HypoidPair", "pair_flanks",
-    "complementary_pinion", "prepare_hypoid", "pinion_outline", "involute_limits", "BlankInput", "blank_geometry",
-    "blank_sensitivity",
-    "VHCattPair", "VHCattDesign",
-    # flanks
-    "FaceMillCutter", "make_cutter", "MachineSettings", "MemberBlank", "FlankSpec",
-    "flank_surface", "generated_flank", "GeneratedSurface", "local_geometry",
+    # designs
+    "load_design", "design_from_dict", "list_examples", "example_path", "check_design",
     # tooth contact analysis
-    "run_tca", "tca_function", "tca_sensitivity", "TCAResult", "ContactPath", "MultiPair",
-    "Misalignment", "SIDES", "ARCSEC", "NoContactError", "EDGE_NAMES", "family_of",
-    # kinematics
-    "ContactKinematics", "contact_kinematics", "Kinematics", "Mesh", "eigen_kinematics",
-    "parallel_axes", "crossed_axes", "involute_path_kinematics", "involute_path_table",
-    # synthesis
-    "synthesis", "synthesis_start", "synthesise", "Targets",
-    # contact and friction
-    "HertzResult", "hertz_point", "hertz_line", "Oil", "OILS", "get_oil", "make_oil",
-    "Surface", "make_surface", "FrictionResult", "friction_coefficient", "friction_traced",
-    "mesh_losses", "mesh_losses_traced", "stribeck_curve", "solve_ehl",
+    "run_tca", "tca_function", "tca_sensitivity", "TCAResult", "ContactPath", "Misalignment",
+    "ContactKinematics", "contact_kinematics", "SIDES", "ARCSEC",
     # loaded contact and mesh efficiency
-    "mesh_efficiency", "efficiency_function", "efficiency_warnings", "efficiency_guard",
-    "MeshEfficiency",
-    "DEFAULT_COMPLIANCE", "COMPLIANCE_HELP", "Material", "STEEL_MATERIAL", "pair_material",
-    "E_PRIME_RANGE_MPA",
-    "check_design",
-    "LoadedContact", "check_operating_point", "TORQUE_RANGE_NM", "RPM_RANGE", "COMPLIANCE_MODELS",
-    # optimisers and solvers
+    "mesh_efficiency", "efficiency_function", "MeshEfficiency", "LoadedContact", "Material",
+    "pair_material", "check_operating_point", "efficiency_warnings", "efficiency_guard",
+    # optimisers and solvers, their results and status
     "minimize_optax", "minimize_lbfgsb", "least_squares_lm", "OptResult", "LMResult",
-    "status_message", "newton_solve", "NewtonResult", "ConvergenceError",
+    "status_message", "newton_solve", "NewtonResult", "ConvergenceError", "NoContactError",
     # design fields by name
     "field_names", "get_fields", "with_fields",
-    # frames
-    "rot_x", "rot_y", "rot_z", "rot_axis", "translate",
-    # pure-rolling bevel pairs with a preset TE
-    "PresetBevelDesign", "PresetBevelFile", "preset_bevel_flank_grid", "preset_bevel_analysis",
+    # namespaces
+    "hypoid", "involute", "vh_catt", "preset_bevel", "tribology",
 ]

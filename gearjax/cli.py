@@ -12,6 +12,7 @@ import argparse
 import importlib
 import os
 import sys
+import warnings
 
 # sub-command modules, in the order they appear in ``gearjax --help``
 COMMANDS = [
@@ -63,38 +64,65 @@ def _drop_cache_entry(path: str, key: str) -> None:
             pass
 
 
-def _install_cache_repair(path: str) -> bool:
+#: the start of the warning JAX gives for a cache entry it cannot read
+CACHE_READ_WARNING = "Error reading persistent compilation cache entry"
+
+
+def _decompress(data: bytes) -> bytes:
+    """Decompress a cache entry with the codec JAX writes it with (zstd where Python
+    has it -- ``compression.zstd`` or the ``zstandard`` package -- else zlib)."""
+    try:
+        from compression import zstd          # Python >= 3.14
+        return zstd.decompress(data)
+    except ImportError:
+        pass
+    try:
+        import zstandard
+    except ImportError:
+        import zlib
+        return zlib.decompress(data)
+    return zstandard.ZstdDecompressor().decompress(data)
+
+
+def drop_unreadable_entries(path: str) -> int:
+    """Delete every entry of the cache directory ``path`` whose payload does not
+    decompress (a run killed while it wrote the entry); returns how many."""
+    dropped = 0
+    for name in sorted(os.listdir(path)):
+        if not name.endswith("-cache"):
+            continue
+        try:
+            with open(os.path.join(path, name), "rb") as f:
+                _decompress(f.read())
+        except OSError:
+            continue
+        except Exception:  # noqa: BLE001 - any undecodable payload is a bad entry
+            _drop_cache_entry(path, name[:-len("-cache")])
+            dropped += 1
+    return dropped
+
+
+def _install_cache_repair(path: str) -> None:
     """Make a corrupt cache entry a one-off cache miss instead of a warning on every run.
 
-    JAX (0.10) reads an entry with ``compilation_cache.get_executable_and_time``; when
-    the entry is truncated or corrupt, decompression or deserialisation raises, the
-    compiler warns "Error reading persistent compilation cache entry", recompiles,
-    and its ``put`` keeps the bad file because an entry with that key exists, so
-    every later run warns again.  The wrapper installed here catches the error,
-    deletes the entry's files and reports a miss: JAX then recompiles and stores a
-    good entry.  Returns False (nothing installed) when this JAX has no such hook.
-    """
-    try:
-        from jax._src import compilation_cache as cc
-    except ImportError:  # pragma: no cover  (a JAX without the module)
-        return False
-    original = getattr(cc, "get_executable_and_time", None)
-    if original is None:  # pragma: no cover
-        return False
-    if getattr(original, "_gearjax_repair", False):
-        return True
+    When JAX cannot read an entry (truncated or corrupt) it warns
+    (:data:`CACHE_READ_WARNING`), recompiles, and would keep the bad file (its ``put``
+    skips a key whose file exists), so that every later run warned again.  The warning
+    hook installed here (Python's ``warnings.showwarning``) drops the unreadable
+    entries instead of printing (:func:`drop_unreadable_entries`; JAX then stores a
+    good entry); every other warning is shown as before."""
+    previous = warnings.showwarning
+    if getattr(previous, "_gearjax_repair", False):
+        return
 
-    def get_executable_and_time(cache_key, *args, **kwargs):
-        try:
-            return original(cache_key, *args, **kwargs)
-        except Exception:  # noqa: BLE001 - any unreadable entry is a miss
-            cache = getattr(cc, "_cache", None)    # the directory JAX actually uses
-            _drop_cache_entry(os.fspath(getattr(cache, "_path", None) or path), cache_key)
-            return None, None
+    def showwarning(message, category, filename, lineno, file=None, line=None):
+        if str(message).startswith(CACHE_READ_WARNING):
+            drop_unreadable_entries(path)
+            return
+        previous(message, category, filename, lineno, file, line)
 
-    get_executable_and_time._gearjax_repair = True
-    cc.get_executable_and_time = get_executable_and_time
-    return True
+    showwarning._gearjax_repair = True
+    warnings.showwarning = showwarning
 
 
 def _enable_compilation_cache() -> None:
@@ -137,7 +165,7 @@ def main(argv=None) -> int:
     except (ConvergenceError, UnconvergedExportError) as exc:
         # a solve failed on valid input (or an export would carry such points): one
         # line, status 3
-        msg = str(exc).split("; pass strict=False")[0]
+        msg = str(exc).split("; pass throw=False")[0]
         sys.stderr.write(f"gearjax: error: {msg}\n")
         return 3
     except OSError as exc:  # a write (or read) failed: disk full, permissions, size limit

@@ -357,7 +357,7 @@ def _check_array_positive(name, value, unit, hi=None):
     return arr
 
 
-def hertz_point(F, Rx, Ry, E_prime, method: str = "exact", strict: bool = True) -> HertzResult:
+def hertz_point(F, Rx, Ry, E_prime, method: str = "exact", throw: bool = True) -> HertzResult:
     """Hertz elliptical point contact (validated public entry point).
 
     Parameters
@@ -370,7 +370,7 @@ def hertz_point(F, Rx, Ry, E_prime, method: str = "exact", strict: bool = True) 
     method : ``"exact"`` (AGM elliptic integrals + Newton for the ellipticity) or a
         curve fit: ``"brewe_hamrock_1977"`` (alias ``"hamrock_brewe"``) or
         ``"hamrock_brewe_1983"`` (warned outside 1 ≤ max/min radius ≤ 100).
-    strict : raise :class:`gearjax.errors.ConvergenceError` if a solve failed
+    throw : raise :class:`gearjax.errors.ConvergenceError` if a solve failed
         (default); with False the ``converged`` mask is returned instead.
 
     Returns
@@ -393,7 +393,7 @@ def hertz_point(F, Rx, Ry, E_prime, method: str = "exact", strict: bool = True) 
                       f"1 <= Ry/Rx <= 100 (got {float(np.max(ratio)):g}); use method='exact'",
                       stacklevel=2)
     out = _hertz_point_jit(F, Rx, Ry, E_prime, method=method)
-    if strict:
+    if throw:
         require_converged(out.converged, "Hertz ellipticity solve")
     return out
 

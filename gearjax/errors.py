@@ -25,6 +25,13 @@ def is_traced(value: Any) -> bool:
     return isinstance(value, jax.core.Tracer)
 
 
+def any_traced(*trees: Any) -> bool:
+    """True when any leaf of the pytrees ``trees`` is a JAX tracer: the call runs inside
+    ``jax.jit``/``grad``/``vmap``, where a public entry point skips its validation (and
+    never raises on a solve's status; the result carries its ``converged`` flags)."""
+    return any(is_traced(leaf) for leaf in jax.tree_util.tree_leaves(trees))
+
+
 def _fmt(value: Any) -> str:
     try:
         return f"{float(value):g}"
@@ -98,4 +105,4 @@ def require_converged(converged: Any, what: str, residual: Any = None) -> None:
             # says nothing about them)
             r = np.broadcast_to(np.asarray(residual, float), c.shape)[~c.astype(bool)]
             msg += f" (worst residual among them {float(np.max(np.where(np.isfinite(r), r, np.inf))):.3g})"
-        raise ConvergenceError(msg + "; pass strict=False to get masks instead")
+        raise ConvergenceError(msg + "; pass throw=False to get masks instead")

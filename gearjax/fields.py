@@ -2,7 +2,7 @@
 
 A design (for example a :class:`~gearjax.gears.hypoid.pair.HypoidPair`, an
 :class:`~gearjax.gears.involute.tca.InvoluteTCA` or a
-:class:`~gearjax.tca.Misalignment`) is a pytree whose array leaves are its continuous
+:class:`~gearjax.tca.assembly.Misalignment`) is a pytree whose array leaves are its continuous
 fields.  These helpers name them by their path (``"pinion.machine.modified_roll_2c"``,
 ``"pair.x1"``) so that a sensitivity study, a finite-difference check or an
 optimiser can pick the fields it varies and put new values back, without writing a

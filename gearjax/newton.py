@@ -230,7 +230,7 @@ def newton_solve(F: Callable, x0, theta=(), *, tol: float = 1e-10, xtol: float =
     x0 = jnp.asarray(x0, dtype=jnp.result_type(float))
     if x0.ndim > 1:
         raise ValueError(f"x0 must be a scalar or a 1-D array, got shape {x0.shape}")
-    if _eager(theta):
+    if _eager(F, theta):
         # an eager call runs as one jitted program cached on ``F`` (by identity) and
         # the options: a module-level ``F`` is traced and compiled once per process
         # instead of at every call (an eager ``while_loop`` compiles its loop anew)
@@ -248,16 +248,36 @@ def newton_solve(F: Callable, x0, theta=(), *, tol: float = 1e-10, xtol: float =
     return NewtonResult(x, res, steps, conv)
 
 
-def _eager(theta) -> bool:
-    """True outside any trace when every parameter is a concrete ``jax.Array``."""
-    try:
-        from jax._src.core import trace_state_clean
-        if not trace_state_clean():
-            return False
-    except ImportError:  # pragma: no cover - other JAX versions: stay on the plain path
+def _eager(F, theta) -> bool:
+    """True for a call outside any JAX transformation: nothing is being staged (an
+    array made here is concrete, not a tracer of ``jit``) and neither ``theta`` nor the
+    arrays ``F`` closes over (one closure level deep, and the closures of the
+    functions it closes over) is a tracer of ``grad``/``vmap``.  Public JAX only."""
+    if isinstance(jnp.zeros(()), jax.core.Tracer):
         return False
-    return all(isinstance(t, jax.Array) and not isinstance(t, jax.core.Tracer)
-               for t in jax.tree_util.tree_leaves(theta))
+    seen, todo, leaves = set(), [F], list(jax.tree_util.tree_leaves(theta))
+    while todo:
+        f = todo.pop()
+        if id(f) in seen:
+            continue
+        seen.add(id(f))
+        held = []
+        for cell in getattr(f, "__closure__", None) or ():
+            try:
+                held.append(cell.cell_contents)
+            except ValueError:       # an empty cell
+                continue
+        if isinstance(f, partial):
+            held += [f.func, *f.args, *f.keywords.values()]
+        if hasattr(f, "__self__"):   # a bound method: its object
+            held.append(f.__self__)
+        for v in held:
+            if callable(v) and not isinstance(v, jax.Array):
+                todo.append(v)
+            else:
+                leaves += jax.tree_util.tree_leaves(v)
+    return all(not isinstance(t, jax.core.Tracer) for t in leaves) and all(
+        isinstance(t, jax.Array) for t in jax.tree_util.tree_leaves(theta))
 
 
 @partial(jax.jit, static_argnums=(0, 1, 2, 3, 4, 5))

@@ -4,7 +4,7 @@ recorded baseline (tests/cost_baseline.json), without timing anything.
 Two kinds of measure, both deterministic on one JAX version and XLA flag set:
 
 * ``newton_work`` -- the Newton iterations a TCA executed
-  (:attr:`gearjax.tca.ContactPath.newton_work`: every ``vmap``-ed lane counted for as
+  (:attr:`gearjax.tca.path.ContactPath.newton_work`: every ``vmap``-ed lane counted for as
   long as its batch's slowest lane runs).  The TCA's run time is this count times a
   nearly constant cost per iteration; the edge search that made the involute TCA 30x
   slower (issue [D]) raised it from 179 to 5619 on the crowned 25/41 pair.  Up to

@@ -54,8 +54,8 @@ def no_work(monkeypatch):
     """Replace every compute entry point the commands call by a test failure."""
     def forbidden(*a, **k):
         raise AssertionError("the command started computing before refusing its input")
-    for mod, name in [(gearjax, "involute_path_kinematics"), (gearjax, "load_design"),
-                      (gearjax, "run_tca"), (gearjax, "flank_surface"),
+    for mod, name in [(gearjax.involute, "path_kinematics"), (gearjax, "load_design"),
+                      (gearjax, "run_tca"), (gearjax.hypoid, "flank_surface"),
                       (trib, "friction_coefficient"), (trib, "stribeck_curve")]:
         monkeypatch.setattr(mod, name, forbidden)
 
@@ -199,7 +199,7 @@ def test_print_json_writes_null_and_flags_nonfinite(capsys):
 
 
 def test_involute_json_is_strict_and_nonfinite_results_are_flagged(capsys, monkeypatch):
-    real = gearjax.involute_path_table
+    real = gearjax.involute.path_table
 
     def with_nan(res):
         t = dict(real(res))
@@ -209,7 +209,7 @@ def test_involute_json_is_strict_and_nonfinite_results_are_flagged(capsys, monke
 
     assert main(INVOLUTE + ["--points", "3", "--json"]) == 0
     clean = _strict_json(capsys.readouterr().out)
-    monkeypatch.setattr(gearjax, "involute_path_table", with_nan)
+    monkeypatch.setattr(gearjax.involute, "path_table", with_nan)
     assert main(INVOLUTE + ["--points", "3", "--json"]) == 0
     cap = capsys.readouterr()
     data = _strict_json(cap.out)
@@ -415,26 +415,26 @@ def test_failed_side_alone_gives_one_actionable_line(capsys, monkeypatch):
 
     _fail_side(monkeypatch, "drive", NoContactError(
         "no contact inside the flank boundaries at any grid position (the flanks do not "
-        "touch); pass strict=False to get the masks"))
+        "touch); pass throw=False to get the masks"))
     assert main(TCA + ["--misalign", "dE=1"]) == 3
     cap = capsys.readouterr()
     lines = cap.err.splitlines()
     assert len(lines) == 1 and lines[0].startswith("gearjax: error: drive side:")
     assert "do not touch" in lines[0] and "--misalign" in lines[0] and "--pitches 2" in lines[0]
-    assert "strict" not in lines[0]
+    assert "throw" not in lines[0]
     assert cap.out == ""
 
 
 def test_both_sides_keep_the_good_side(capsys, monkeypatch):
     _fail_side(monkeypatch, "coast", ConvergenceError(
         "tooth contact analysis on the flank: 3 of 61 solves did not converge (worst residual "
-        "0.1); pass strict=False to get masks instead"))
+        "0.1); pass throw=False to get masks instead"))
     assert main(TCA + ["--side", "both", "--json"]) == 3
     cap = capsys.readouterr()
     data = _strict_json(cap.out)
     assert set(data) == {"input", "drive", "coast"}
     assert set(data["coast"]) == {"error"} and "did not converge" in data["coast"]["error"]
-    assert "strict" not in data["coast"]["error"]
+    assert "throw" not in data["coast"]["error"]
     drive = data["drive"]
     assert drive["quality"]["converged"] and math.isfinite(drive["ptp_arcsec"])
     assert any(v is not None for v in drive["te_arcsec"])
@@ -462,12 +462,12 @@ def test_a_failed_solve_on_valid_input_is_one_line_and_status_3(capsys, monkeypa
 
     def boom(args):
         raise ConvergenceError("involute path of contact: 3 of 21 solves did not converge; "
-                               "pass strict=False to get masks instead")
+                               "pass throw=False to get masks instead")
     monkeypatch.setattr(inv, "run", boom)
     assert main(["involute", "--z1", "20", "--z2", "40", "--module", "4",
                  "--pressure-angle", "20"]) == 3
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "did not converge" in err[0] and "strict" not in err[0]
+    assert len(err) == 1 and "did not converge" in err[0] and "throw" not in err[0]
 
 
 def test_blank_without_a_solution_prints_none_and_warns(capsys):

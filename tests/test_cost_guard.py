@@ -26,8 +26,8 @@ def test_cost_of_the_lowered_efficiency_program():
     """TCA (with the involute edge search), load sharing and friction of a spur pair in
     one program: it stands for the involute TCA program too (lowering costs ~5 s of
     tracing per program; the involute TCA's own work is guarded in test_tca.py)."""
-    des = gj.InvoluteTCA.create(gj.InvolutePair.create(20, 40, 4.0, 20.0), 30.0)
+    des = gj.involute.InvoluteTCA.create(gj.involute.InvolutePair.create(20, 40, 4.0, 20.0), 30.0)
     f = gj.efficiency_function(des)
-    oil, surf = gj.get_oil(gj.OILS[0]), gj.make_surface(0.4)
+    oil, surf = gj.tribology.get_oil(gj.tribology.OILS[0]), gj.tribology.make_surface(0.4)
     check_cost("lowered_efficiency_spur",
                **static_cost(lambda p: f(p, 100.0, 1000.0, oil, surf), f.pair))

@@ -14,7 +14,8 @@ from gearjax.gears.hypoid import tca as th
 from gearjax.gears.hypoid.contact_kinematics import path_kinematics
 from gearjax.studies import cutter_radius as hk
 from gearjax.studies.cutter_radius_pair import study_pair, study_uv
-from gearjax.tca import ARCSEC, Misalignment
+from gearjax.tca.path import ARCSEC
+from gearjax.tca.assembly import Misalignment
 
 
 @pytest.fixture(scope="module")
@@ -23,7 +24,7 @@ def conj():
     sp = study_pair(inp, hk.StudySettings.make(95.25), "convex")
     prep = th.prepare(sp.pair)
     out = th.hypoid_tca(prep, line_contact=True, steps_per_pitch=8, half_pitches=1.0, n_pairs=3,
-                        strict=False)
+                        throw=False)
     return sp, prep, out
 
 
@@ -76,7 +77,7 @@ def test_contact_kinematics_equal_the_seed_model(conj):
         x_ref = np.array(prep.x_ref, float)
         x_ref[1] = 2.0 * frac * x_ref[1]          # x_ref[1] is half the blade to the tip
         outs.append(th.hypoid_tca(prep._replace(x_ref=x_ref), line_contact=True, steps_per_pitch=8,
-                                  half_pitches=1.0, n_pairs=3, strict=False))
+                                  half_pitches=1.0, n_pairs=3, throw=False))
     uv_all = []
     for out in outs:
         assert np.asarray(out.path.converged).all()
@@ -206,7 +207,7 @@ def test_study_pair_search_is_refused_under_jit():
 
 def test_common_contact_kinematics_equal_the_pair_route_on_a_hypoid(conj):
     """The family-independent kinematics of the common TCA result
-    (:func:`gearjax.tca_result.contact_kinematics`, pinion = member 1, rolling
+    (:func:`gearjax.tca.result.contact_kinematics`, pinion = member 1, rolling
     direction across the contact line) on this conjugate *hypoid* pair (offset 35 mm:
     the gear axis does not pass through the pinion's origin, so the ``r - c`` lever and
     the actual gear speed both matter) against the pair route of
@@ -216,7 +217,7 @@ def test_common_contact_kinematics_equal_the_pair_route_on_a_hypoid(conj):
     import gearjax as gj
     sp, prep, out = conj
     res = gj.run_tca(prep, line_contact=True, steps_per_pitch=8, half_pitches=1.0, n_pairs=3,
-                     strict=False)
+                     throw=False)
     on = np.asarray(res.on_flank)
     assert on.sum() >= 9
     np.testing.assert_allclose(np.asarray(res.path.phi2), np.asarray(out.path.phi2), rtol=0,

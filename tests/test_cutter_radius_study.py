@@ -206,7 +206,7 @@ def test_validation_and_strict():
     bad = hk.StudySettings(jnp.asarray(2.0), 0.0, 0.0)
     with pytest.raises(ConvergenceError):
         hk.flank_fields(inp, bad, "convex", SHAPE)
-    s, f = hk.flank_fields(inp, bad, "convex", SHAPE, strict=False)
+    s, f = hk.flank_fields(inp, bad, "convex", SHAPE, throw=False)
     assert float(s.blank["converged"]) == 0.0
 
 

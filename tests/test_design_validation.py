@@ -19,7 +19,7 @@ from gearjax.gears.hypoid.cutter import make_cutter
 from gearjax.gears.hypoid.design_file import (CROSS_CHECK_RTOL, MACHINE_DEFAULTS, cross_check,
                                               defaults_applied, design_from_dict, load_design)
 from gearjax.gears.hypoid.machine import MachineSettings
-from gearjax.tca import Misalignment
+from gearjax.tca.assembly import Misalignment
 
 # the hypoid/spiral-bevel examples (other families' kinds have their own tests)
 EXAMPLES = [n for n in io.list_examples()

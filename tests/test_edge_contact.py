@@ -1,4 +1,4 @@
-"""Edge contact at the face ends (gearjax.edge_contact) against closed forms.
+"""Edge contact at the face ends (gearjax.tca.edge_contact) against closed forms.
 
 Reference: a spur pair whose gear axis is turned by a small angle dg about the
 centre line (``dSigma``, crossed axes).  A gear point at axial position z moves by
@@ -26,13 +26,13 @@ from cost_guard import check_cost
 import gearjax as gj
 from gearjax import ARCSEC
 from gearjax.cli import main
-from gearjax.edge_contact import EDGE_NAMES
+from gearjax.tca.edge_contact import EDGE_NAMES
 from gearjax.gears.involute import tca as itca
 from gearjax.gears.involute.geometry import generated_flank
 
 B = 30.0
-PAIR = gj.InvolutePair.create(20, 40, 4.0, 20.0, 0.0, 0.0, 0.0)
-SPUR = gj.InvoluteTCA.create(PAIR, B)
+PAIR = gj.involute.InvolutePair.create(20, 40, 4.0, 20.0, 0.0, 0.0, 0.0)
+SPUR = gj.involute.InvoluteTCA.create(PAIR, B)
 DG = np.radians(0.05)
 RB2 = 0.5 * 40 * 4.0 * np.cos(np.radians(20.0))
 LEAD = 0.5 * B * DG * np.cos(np.radians(20.0)) / RB2      # rad, edge ahead of mid-face
@@ -126,7 +126,7 @@ def test_coast_side_touches_at_the_other_face_end(traced, sign):
     assert ends[-1.0] != ends[1.0], ends
 
 
-HELICAL = gj.InvoluteTCA.create(gj.InvolutePair.create(20, 40, 4.0, 20.0, 15.0, 0.2, 0.0), B)
+HELICAL = gj.involute.InvoluteTCA.create(gj.involute.InvolutePair.create(20, 40, 4.0, 20.0, 15.0, 0.2, 0.0), B)
 
 
 @pytest.mark.parametrize("des", [SPUR, HELICAL], ids=["spur", "helical"])
@@ -182,12 +182,12 @@ def test_edge_te_derivative_matches_closed_form_and_differences(traced):
 
 
 def test_crowned_pinion_keeps_its_bearing_inside_and_a_large_crossing_is_flagged():
-    helical = gj.InvolutePair.create(20, 40, 4.0, 20.0, 15.0, 0.2, 0.0)
-    crowned = gj.InvoluteTCA.create(helical, B, 0.0, 0.0, 2e-4)
-    small = gj.run_tca(crowned, gj.Misalignment.create(dSigma_deg=0.05), strict=False)
+    helical = gj.involute.InvolutePair.create(20, 40, 4.0, 20.0, 15.0, 0.2, 0.0)
+    crowned = gj.involute.InvoluteTCA.create(helical, B, 0.0, 0.0, 2e-4)
+    small = gj.run_tca(crowned, gj.Misalignment.create(dSigma_deg=0.05), throw=False)
     assert not small.flags()["face_end_contact"]
     assert small.face_ends_loaded() == []
-    big = gj.run_tca(crowned, gj.Misalignment.create(dSigma_deg=0.5), strict=False)
+    big = gj.run_tca(crowned, gj.Misalignment.create(dSigma_deg=0.5), throw=False)
     f = big.flags()
     assert f["face_end_contact"] and f["edge_contact"]
     assert any("edge contact at the" in w for w in big.warnings())
@@ -296,7 +296,7 @@ def mismatch(traced):
     edges and the closed form."""
     out = {}
     for da in (1.0, -1.0):
-        des = gj.InvoluteTCA.create(PAIR, B, dalpha_deg=da)
+        des = gj.involute.InvoluteTCA.create(PAIR, B, dalpha_deg=da)
         res = traced[True](des, _mis(0.0))
         plain = traced[False](des, _mis(0.0))
         path = res[0]
@@ -403,10 +403,10 @@ def test_hypoid_tip_edge_function_is_the_face_cone():
     the tooth as the normal distance, cos(face angle) per mm of radius; the margins
     give it as the tip part.  (No TCA: the edge system with it is the one above.)"""
     from gearjax.gears.hypoid.pair import hypoid_face_ends
-    pair = gj.pair_flanks(gj.load_design(gj.example_path("spiral_bevel_10x30_synthesised")),
+    pair = gj.hypoid.pair_flanks(gj.load_design(gj.example_path("spiral_bevel_10x30_synthesised")),
                           "drive")
     parts, g1, g2, (t1, t2) = hypoid_face_ends(pair)
-    corners = gj.pinion_outline(pair)["outline"]
+    corners = gj.hypoid.pinion_outline(pair)["outline"]
     z, r = 0.5 * (corners[2] + corners[3])               # mid face on the face cone
     q = jnp.array([r, 0.0, z])
     assert abs(float(t1(q))) < 1e-9
@@ -422,7 +422,7 @@ def test_hypoid_tip_edge_function_is_the_face_cone():
 @pytest.fixture(scope="module")
 def bevel_coast():
     d = gj.load_design(gj.example_path("spiral_bevel_10x30_synthesised"))
-    return gj.run_tca(d, side="coast", steps_per_pitch=16, half_pitches=1.25, strict=False,
+    return gj.run_tca(d, side="coast", steps_per_pitch=16, half_pitches=1.25, throw=False,
                       kinematics=False)
 
 
@@ -582,7 +582,7 @@ def test_tip_corner_under_a_shaft_angle_error_matches_the_closed_form(traced, mi
     des, _, _, cf = mismatch[da]
     dg = np.radians(dg_deg)
     mis = gj.Misalignment(*(jnp.asarray(v, float) for v in (0.0, dP, 0.0, dg)))
-    from gearjax.tca import rotation_about
+    from gearjax.tca.assembly import rotation_about
     np.testing.assert_allclose(np.asarray(rotation_about(jnp.array([0.0, 1.0, 0.0]), dg)),
                                _rot_y(dg), atol=1e-15)         # the closed form's convention
     path, margin, multi = traced[True](des, mis)
@@ -869,7 +869,7 @@ def test_neighbour_key_covers_every_whole_pitch_on_the_grid(n, p):
     above 2 (or at the grid's ends, where only the far neighbour is on the grid) pair
     0's edge contact would be compared with too few neighbours and kept behind a pair
     that carries the load."""
-    from gearjax.edge_contact import neighbour_key
+    from gearjax.tca.edge_contact import neighbour_key
     key = np.random.default_rng(n * 100 + p).normal(size=n)
     got = np.asarray(neighbour_key(jnp.asarray(key), p))
     want = np.array([max([key[j] for j in range(n) if j != i and (j - i) % p == 0],
@@ -890,7 +890,7 @@ def test_corner_leads_only_where_the_te_falls_both_ways(drive):
     with one slope falling and the other rising is not (the rising side's flank point
     would be through the mating flank first).  Rule by cases, both sides (the sense
     of the load flips the signs)."""
-    from gearjax.edge_contact import CORNER_SLOPE_TOL, corner_leads
+    from gearjax.tca.corners import CORNER_SLOPE_TOL, corner_leads
     s = 1.0 if drive else -1.0
     slopes = s * jnp.array([[-1e-3, -2e-3],     # falls both ways: leads
                             [-1e-3, 0.0],       # falls and level: leads

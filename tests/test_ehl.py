@@ -375,7 +375,7 @@ def test_limiter_name_is_checked():
 def test_non_converged_solve_raises_or_is_flagged():
     with pytest.raises(ConvergenceError):
         _solve(tol=1e-30, continuation=())
-    res, _, _ = _solve(tol=1e-30, continuation=(), strict=False)
+    res, _, _ = _solve(tol=1e-30, continuation=(), throw=False)
     assert not bool(res.converged)
 
 

@@ -1,5 +1,5 @@
 """The family interface is enough: a tiny toy family written in the test, run by the
-one TCA driver (gearjax/family.py) through the public entry points.
+one TCA driver (gearjax/tca/family.py) through the public entry points.
 
 The toy is a standard spur pair with closed-form involute flanks -- no tool, no
 generation: a point at radius R of member i lies at the polar angle
@@ -27,9 +27,9 @@ import numpy as np
 import pytest
 
 import gearjax as gj
-from gearjax.family import DriverAdapter, GearFamily
-from gearjax.tca import Assembly
-from gearjax.tca_result import register_family
+from gearjax.tca.family import DriverAdapter, GearFamily
+from gearjax.tca.assembly import Assembly
+from gearjax.tca.result import register_family
 
 
 class ToyPair(NamedTuple):
@@ -184,21 +184,21 @@ def test_toy_family_options_sensitivity_and_gradient():
 
 
 def test_driver_strict_default_and_masks():
-    """``strict`` defaults to True in the driver's ``run``: a pair with no grid point on
+    """``throw`` defaults to True in the driver's ``run``: a pair with no grid point on
     both flanks (here a negative face width: every face margin < 0) is a
-    ``NoContactError`` (a ``ConvergenceError``), and ``strict=False`` returns the result
+    ``NoContactError`` (a ``ConvergenceError``), and ``throw=False`` returns the result
     with its masks instead (the same compiled program as the closed-form runs)."""
     bad = _toy(b=-1.0)
     with pytest.raises(gj.ConvergenceError, match="no contact inside the flank boundaries"):
         gj.run_tca(bad, side="drive")
-    res = gj.run_tca(bad, side="drive", strict=False)
+    res = gj.run_tca(bad, side="drive", throw=False)
     assert not np.any(np.asarray(res.on_flank))
 
 
 def test_driver_solves_edges_only_when_asked():
     """``face_ends`` reaches the family: its ``edges`` are asked for exactly when the
     option is on (traced only, nothing compiled)."""
-    from gearjax.family import tca_parts
+    from gearjax.tca.family import tca_parts
 
     calls = []
 

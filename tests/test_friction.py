@@ -411,5 +411,5 @@ def test_nonconvergence_is_not_returned_as_valid(monkeypatch):
     monkeypatch.setattr(fr, "_friction_jit", fake)
     with pytest.raises(ConvergenceError):
         friction_coefficient(F, 3000.0, 300.0, RX, RY, OIL, make_surface(0.4))
-    r = friction_coefficient(F, 3000.0, 300.0, RX, RY, OIL, make_surface(0.4), strict=False)
+    r = friction_coefficient(F, 3000.0, 300.0, RX, RY, OIL, make_surface(0.4), throw=False)
     assert not bool(r.converged)

@@ -103,3 +103,33 @@ def test_efficiency_gradients_match_central_differences():
         np.testing.assert_allclose(J[:, i], fd, rtol=1e-6, atol=1e-9 * np.abs(fd).max())
     # pure-rolling position (index 1) has zero loss and zero sensitivity
     assert J[1].tolist() == [0.0] * 5
+
+
+def test_public_entry_points_are_jit_safe_and_match_the_concrete_call():
+    """``friction_coefficient`` and ``mesh_losses`` are one function each for concrete and
+    traced use: under ``jax.jit`` they give the concrete call's numbers (which went
+    through validation and the padded kernel), under ``jax.grad`` the kernel's gradient;
+    a concrete call still refuses bad input."""
+    from gearjax.tribology import friction_coefficient, get_oil, make_surface, mesh_losses
+
+    oil, surf = get_oil("mineral_vg100"), make_surface(0.4, f_c=0.1)
+    args = (np.array([800.0, 1200.0]), np.array([3000.0, 5000.0]), np.array([600.0, 900.0]),
+            np.array([8.0, 12.0]), np.array([80.0, 150.0]))
+    mu_c = np.asarray(friction_coefficient(*args, oil, surf).mu)
+    mu_j = np.asarray(jax.jit(lambda *a: friction_coefficient(*a, oil, surf).mu)(*args))
+    np.testing.assert_allclose(mu_j, mu_c, rtol=1e-12)
+    g = jax.grad(lambda F: jnp.sum(friction_coefficient(F, *args[1:], oil, surf).mu))(args[0])
+    h = 1e-3
+    fd = [(np.sum(friction_coefficient(args[0] + h * e, *args[1:], oil, surf).mu)
+           - np.sum(friction_coefficient(args[0] - h * e, *args[1:], oil, surf).mu)) / (2 * h)
+          for e in np.eye(2)]
+    np.testing.assert_allclose(np.asarray(g), fd, rtol=1e-5)
+    with pytest.raises(ValueError, match="load = -1 N"):
+        friction_coefficient(-1.0, 3000.0, 600.0, 8.0, 80.0, oil, surf)
+    F = np.array([[600.0, 400.0], [1000.0, 0.0]])
+    us, ue = np.array([[-900.0, 1500.0], [500.0, 0.0]]), np.array([[4000.0, 4500.0], [4400.0, 1.0]])
+    Rx = np.array([[6.0, 9.0], [9.0, 1.0]])
+    eta_c = float(mesh_losses(F, us, ue, Rx, 20 * Rx, oil, surf, 9000.0).mean_efficiency)
+    eta_j = float(jax.jit(lambda F: mesh_losses(F, us, ue, Rx, 20 * Rx, oil, surf,
+                                                  9000.0).mean_efficiency)(F))
+    assert abs(eta_j - eta_c) < 1e-12 and 0.9 < eta_c < 1.0

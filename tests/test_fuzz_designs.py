@@ -25,12 +25,12 @@ pointed teeth, interference -- counts as "refused": a ``ValueError``), face widt
 6..12 modules, pressure-angle modification +-0.05 deg, profile crown 0..5e-4 1/mm,
 lead crown 1e-5..2e-3 1/mm (always crowned: one program per tooth pair), dE, dP, dG
 in [-0.05, 0.05] mm and dSigma in [-0.2, 0.2] deg; ``gearjax.run_tca(...,
-strict=False, steps_per_pitch=8, kinematics=False)``.
+throw=False, steps_per_pitch=8, kinematics=False)``.
 
 Property of every result (``touching`` = ``on_flank | edge_points``, pair 0 touches):
 at every touching grid point the solve converged with ``residual < 1e-9`` and finite
 TE; ``flags()["converged"]`` is False exactly when the strict check of ``run_tca``
-(``gearjax.tca.check_on_flank_converged``) raises; a result with no flag raised
+(``gearjax.tca.path.check_on_flank_converged``) raises; a result with no flag raised
 (converged, reference on the flanks, no edge / face-end contact, contact ratio >= 1,
 TE peak-to-peak <= 60 arcsec) has finite TE over its whole touching span and a
 finite peak-to-peak.  Involute: the flag ``face_end_contact`` is raised exactly when
@@ -69,7 +69,7 @@ from hypothesis import strategies as st
 
 import gearjax as gj
 from gearjax.errors import ConvergenceError
-from gearjax.tca import check_on_flank_converged
+from gearjax.tca.path import check_on_flank_converged
 
 SCALE = int(os.environ.get("GEARJAX_FUZZ_EXAMPLES", "1"))
 HYPOID_EXAMPLES = 8 * SCALE
@@ -91,7 +91,7 @@ INVOLUTE_OPTIONS = dict(side="drive", steps_per_pitch=8, half_pitches=1.25, n_pa
 
 # the hypoid/spiral-bevel examples (other families' kinds have their own tests)
 ALL_EXAMPLES = [n for n in gj.list_examples()
-                if gj.io.read_toml(f"example:{n}")["design"]["kind"] in gj.HYPOID_KINDS]
+                if gj.io.read_toml(f"example:{n}")["design"]["kind"] in gj.hypoid.KINDS]
 TCA_EXAMPLES = [n for n in ALL_EXAMPLES if gj.load_design(f"example:{n}").flanks()]
 NO_FLANK_EXAMPLES = [n for n in ALL_EXAMPLES if n not in TCA_EXAMPLES]
 
@@ -229,8 +229,8 @@ def _involute_case(draw, z1, z2):
 
 
 def _involute(z1, z2, d, mis):
-    pair = gj.InvolutePair.create(z1, z2, d["module"], d["alpha"], d["helix"], d["x1"], d["x2"])
-    des = gj.InvoluteTCA.create(pair, d["b"], d["dalpha"], d["profile_crown"], d["lead_crown"])
+    pair = gj.involute.InvolutePair.create(z1, z2, d["module"], d["alpha"], d["helix"], d["x1"], d["x2"])
+    des = gj.involute.InvoluteTCA.create(pair, d["b"], d["dalpha"], d["profile_crown"], d["lead_crown"])
     return des, gj.Misalignment.create(**mis)
 
 
@@ -262,7 +262,7 @@ def test_involute_designs_are_valid_flagged_or_refused(run, data):
         return
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        res = gj.run_tca(des, mis, strict=False, **INVOLUTE_OPTIONS)
+        res = gj.run_tca(des, mis, throw=False, **INVOLUTE_OPTIONS)
     outcome = _check_result(res, (z1, z2, d, m))
     # face-end contact from the contact points' own coordinates
     face_end = res.flags()["face_end_contact"]

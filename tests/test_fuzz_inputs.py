@@ -211,8 +211,8 @@ def _forbidden(*a, **k):
 @contextlib.contextmanager
 def _no_work():
     with contextlib.ExitStack() as stack:
-        for mod, name in [(gearjax, "involute_path_kinematics"), (gearjax, "load_design"),
-                          (gearjax, "run_tca"), (gearjax, "flank_surface"),
+        for mod, name in [(gearjax.involute, "path_kinematics"), (gearjax, "load_design"),
+                          (gearjax, "run_tca"), (gearjax.hypoid, "flank_surface"),
                           (trib, "friction_coefficient"), (trib, "stribeck_curve")]:
             stack.enter_context(mock.patch.object(mod, name, _forbidden))
         yield
@@ -270,14 +270,14 @@ def test_cli_refuses_random_invalid_grids(cmd, which, data):
 
 # ------------------------------------------------------------------- library constructors
 
-_PAIR = gearjax.InvolutePair.create(20, 40, 4.0, 20.0)
+_PAIR = gearjax.involute.InvolutePair.create(20, 40, 4.0, 20.0)
 NOT_NUMBERS = [None, "abc", [1.0], {"a": 1}, 1 + 2j, object()]
 
 # constructor -> (callable taking keyword overrides,
 #                 {parameter: (low, high, low excluded, high excluded, integer, needle)})
 CONSTRUCTORS = {
     "InvolutePair.create": (
-        lambda **k: gearjax.InvolutePair.create(**{**dict(z1=20, z2=40, module=4.0,
+        lambda **k: gearjax.involute.InvolutePair.create(**{**dict(z1=20, z2=40, module=4.0,
                                                           pressure_angle_deg=20.0), **k}),
         {"z1": (6, 1000, False, False, True, "z1"), "z2": (6, 1000, False, False, True, "z2"),
          "module": (0.01, 100.0, False, False, False, "module"),
@@ -286,19 +286,19 @@ CONSTRUCTORS = {
          "x1": (-3.0, 3.0, False, False, False, "x1"),
          "x2": (-3.0, 3.0, False, False, False, "x2")}),
     "InvoluteTCA.create": (
-        lambda **k: gearjax.InvoluteTCA.create(**{**dict(pair=_PAIR, face_width=30.0), **k}),
+        lambda **k: gearjax.involute.InvoluteTCA.create(**{**dict(pair=_PAIR, face_width=30.0), **k}),
         {"face_width": (0.0, 1000.0, True, False, False, "face_width"),
          "dalpha_deg": (-5.0, 5.0, False, False, False, "dalpha"),
          "profile_crown": (0.0, 0.1, False, False, False, "profile_crown"),
          "lead_crown": (0.0, 0.1, False, False, False, "lead_crown")}),
     "make_oil": (
-        lambda **k: gearjax.make_oil(**{**dict(eta0=0.1, alpha_per_GPa=20.0), **k}),
+        lambda **k: gearjax.tribology.make_oil(**{**dict(eta0=0.1, alpha_per_GPa=20.0), **k}),
         {"eta0": (6.31e-5, 100.0, True, False, False, "eta0"),
          "alpha_per_GPa": (0.0, 100.0, True, False, False, "alpha"),
          "tau0_MPa": (0.0, 100.0, True, False, False, "tau0"),
          "rho0": (0.0, 2e4, True, False, False, "rho0")}),
     "make_surface": (
-        lambda **k: gearjax.make_surface(**{**dict(sigma_um=0.4), **k}),
+        lambda **k: gearjax.tribology.make_surface(**{**dict(sigma_um=0.4), **k}),
         {"sigma_um": (0.0, 10.0, True, False, False, "sigma"),
          "density_per_mm2": (0.0, 1e6, True, False, False, "asperity density"),
          "beta_um": (0.0, 1000.0, True, False, False, "asperity radius"),
@@ -311,7 +311,7 @@ CONSTRUCTORS = {
          "dG": (-50.0, 50.0, False, False, False, "dG"),
          "dSigma_deg": (-5.0, 5.0, False, False, False, "dSigma")}),
     "make_cutter": (
-        lambda **k: gearjax.make_cutter(**{**dict(point_radius=100.0, blade_angle_deg=20.0,
+        lambda **k: gearjax.hypoid.make_cutter(**{**dict(point_radius=100.0, blade_angle_deg=20.0,
                                                   edge_radius=1.0, flank="convex"), **k}),
         {"point_radius": (0.0, 1e4, True, False, False, "point_radius"),
          "blade_angle_deg": (0.0, 45.0, True, True, False, "blade_angle"),
@@ -389,7 +389,7 @@ def test_gap_wrong_type_accepted(ctor, name, value):
 @pytest.mark.parametrize("value", [None, "abc", [20], {"z": 20}, 1 + 2j])
 def test_gap_tooth_number_not_a_number(value):
     with pytest.raises(ValueError, match="z1"):
-        gearjax.InvolutePair.create(value, 40, 4.0, 20.0)
+        gearjax.involute.InvolutePair.create(value, 40, 4.0, 20.0)
 
 
 @pytest.mark.parametrize("ctor,name", [("InvoluteTCA.create", "face_width"),

@@ -68,8 +68,8 @@ def _check(f, design, fields, mis=None, rel_step=1e-4):
 
 
 def test_involute_chain():
-    pair = gj.InvolutePair.create(25, 41, 2.0, 20.0, helix_deg=15.0)
-    des = gj.InvoluteTCA.create(pair, 20.0, dalpha_deg=0.02, profile_crown=2e-4, lead_crown=1e-3)
+    pair = gj.involute.InvolutePair.create(25, 41, 2.0, 20.0, helix_deg=15.0)
+    des = gj.involute.InvoluteTCA.create(pair, 20.0, dalpha_deg=0.02, profile_crown=2e-4, lead_crown=1e-3)
     f = gj.tca_function(des, side="drive", steps_per_pitch=8)
     jac = _check(f, des, ["dalpha", "profile_crown", "lead_crown", "pair.x1", "pair.helix",
                           "mis.dE", "mis.dSigma"])
@@ -185,7 +185,7 @@ def test_field_helpers_name_and_replace_leaves():
         gj.with_fields(mis, {"dX": 1.0})
     with pytest.raises(KeyError, match="dX"):
         gj.get_fields(mis, ["dX"])
-    pair = gj.InvoluteTCA.create(gj.InvolutePair.create(20, 40, 4.0, 20.0), 30.0)
+    pair = gj.involute.InvoluteTCA.create(gj.involute.InvolutePair.create(20, 40, 4.0, 20.0), 30.0)
     assert "pair.x1" in gj.field_names(pair) and "lead_crown" in gj.field_names(pair)
 
 
@@ -195,25 +195,25 @@ def test_validated_constructors_pass_traced_values_and_check_concrete_ones():
     still checked."""
     d = jax.grad(lambda e: gj.Misalignment.create(dE=e, dSigma_deg=2.0 * e).dSigma)(0.1)
     assert abs(float(d) - 2.0 * np.pi / 180.0) < 1e-15
-    g = jax.grad(lambda a: gj.InvolutePair.create(20, 40, 4.0, a, helix_deg=a).helix)(20.0)
+    g = jax.grad(lambda a: gj.involute.InvolutePair.create(20, 40, 4.0, a, helix_deg=a).helix)(20.0)
     assert abs(float(g) - np.pi / 180.0) < 1e-15
-    pair = gj.InvolutePair.create(20, 40, 4.0, 20.0)
-    g = jax.grad(lambda c: gj.InvoluteTCA.create(pair, 30.0, lead_crown=c).lead_crown)(1e-3)
+    pair = gj.involute.InvolutePair.create(20, 40, 4.0, 20.0)
+    g = jax.grad(lambda c: gj.involute.InvoluteTCA.create(pair, 30.0, lead_crown=c).lead_crown)(1e-3)
     assert float(g) == 1.0
     with pytest.raises(ValueError, match="dE = 60"):
         gj.Misalignment.create(dE=60.0)
     with pytest.raises(ValueError, match="lead_crown"):
-        gj.InvoluteTCA.create(pair, 30.0, lead_crown=-1.0)
+        gj.involute.InvoluteTCA.create(pair, 30.0, lead_crown=-1.0)
     with pytest.raises(ValueError, match="x1"):
-        gj.InvolutePair.create(8, 40, 4.0, 20.0, x1=-1.0)      # undercut
+        gj.involute.InvolutePair.create(8, 40, 4.0, 20.0, x1=-1.0)      # undercut
 
 
 def test_hypoid_constructors_pass_traced_values():
     """The design-file constructors of the hypoid family under ``jax.grad``: cutter
     (degrees -> rad), machine settings, member blank."""
-    g = jax.grad(lambda a: gj.make_cutter(75.0, a, 1.0, "convex").blade_angle)(20.0)
+    g = jax.grad(lambda a: gj.hypoid.make_cutter(75.0, a, 1.0, "convex").blade_angle)(20.0)
     assert abs(float(g) - np.pi / 180.0) < 1e-15
-    g = jax.grad(lambda r: gj.MachineSettings.create(radial_distance=r, cradle_angle=0.1,
+    g = jax.grad(lambda r: gj.hypoid.MachineSettings.create(radial_distance=r, cradle_angle=0.1,
                                                      machine_root_angle=0.3,
                                                      ratio_of_roll=3.0).radial_distance)(70.0)
     assert float(g) == 1.0
@@ -224,4 +224,4 @@ def test_hypoid_constructors_pass_traced_values():
         teeth=30, hand="right").face_angle)(70.0)
     assert abs(float(g) - np.pi / 180.0) < 1e-15
     with pytest.raises(ValueError, match="edge_radius"):
-        gj.make_cutter(1.0, 20.0, 2.0, "convex")
+        gj.hypoid.make_cutter(1.0, 20.0, 2.0, "convex")

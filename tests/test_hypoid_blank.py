@@ -163,7 +163,7 @@ FLOOR = dict(rtol=5e-11, atol=5e-11)
 def test_jit_matches_eager_and_no_nans():
     inp = BlankInput.from_dict(dict(SAMPLE2, method="tangent-cones"))
     a = blank_geometry(inp)
-    b = jax.jit(lambda i: blank_geometry(i, strict=False))(inp)
+    b = jax.jit(lambda i: blank_geometry(i, throw=False))(inp)
     for n, _, _ in hb.OUTPUTS:
         if n == "machine_tilt":
             continue
@@ -235,7 +235,7 @@ def test_non_convergence_strict_and_flag():
     inp = BlankInput.from_dict(dict(SAMPLE2, method="tangent-cones", cutter_radius_mm=2.0))
     with pytest.raises(ConvergenceError):
         blank_geometry(inp)
-    b = blank_geometry(inp, strict=False)
+    b = blank_geometry(inp, throw=False)
     assert float(b.converged) == 0.0
 
 
@@ -248,7 +248,7 @@ def test_pytree_registration():
     # reverse mode over the whole pytree (Method 0: closed forms, cheap to compile;
     # Newton-based routes are differentiated in the sensitivity tests)
     inp0 = BlankInput.from_dict(dict(SAMPLE2, method="iso23509-method0", offset_mm=0.0))
-    g = jax.grad(lambda i: blank_geometry(i, strict=False).dae1)(inp0)
+    g = jax.grad(lambda i: blank_geometry(i, throw=False).dae1)(inp0)
     assert isinstance(g, BlankInput)
     assert all(np.isfinite(v) for v in jax.tree_util.tree_leaves(g))
     # d(dae1)/d(de2) at fixed angles: outer pitch diameters scale with d_e2 (de1 = de2 z1/z2)
@@ -261,7 +261,7 @@ def test_cutter_too_small_for_face_width_is_a_value_error():
     inp = BlankInput.from_dict(dict(SAMPLE2, cutter_radius_mm=20.0))
     with pytest.raises(ValueError, match="cutter_radius_mm = 20"):
         blank_geometry(inp)
-    b = blank_geometry(inp, strict=False)
+    b = blank_geometry(inp, throw=False)
     assert float(b.converged) == 1.0 and np.isnan(float(b.beta_e2))
 
 

@@ -242,7 +242,7 @@ def test_strict_raises_and_masks(design):
                                                               radial_distance=jnp.asarray(400.0)))
     with pytest.raises(ConvergenceError, match="did not converge"):
         flank_surface(bad, 3, 3)
-    g = flank_surface(bad, 3, 3, strict=False)
+    g = flank_surface(bad, 3, 3, throw=False)
     assert not bool(np.any(g.converged))
 
 

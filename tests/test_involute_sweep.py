@@ -100,7 +100,7 @@ def test_refusal_exactly_at_the_undercut_limit():
 
 def _accepts(z1, z2, alpha, beta, x1, x2):
     try:
-        gj.InvolutePair.create(z1, z2, 1.0, alpha, beta, x1, x2)
+        gj.involute.InvolutePair.create(z1, z2, 1.0, alpha, beta, x1, x2)
         return True
     except ValueError:
         return False
@@ -115,7 +115,7 @@ def test_signed_roll_derivative_is_finite_at_and_inside_the_base_circle():
     import jax
     import jax.numpy as jnp
     from gearjax.gears.involute.limits import flank_limits, signed_roll
-    des = gj.InvoluteTCA.create(gj.InvolutePair.create(25, 41, 2.0, 20.0), 20.0)
+    des = gj.involute.InvoluteTCA.create(gj.involute.InvolutePair.create(25, 41, 2.0, 20.0), 20.0)
     lim, _, _ = flank_limits(des)
     rb = float(lim.rb)
 

@@ -152,7 +152,7 @@ def test_atomic_write_keeps_old_file_on_failure(tmp_path, monkeypatch, gear_grid
     def boom(src, dst):
         raise OSError("disk full")
 
-    monkeypatch.setattr(io.os, "replace", boom)
+    monkeypatch.setattr(io.files.os, "replace", boom)
     with pytest.raises(OSError, match="disk full"):
         write_csv(p, gear_grids["convex"])
     assert p.read_text() == "old content\n"

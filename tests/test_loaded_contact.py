@@ -1,4 +1,4 @@
-"""Load sharing between tooth pairs (gearjax.loaded_contact) against closed forms.
+"""Load sharing between tooth pairs (gearjax.loading.loaded_contact) against closed forms.
 
 References: equal pairs share equally (textbook double contact); linear springs in
 parallel with a gap; the Hertz point-contact approach delta = c F^(2/3) alone;
@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from gearjax.contact import hertz_exact
-from gearjax.loaded_contact import BALANCE_TOL, force_from_approach, pair_arrays, share_torque
+from gearjax.loading.loaded_contact import (BALANCE_TOL, force_from_approach, pair_arrays,
+                                            share_torque)
 
 T1 = 2.0e5          # N mm
 L1, L2 = 30.0, 60.0  # lever arms, mm

@@ -8,7 +8,7 @@
   the fall-back lies between the linear (1/E) and the Hertz (E'^(-2/3)) scalings;
 * ``--E-prime-MPa`` overrides the file with the file's nu (E = E'(1 - nu^2)): the same
   numbers as a file with that E; the JSON names the source;
-* the command and ``gearjax.mesh_efficiency`` give the same eta_bar (one default
+* the command and ``gearjax.loading.mesh_efficiency`` give the same eta_bar (one default
   compliance model);
 * concrete inputs typed in the wrong unit are refused in one line before any work,
   traced ones are not checked.
@@ -31,8 +31,8 @@ import pytest
 
 import gearjax as gj
 from gearjax.cli import main
-from gearjax.materials import SOURCE_DESIGN, SOURCE_DEFAULT, reduced_modulus
-from gearjax.mesh_efficiency import check_efficiency_inputs, mesh_efficiency_traced
+from gearjax.loading.materials import SOURCE_DESIGN, SOURCE_DEFAULT, reduced_modulus
+from gearjax.loading.mesh_efficiency import check_efficiency_inputs, mesh_efficiency_traced
 
 EX = "example:vh_catt_17x23"
 T, RPM = 100.0, 1000.0
@@ -47,7 +47,7 @@ def vh():
 
 @pytest.fixture(scope="module")
 def oil_surface():
-    return gj.get_oil("mineral_vg100"), gj.make_surface(0.4)
+    return gj.tribology.get_oil("mineral_vg100"), gj.tribology.make_surface(0.4)
 
 
 def _with_E(design, E_GPa):
@@ -82,9 +82,9 @@ def test_pair_material_precedence(vh):
     o = gj.pair_material(vh, 300000.0, override_source="--E-prime-MPa")
     assert o.source == "--E-prime-MPa" and o.poisson == 0.3
     assert float(o.e_prime_MPa) == pytest.approx(300000.0, rel=1e-15)
-    spur = gj.InvoluteTCA.create(gj.InvolutePair.create(20, 40, 4.0, 20.0), 30.0)
+    spur = gj.involute.InvoluteTCA.create(gj.involute.InvolutePair.create(20, 40, 4.0, 20.0), 30.0)
     s = gj.pair_material(spur)
-    assert s == gj.STEEL_MATERIAL and s.source == SOURCE_DEFAULT
+    assert s == gj.loading.STEEL and s.source == SOURCE_DEFAULT
     assert float(s.e_prime_MPa) == pytest.approx(gj.tribology.STEEL_E_PRIME, rel=1e-12)
 
 
@@ -119,7 +119,7 @@ def test_cli_equals_python_and_reports_the_material(runs):
     file's nu, giving exactly the run of a file with E = E'(1 - nu^2)."""
     rc, out, _ = _cli(CLI)
     assert rc == 0
-    assert out["input"]["compliance"] == gj.DEFAULT_COMPLIANCE == "weber"
+    assert out["input"]["compliance"] == gj.loading.DEFAULT_COMPLIANCE == "weber"
     assert out["input"]["material_source"] == SOURCE_DESIGN
     assert out["input"]["E_prime_MPa"] == pytest.approx(203000.0 / 0.91, rel=1e-15)
     assert out["input"]["youngs_modulus_MPa"] == 203000.0 and out["input"]["poisson"] == 0.3
@@ -159,8 +159,8 @@ def test_wrong_units_refused_in_one_line_before_any_work(vh, oil_surface, monkey
     oil, surf = oil_surface
     def forbidden(*a, **k):
         raise AssertionError("work started on bad input")
-    monkeypatch.setattr(gj.family_of(vh), "run", forbidden)
-    monkeypatch.setattr(gj.family_of(vh), "mesh", forbidden)
+    monkeypatch.setattr(gj.tca.family_of(vh), "run", forbidden)
+    monkeypatch.setattr(gj.tca.family_of(vh), "mesh", forbidden)
     args = dict(design=vh, torque_Nm=T, pinion_rpm=RPM, oil=oil, surface=surf, E_prime=None)
     if case == "pressure_angle_deg":
         args["design"] = dataclasses.replace(vh.pair, pressure_angle=jnp.asarray(20.0))
@@ -209,7 +209,7 @@ def test_one_compliance_sentence_in_readme_help_and_docstring():
         readme = norm(fh.read())
     sub = build_parser()._subparsers._group_actions[0].choices["efficiency"]
     helptext = norm(sub.format_help())
-    sentence = norm(gj.COMPLIANCE_HELP)
+    sentence = norm(gj.loading.COMPLIANCE_HELP)
     assert sentence in readme and sentence in helptext
     assert sentence in norm(gj.mesh_efficiency.__doc__)
     comp = [a for a in sub._actions if a.dest == "compliance"][0]
@@ -224,7 +224,7 @@ def test_one_compliance_sentence_in_readme_help_and_docstring():
 def test_hand_built_hypoid_pair_checked_before_work(field, words):
     """A HypoidPair built by hand with degrees in a radian field is refused by
     run_tca / tca_function in one line, as make_cutter and the design file would."""
-    pair = gj.pair_flanks(gj.load_design("example:spiral_bevel_10x30"), "drive")
+    pair = gj.hypoid.pair_flanks(gj.load_design("example:spiral_bevel_10x30"), "drive")
     gj.check_design(pair)                                    # the loader's pair passes
     if field == "blade_angle":
         cut = dataclasses.replace(pair.pinion.cutter, blade_angle=jnp.asarray(20.0))
@@ -245,7 +245,7 @@ def test_operating_point_accepts_its_documented_range():
     and one step outside either end is refused in one line naming the parameter.
     Planted bugs caught: a range narrowed below the documented one (a legitimate
     high-speed point refused), an open end."""
-    from gearjax.efficiency_inputs import check_operating_point
+    from gearjax.loading.efficiency_inputs import check_operating_point
     for T, n in ((1e-3, 1e-3), (200.0, 1500.0), (50.0, 3.0e4), (5.0, 1.2e5), (1e6, 1e6)):
         assert check_operating_point(T, n) == (T, n)
     for T, n, name in ((0.5e-3, 1500.0, "torque_Nm"), (2e6, 1500.0, "torque_Nm"),

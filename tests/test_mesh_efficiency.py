@@ -1,4 +1,4 @@
-"""Mesh efficiency of a spur pair (gearjax.mesh_efficiency) against independent routes.
+"""Mesh efficiency of a spur pair (gearjax.loading.mesh_efficiency) against independent routes.
 
 * load sharing of the textbook: equal pairs share the load 50/50 in double contact
   and carry it alone in single contact; the double-contact part of the cycle is
@@ -24,9 +24,10 @@ import pytest
 import gearjax as gj
 from gearjax.gears.involute.geometry import pair_geometry
 from gearjax.gears.involute.mesh import ohlendorf_loss_factor
-from gearjax.loaded_contact import BALANCE_TOL
-from gearjax.mesh_efficiency import efficiency_warnings, mesh_efficiency, mesh_efficiency_traced
-from gearjax.tooth_compliance import iso6336_mesh_stiffness, iso6336_single_stiffness
+from gearjax.loading.loaded_contact import BALANCE_TOL
+from gearjax.loading.efficiency_checks import efficiency_warnings
+from gearjax.loading.mesh_efficiency import mesh_efficiency, mesh_efficiency_traced
+from gearjax.loading.pair_stiffness import iso6336_mesh_stiffness, iso6336_single_stiffness
 
 Z1, Z2, M, B = 20, 40, 4.0, 30.0
 TORQUE, RPM = 200.0, 1500.0
@@ -34,13 +35,13 @@ TORQUE, RPM = 200.0, 1500.0
 
 @pytest.fixture(scope="module")
 def spur():
-    pair = gj.InvolutePair.create(Z1, Z2, M, 20.0)
-    return pair, gj.InvoluteTCA.create(pair, B)
+    pair = gj.involute.InvolutePair.create(Z1, Z2, M, 20.0)
+    return pair, gj.involute.InvoluteTCA.create(pair, B)
 
 
 @pytest.fixture(scope="module")
 def oil_surface():
-    return gj.get_oil(gj.OILS[0]), gj.make_surface(0.4)
+    return gj.tribology.get_oil(gj.tribology.OILS[0]), gj.tribology.make_surface(0.4)
 
 
 @pytest.fixture(scope="module")
@@ -59,9 +60,9 @@ def test_one_loaded_program_for_every_tooth_pair(spur, oil_surface, weber_run):
     20/40 run compiled, and its result is that pair's (eta_bar differs, all positions of
     a conjugate pair valid).  Planted bug caught: tooth numbers static again (one
     program per pair: the suite and every sweep pay a compilation per design)."""
-    from gearjax.mesh_efficiency import _post_jit
+    from gearjax.loading.mesh_efficiency import _post_jit
     n0 = _post_jit._cache_size()
-    other = gj.InvoluteTCA.create(gj.InvolutePair.create(12, 24, 3.0, 20.0, 0.0, 0.6, 0.36), 20.0)
+    other = gj.involute.InvoluteTCA.create(gj.involute.InvolutePair.create(12, 24, 3.0, 20.0, 0.0, 0.6, 0.36), 20.0)
     eff, _ = mesh_efficiency(other, TORQUE, RPM, *oil_surface, compliance="weber")
     assert _post_jit._cache_size() == n0
     assert int(eff.n_valid) == eff.valid.shape[0]
@@ -70,7 +71,7 @@ def test_one_loaded_program_for_every_tooth_pair(spur, oil_surface, weber_run):
     # the same pair through its own fresh program (the static route) gives the same result
     # the same pair through a program of its own with the tooth numbers as Python ints
     # (the static route the traced one replaced)
-    ad = gj.family_of(other)
+    ad = gj.tca.family_of(other)
     opts = dict(ad.defaults)
     teeth_of, pair, run_des = ad.mesh(other, **opts)
     res = ad.run(run_des, None, **opts, kinematics=True)
@@ -109,8 +110,8 @@ def test_textbook_load_sharing_and_balance(spur, iso_run):
 def test_sliding_speed_closed_form(spur, iso_run):
     eff, res = iso_run
     geo = pair_geometry(spur[0])
-    from gearjax.loaded_contact import pair_arrays
-    from gearjax.mesh_efficiency import cycle_window
+    from gearjax.loading.loaded_contact import pair_arrays
+    from gearjax.loading.mesh_efficiency import cycle_window
     n = res.path.phi1.shape[0]
     spp = eff.phi1.shape[0]
     win = cycle_window(n, spp)
@@ -156,17 +157,17 @@ def test_weber_mean_mesh_stiffness_against_iso6336(spur, weber_run):
 def test_weber_single_contact_approach_is_the_path_model(spur, weber_run):
     """Weber/Sainsot through the whole loaded chain: in single contact the one loaded
     pair carries F = T1 / r_b1 and its approach is q F, q the stand-alone path model
-    of gearjax.tooth_compliance (per unit width, mm^2/N) over the face width at the
+    of gearjax.loading.tooth_compliance (per unit width, mm^2/N) over the face width at the
     roll distance of the contact (hand, from the contact radius) and the load per
     unit face width F / b.  Planted bugs caught: the nominal line load not taken per
     unit width (it enters the contact term's logarithm), the face width missing
     from q."""
-    from gearjax.tooth_compliance import pair_compliance as path_compliance
+    from gearjax.loading.pair_stiffness import pair_compliance as path_compliance
     eff, res = weber_run
     geo = pair_geometry(spur[0])
     rb1, rho_P = float(geo["rb1"]), float(geo["rho_P"])
-    from gearjax.loaded_contact import pair_arrays
-    from gearjax.mesh_efficiency import cycle_window
+    from gearjax.loading.loaded_contact import pair_arrays
+    from gearjax.loading.mesh_efficiency import cycle_window
     spp = eff.phi1.shape[0]
     win = cycle_window(res.path.phi1.shape[0], spp)
     r1 = np.asarray(pair_arrays(res.path.radial1, spp, 3, np.nan, win))
@@ -217,9 +218,9 @@ def test_loaded_edge_contact_is_flagged_and_not_valid(spur, oil_surface, weber_r
     assert not np.any(np.asarray(eff0.edge_loaded))
     mis = gj.Misalignment.create(dSigma_deg=0.05)
     eff, res = mesh_efficiency(spur[1], TORQUE, RPM, *oil_surface, compliance="weber",
-                               misalignment=mis, strict=False)
-    from gearjax.loaded_contact import pair_arrays
-    from gearjax.mesh_efficiency import cycle_window
+                               misalignment=mis, throw=False)
+    from gearjax.loading.loaded_contact import pair_arrays
+    from gearjax.loading.mesh_efficiency import cycle_window
     spp = eff.phi1.shape[0]
     win = cycle_window(res.path.phi1.shape[0], spp)
     edge_pairs = np.asarray(pair_arrays(res.edge_points, spp, 3, False, win))
@@ -247,10 +248,10 @@ def test_tip_contact_ahead_of_the_loaded_gear_is_flagged(spur, oil_surface, webe
     is valid.  Same compiled programs as ``weber_run`` (the mismatch is a traced field
     of the design).  Planted bug caught: the sign of the 'pressed by the loaded gear'
     test (an edge contact behind the loaded gear flagged, the one it presses not)."""
-    from gearjax.loaded_contact import pair_arrays
-    from gearjax.mesh_efficiency import cycle_window
-    des = gj.InvoluteTCA.create(spur[0], B, dalpha_deg=dalpha)
-    eff, res = mesh_efficiency(des, TORQUE, RPM, *oil_surface, compliance="weber", strict=False)
+    from gearjax.loading.loaded_contact import pair_arrays
+    from gearjax.loading.mesh_efficiency import cycle_window
+    des = gj.involute.InvoluteTCA.create(spur[0], B, dalpha_deg=dalpha)
+    eff, res = mesh_efficiency(des, TORQUE, RPM, *oil_surface, compliance="weber", throw=False)
     spp = eff.phi1.shape[0]
     win = cycle_window(res.path.phi1.shape[0], spp)
     te_surface = np.asarray(pair_arrays(jnp.where(res.on_flank, res.path.te, -jnp.inf), spp, 3,
@@ -307,7 +308,7 @@ def traced_spur(spur, oil_surface, iso_run):
     oil = dataclasses.replace(oil, name="")
     _, res = iso_run
     des = spur[1]
-    teeth_of = gj.family_of(des).mesh(des)[0]
+    teeth_of = gj.tca.family_of(des).mesh(des)[0]
 
     def full(v):
         T, sigma, eta0, a, b, c, d = v
@@ -375,7 +376,7 @@ def test_cycle_summary_over_valid_positions_only():
     eta_bar towards 100 %: 0.95 instead of 0.90), invalid or unloaded contacts in mean
     mu / max p_max / loaded TE, and a silent number (instead of NaN) when nothing is
     valid."""
-    from gearjax.mesh_efficiency import cycle_summary
+    from gearjax.loading.mesh_efficiency import cycle_summary
     P_in = 100.0
     P_f = jnp.array([10.0, 0.0, 10.0, 0.0])          # positions 1, 3 carry no modelled load
     load = jnp.array([[100.0, 0.0, 50.0, 0.0], [0.0, 0.0, 50.0, 0.0]])
@@ -408,7 +409,8 @@ def test_efficiency_guard_cannot_be_raised_by_invalidating_positions(iso_run):
     run's arrays.  Planted bugs caught: a lost position dropped from the mean (guard
     rises), counted at P_f = 0 (guard rises to ~1), a mean over the current valid set
     instead of the fixed nominal one, n_lost counting positions outside V0."""
-    from gearjax.mesh_efficiency import cycle_summary, efficiency_guard
+    from gearjax.loading.mesh_efficiency import cycle_summary
+    from gearjax.loading.efficiency_checks import efficiency_guard
     eff, _ = iso_run
     v0 = np.asarray(eff.valid)
     P_f, P_in = np.asarray(eff.power_loss, float), float(eff.power_in)
@@ -444,8 +446,8 @@ def test_plausibility_thresholds_on_synthetic_positions():
     failing one check each).  Planted bugs caught: a check dropped or with a flipped
     comparison, eta = 0 or eta > 1 accepted, an unloaded contact's value counted, a
     NaN passing, a deflection limit not scaled by the pitch."""
-    from gearjax.mesh_efficiency import (DEFLECTION_MAX_PITCH, HERTZ_SIZE_MAX, MU_MAX,
-                                         P_MAX_LIMIT_MPA, plausibility)
+    from gearjax.loading.efficiency_checks import (DEFLECTION_MAX_PITCH, HERTZ_SIZE_MAX, MU_MAX,
+                                                   P_MAX_LIMIT_MPA, plausibility)
     pitch = 2 * np.pi / 20
     eta = jnp.array([0.99, 1.0, 0.0, 1.0 + 1e-12, 0.98, 0.98, 0.98, np.nan])
     load = jnp.array([[1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0],
@@ -474,7 +476,8 @@ def test_implausible_results_are_flagged_and_not_valid(spur, iso_run):
     check naming the threshold; a film below FILM_MIN_MM warns.  Planted bugs caught:
     a check that never fires on a real result's fields (wrong field, wrong axis), a
     warning line without the value."""
-    from gearjax.mesh_efficiency import FILM_MIN_MM, MU_MAX, P_MAX_LIMIT_MPA
+    from gearjax.loading.mesh_efficiency import FILM_MIN_MM
+    from gearjax.loading.efficiency_checks import MU_MAX, P_MAX_LIMIT_MPA
     eff, res = iso_run
     assert all("implausible" not in w for w in efficiency_warnings(eff, res))
     fr = eff.friction._replace(mu=eff.friction.mu * 100.0, h_c=eff.friction.h_c * 0 + 1e-6)
@@ -529,7 +532,7 @@ def test_efficiency_function_is_mesh_efficiency_as_a_pure_function(spur, oil_sur
     des = spur[1]
     f = gj.efficiency_function(des, E_prime=1.5 * STEEL_E_PRIME)
     assert f.material.e_prime_MPa == pytest.approx(1.5 * STEEL_E_PRIME)
-    assert f.options["compliance"] == gj.DEFAULT_COMPLIANCE
+    assert f.options["compliance"] == gj.loading.DEFAULT_COMPLIANCE
     got, res = jax.jit(lambda p, T: f(p, T, RPM, oil, surf))(f.pair, jnp.asarray(TORQUE))
     want, res_w = mesh_efficiency(des, TORQUE, RPM, oil, surf, E_prime=1.5 * STEEL_E_PRIME)
     for name in ("mean_efficiency", "mean_mu", "te_loaded_ptp"):
@@ -545,9 +548,9 @@ def test_efficiency_function_is_mesh_efficiency_as_a_pure_function(spur, oil_sur
     # the loaded chain runs on the grid the family picks for the design (no compile
     # here): a 40/80, 14.5 deg pair (contact ratio 2.16, its path reaching 1.1 pitches
     # from the pitch point) gets 2 pitches and 5 pairs, as in gearjax.run_tca
-    high = gj.InvoluteTCA.create(gj.InvolutePair.create(40, 80, 1.5, 14.5), 20.0)
+    high = gj.involute.InvoluteTCA.create(gj.involute.InvolutePair.create(40, 80, 1.5, 14.5), 20.0)
     g = gj.efficiency_function(high)
     assert (g.options["half_pitches"], g.options["n_pairs"]) == (2.0, 5)
     assert g.options["line_contact"] is True
     for k in ("steps_per_pitch", "half_pitches", "n_pairs", "line_contact"):
-        assert g.options[k] == gj.family_of(high).resolve(high, {})[k], k
+        assert g.options[k] == gj.tca.family_of(high).resolve(high, {})[k], k

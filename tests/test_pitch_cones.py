@@ -174,7 +174,7 @@ def test_jacobian_matches_central_differences():
 
     @jax.jit
     def f(x):
-        s = pc.solve_pitch_cones(x[1], D(90.0), x[0], x[2], x[3], x[5], x[4], strict=False)
+        s = pc.solve_pitch_cones(x[1], D(90.0), x[0], x[2], x[3], x[5], x[4], throw=False)
         return jnp.stack([s.delta1, s.delta2, s.beta2, s.alpha_lim, s.R1, s.R2, s.a1, s.a2,
                           s.theta1, s.theta2])
 
@@ -196,7 +196,7 @@ def test_non_convergence_raises_or_flags():
     u, S, E, de2, b2, beta, rc0 = CASES[0]
     with pytest.raises(ConvergenceError):
         pc.solve_pitch_cones(u, S, E, de2, b2, beta, 2.0)
-    sol = pc.solve_pitch_cones(u, S, E, de2, b2, beta, 2.0, strict=False)
+    sol = pc.solve_pitch_cones(u, S, E, de2, b2, beta, 2.0, throw=False)
     assert not bool(sol.converged)
 
 

@@ -137,7 +137,7 @@ def test_flank_contains_curve_with_arc_profile(des, member):
     np.testing.assert_allclose(P[2], r, atol=1e-13)                       # u = 0 on the curve
     np.testing.assert_allclose(np.linalg.norm(P - centre, axis=1), rho, rtol=1e-13)
     np.testing.assert_allclose(np.asarray(P - r) @ np.asarray(al), 0.0, atol=1e-12)  # normal plane
-    nu = gj.local_geometry(jax.tree_util.Partial(fn, c), jnp.stack([0.0, t])).n
+    nu = gj.surfaces.local_geometry(jax.tree_util.Partial(fn, c), jnp.stack([0.0, t])).n
     assert abs(abs(float(jnp.dot(nu, n))) - 1.0) < 1e-13                # surface normal = n
 
 
@@ -169,17 +169,17 @@ def test_design_file_validation_names_key():
     with pytest.raises(ValueError, match="face_width"):
         read_preset_bevel(bad)
     f = gj.design_from_dict(data)
-    assert isinstance(f, gj.PresetBevelFile) and f.teeth("gear") == 30
-    assert gj.family_of(f).family == "preset_bevel"
+    assert isinstance(f, gj.preset_bevel.PresetBevelFile) and f.teeth("gear") == 30
+    assert gj.tca.family_of(f).family == "preset_bevel"
 
 
 def test_constructor_matches_design_file(des):
-    d = gj.PresetBevelDesign.create(z1=10, z2=30, beta_deg=35, alpha_n_deg=20, shaft_angle_deg=90,
+    d = gj.preset_bevel.PresetBevelDesign.create(z1=10, z2=30, beta_deg=35, alpha_n_deg=20, shaft_angle_deg=90,
                                     module_t=7, face_width=30, rho1=16, rho2=16, addendum=4.5,
                                     dedendum=4.5, preset_te_arcsec=36)
     for a, b in zip(jax.tree_util.tree_leaves(d), jax.tree_util.tree_leaves(des)):
         assert float(a) == float(b)
     with pytest.raises(ValueError, match="beta"):
-        gj.PresetBevelDesign.create(z1=10, z2=30, beta_deg=70, alpha_n_deg=20,
+        gj.preset_bevel.PresetBevelDesign.create(z1=10, z2=30, beta_deg=70, alpha_n_deg=20,
                                     shaft_angle_deg=90, module_t=7, face_width=30, rho1=16,
                                     rho2=16, addendum=4.5, dedendum=4.5)

@@ -21,8 +21,8 @@ from gearjax.gears.preset_bevel import analysis as A
 from gearjax.gears.preset_bevel import geometry as G
 from gearjax.gears.preset_bevel.pair import preset_assembly, reference_contact, side_flanks
 from gearjax.gears.preset_bevel.tca import preset_result_traced
-from gearjax.tca import gear_mount
-from gearjax.tca_result import strong_float64
+from gearjax.tca.assembly import gear_mount
+from gearjax.tca.result import strong_float64
 
 OPTS = dict(steps_per_pitch=16, half_pitches=1.0, n_pairs=3, kinematics=False)
 EX = "example:preset_te_bevel_10x30"
@@ -41,8 +41,8 @@ def runs(des):
             "plain_coast": gj.run_tca(plain, side="coast", **OPTS),
             "mod": gj.run_tca(des, side="drive", **OPTS),
             "mod_coast": gj.run_tca(des, side="coast", **OPTS),
-            "plain_dG": gj.run_tca(plain, dg, side="drive", strict=False, **OPTS),
-            "mod_dG": gj.run_tca(des, dg, side="drive", strict=False, **OPTS)}
+            "plain_dG": gj.run_tca(plain, dg, side="drive", throw=False, **OPTS),
+            "mod_dG": gj.run_tca(des, dg, side="drive", throw=False, **OPTS)}
 
 
 def test_cost_of_the_preset_bevel_tca(runs):
@@ -144,7 +144,7 @@ def test_summary_is_the_result_at_the_reference(runs):
 
 @pytest.mark.parametrize("fn", ["run_tca", "tca_function", "tca_sensitivity"])
 def test_options_are_checked_by_the_one_driver(des, fn):
-    """The family runs through the one TCA driver (gearjax.family): an unknown option
+    """The family runs through the one TCA driver (gearjax.tca.family): an unknown option
     or a contact mode the family does not have is a one-line ValueError naming it,
     before any work, in every entry point (before the driver the family's adapter
     dropped both silently); an option given as None takes the family default."""
@@ -156,7 +156,7 @@ def test_options_are_checked_by_the_one_driver(des, fn):
         call(des, line_contact=True)
     with pytest.raises(ValueError, match=r"steps_per_pitch"):
         call(des, steps_per_pitch=1)
-    assert gj.family_of(des).resolve(des, {"half_pitches": None})["half_pitches"] == 1.0
+    assert gj.tca.family_of(des).resolve(des, {"half_pitches": None})["half_pitches"] == 1.0
 
 def test_cli_tca_and_surface(des, runs, tmp_path, capsys):
     assert main(["tca", EX, "--positions", "41", "--pitches", "1", "--json"]) == 0
@@ -240,7 +240,7 @@ def test_misaligned_pair_touches_at_a_face_end(des, surface_only, case):
     the edge tangent lies in the mating tangent plane; the surface contact (no edge
     solve) lies off the flanks there, and the TE envelope takes the edge contact."""
     mis = EDGE_CASES[case]
-    res = gj.run_tca(des, mis, side="drive", strict=False, **OPTS)
+    res = gj.run_tca(des, mis, side="drive", throw=False, **OPTS)
     ref, _ = surface_only(des, mis)
     p = res.path
     kind = np.asarray(p.edge_kind)

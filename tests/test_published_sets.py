@@ -69,7 +69,7 @@ def test_khk_examples_are_conjugate_with_the_iso21771_contact_ratios(name):
 
 def test_design_file_and_its_pytree_give_identical_tca():
     f = gj.load_design("example:khk_helical_12x60")
-    assert isinstance(f, gj.InvoluteFile) and isinstance(f.design, gj.InvoluteTCA)
+    assert isinstance(f, gj.involute.InvoluteFile) and isinstance(f.design, gj.involute.InvoluteTCA)
     r_file, r_tree = gj.run_tca(f, side="coast"), gj.run_tca(f.design, side="coast")
     for a, b in ((r_file.path.te, r_tree.path.te), (r_file.path.point, r_tree.path.point)):
         np.testing.assert_array_equal(np.asarray(a), np.asarray(b))
@@ -78,7 +78,7 @@ def test_design_file_and_its_pytree_give_identical_tca():
     # through the same adapter (the file adapter takes a pytree as is)
     # (the spur example: the loaded contact of a helical pair in line contact is refused)
     spur = gj.load_design("example:khk_spur_12x24")
-    ad = gj.family_of(spur)
+    ad = gj.tca.family_of(spur)
     _, _, run_des = ad.mesh(spur, side="coast")
     assert run_des is spur.design
     np.testing.assert_array_equal(np.asarray(ad.run(run_des, side="coast").path.te),
@@ -129,8 +129,8 @@ def test_involute_design_file_defaults_are_listed():
 
 def test_involute_design_file_material_sets_e_prime():
     """An involute file's optional [material] is the design's material (E' and the tooth
-    compliance, gearjax.materials); without it the documented steel default applies."""
-    from gearjax.materials import SOURCE_DEFAULT, SOURCE_DESIGN
+    compliance, gearjax.loading.materials); without it the documented steel default applies."""
+    from gearjax.loading.materials import SOURCE_DEFAULT, SOURCE_DESIGN
     f = gj.load_design("example:khk_spur_12x24")
     assert f.material() is None and gj.pair_material(f).source == SOURCE_DEFAULT
     data = f.to_dict()

@@ -32,11 +32,11 @@ from scipy.optimize import brentq
 from scipy.special import ellipe, ellipk
 
 import gearjax as gj
-from gearjax.loaded_contact import (MeshTeeth, contact_stress, hertz_coefficient, lever_arms,
-                                    pair_compliance, share_torque)
-from gearjax.tca import pair_arrays
-from gearjax.tooth_compliance import (iso6336_mesh_stiffness, iso6336_single_stiffness,
-                                      pair_compliance as path_pair_compliance)
+from gearjax.loading.loaded_contact import (MeshTeeth, contact_stress, hertz_coefficient,
+                                            lever_arms, pair_compliance, share_torque)
+from gearjax.tca.path import pair_arrays
+from gearjax.loading.pair_stiffness import (iso6336_mesh_stiffness, iso6336_single_stiffness,
+                                            pair_compliance as path_pair_compliance)
 
 E_STEEL, NU = 206000.0, 0.3
 E_PRIME = 2.0 / (2.0 * (1.0 - NU ** 2) / E_STEEL)       # Hamrock's E' = 2 E*, steel/steel
@@ -126,7 +126,7 @@ def _hand_equilibrium(T1, g, l1, l2, q, c):
 
 
 # ---------------------------------------------------------------------------------
-# load sharing by hand (gearjax.loaded_contact.share_torque)
+# load sharing by hand (gearjax.loading.loaded_contact.share_torque)
 # ---------------------------------------------------------------------------------
 
 T1 = 1.5e5                                   # N mm
@@ -287,7 +287,7 @@ def test_loaded_chain_iso_compliance_is_the_standard_over_the_width():
 
 def test_loaded_chain_weber_compliance_is_the_path_model_over_the_width():
     """The line-contact Weber compliance of the loaded chain (mm/N) equals the
-    stand-alone path model of gearjax.tooth_compliance (mm^2/N, per unit width) over
+    stand-alone path model of gearjax.loading.tooth_compliance (mm^2/N, per unit width) over
     the face width, at the same roll positions and load per unit width: two routes
     to the contact radii (hand involute geometry here, the path model there) and to
     the Hertz depths h = y_m / cos(alpha_m) of Weber's contact term."""
@@ -310,7 +310,7 @@ def test_loaded_chain_weber_compliance_is_the_path_model_over_the_width():
 
 
 # ---------------------------------------------------------------------------------
-# a spur pair through gearjax.mesh_efficiency (ISO compliance: constant along the path)
+# a spur pair through gearjax.loading.mesh_efficiency (ISO compliance: constant along the path)
 # ---------------------------------------------------------------------------------
 
 SZ1, SZ2, SM, SB = 20, 40, 4.0, 30.0
@@ -332,11 +332,11 @@ def _spur_hand(z1, z2, m=SM):
 
 @pytest.fixture(scope="module")
 def oil_surface():
-    return gj.get_oil(gj.OILS[0]), gj.make_surface(0.4)
+    return gj.tribology.get_oil(gj.tribology.OILS[0]), gj.tribology.make_surface(0.4)
 
 
 def _spur_run(z1, z2, torque, side, oil_surface):
-    des = gj.InvoluteTCA.create(gj.InvolutePair.create(z1, z2, SM, 20.0), SB)
+    des = gj.involute.InvoluteTCA.create(gj.involute.InvolutePair.create(z1, z2, SM, 20.0), SB)
     kw = {} if side is None else {"side": side}
     return gj.mesh_efficiency(des, torque, RPM, *oil_surface, compliance="iso6336", **kw)
 
@@ -359,7 +359,7 @@ def spur_swapped(oil_surface):
 
 def _per_pair(res, eff, arr, fill=np.nan):
     """Pair-0 grid quantity -> (K, M) values of the pairs at the cycle's positions."""
-    from gearjax.mesh_efficiency import cycle_window
+    from gearjax.loading.mesh_efficiency import cycle_window
     spp, K = eff.phi1.shape[0], eff.loaded.load.shape[0]
     win = cycle_window(res.path.phi1.shape[0], spp)
     return np.asarray(pair_arrays(jnp.asarray(arr), spp, K, fill, win))
@@ -476,7 +476,7 @@ def test_spur_power_balance_and_ohlendorf_by_hand(spur_drive):
     e2 = (h["rho_P"] - h["rho_A"]) / h["p_b"]
     H_V = math.pi * (u + 1.0) / (SZ1 * u) * (1.0 - h["eps"] + e1 ** 2 + e2 ** 2)
     from gearjax.gears.involute.mesh import ohlendorf_loss_factor
-    np.testing.assert_allclose(ohlendorf_loss_factor(gj.InvolutePair.create(SZ1, SZ2, SM, 20.0)),
+    np.testing.assert_allclose(ohlendorf_loss_factor(gj.involute.InvolutePair.create(SZ1, SZ2, SM, 20.0)),
                                H_V, rtol=1e-12)
     # the cycle mean of a piecewise-linear loss on 24 positions: within 2 % of the integral
     assert abs(P_lib.mean() / (H_V * P_in) - 1.0) < 0.02
@@ -598,7 +598,7 @@ def test_vh_catt_lever_arms_balances_and_approach_by_hand(vh_run):
     contact the approach is q F + delta_Hertz(F): q from the two teeth's compliance
     over the loaded width, delta_Hertz by scipy."""
     pair, (eff, res) = vh_run
-    from gearjax.tooth_compliance import tooth_compliance
+    from gearjax.loading.tooth_compliance import tooth_compliance
     z1, z2 = int(pair.z1), int(pair.z2)
     m, al, bw = float(pair.module), float(pair.pressure_angle), float(pair.face_width)
     F = np.asarray(eff.loaded.load)
@@ -644,7 +644,7 @@ def test_involute_mesh_teeth_by_hand():
     from types import SimpleNamespace
     from gearjax.gears.involute.mesh import involute_mesh_teeth
     z1, z2, m, an, bd, b, dad = 19, 53, 3.0, 20.0, 17.0, 24.0, 0.4
-    des = gj.InvoluteTCA.create(gj.InvolutePair.create(z1, z2, m, an, bd, 0.25, -0.1), b,
+    des = gj.involute.InvoluteTCA.create(gj.involute.InvolutePair.create(z1, z2, m, an, bd, 0.25, -0.1), b,
                                 dalpha_deg=dad, lead_crown=2e-4)
     beta, alpha_n = math.radians(bd), math.radians(an)
     alpha_t = math.atan(math.tan(alpha_n) / math.cos(beta))
@@ -664,7 +664,7 @@ def test_involute_mesh_teeth_by_hand():
     np.testing.assert_allclose(t.r_load[1], 0.5 * zn[1] * m + (path.radial2 - r2_ref), rtol=1e-12)
     np.testing.assert_allclose(t.width, [4.0, 15.0, 23.8, 24.0, 24.0], rtol=1e-14)
     assert t.line_length is None and bool(t.drive)
-    spur = gj.InvoluteTCA.create(gj.InvolutePair.create(z1, z2, m, an), b)
+    spur = gj.involute.InvoluteTCA.create(gj.involute.InvolutePair.create(z1, z2, m, an), b)
     t = involute_mesh_teeth(spur, SimpleNamespace(path=path), True, False)
     np.testing.assert_allclose(t.width, b, rtol=1e-14)
     np.testing.assert_allclose(t.line_length, b, rtol=1e-14)
@@ -746,7 +746,7 @@ def test_preset_bevel_loaded_contacts_by_hand(pb_run):
     Planted bugs caught: the virtual tooth height, dedendum or width slips of the
     preset mesh, a TE envelope with the wrong pitch (loads of the wrong pairs), Hertz
     of a wrong radius, the gear lever arm."""
-    from gearjax.tooth_compliance import tooth_compliance
+    from gearjax.loading.tooth_compliance import tooth_compliance
     des, (eff, res) = pb_run
     z1, z2 = des.z1, des.z2
     F = np.asarray(eff.loaded.load)

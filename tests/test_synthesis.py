@@ -17,7 +17,7 @@ from gearjax.gears.hypoid import synthesis as sy
 from gearjax.gears.hypoid import tca as th
 from gearjax.errors import ConvergenceError
 from gearjax.gears.hypoid.design_file import load_design
-from gearjax.tca import ARCSEC
+from gearjax.tca.path import ARCSEC
 
 
 @pytest.fixture(scope="module")
@@ -111,7 +111,7 @@ def test_residuals_and_jacobian_needs_all_variables(st, res):
 def test_not_converged_raises_unless_strict_false(st, res):
     with pytest.raises(ConvergenceError, match="step limit"):
         sy.synthesise(st, max_iter=1)
-    r = sy.synthesise(st, max_iter=1, strict=False)
+    r = sy.synthesise(st, max_iter=1, throw=False)
     assert not r.converged
     assert r.status == optimize.MAX_ITERATIONS and "step limit" in r.message
     assert r.iterations == 1 and len(r.history) == 2

@@ -12,7 +12,7 @@ from gearjax import optimize
 from gearjax.gears.hypoid import synthesis as sy
 from gearjax.gears.hypoid import tca as th
 from gearjax.gears.hypoid.design_file import load_design
-from gearjax.tca import ARCSEC
+from gearjax.tca.path import ARCSEC
 
 
 def test_generated_hypoid_gear_is_refused_as_start():
@@ -67,7 +67,7 @@ def test_shipped_hft_example_meshes_with_the_synthesised_te():
     import gearjax as gj
     d = load_design("example:hft_8x43_synthesised")
     r = gj.run_tca(d, side="drive", steps_per_pitch=6, half_pitches=1.5, n_pairs=3,
-                   strict=False)
+                   throw=False)
     conv, on = np.asarray(r.path.converged), np.asarray(r.on_flank)
     mid = len(conv) // 2
     assert conv[mid] and on.sum() >= 7 and conv[on].all()

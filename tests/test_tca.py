@@ -16,18 +16,19 @@ from cost_guard import check_cost
 import gearjax as gj
 from gearjax.errors import ConvergenceError
 from gearjax.gears.involute.geometry import InvolutePair, generated_flank, pair_geometry
-from gearjax.edge_contact import EDGE_NAMES
-from gearjax.tca import (ARCSEC, Misalignment, NoContactError, contact_path,
-                         ellipse_from_weingarten, multi_pair)
+from gearjax.tca.edge_contact import EDGE_NAMES
+from gearjax.tca.path import (ARCSEC, NoContactError, contact_path, ellipse_from_weingarten,
+                              multi_pair)
+from gearjax.tca.assembly import Misalignment
 from gearjax.gears.involute.tca import (InvoluteTCA, crowned_pinion_flank,
                                   misalignment_sensitivity, tca_summary, SUMMARY_KEYS)
 
 
-def involute_tca(des, mis=None, *, side=-1, strict=True):
+def involute_tca(des, mis=None, *, side=-1, throw=True):
     """``(path, margin, multi)`` of the involute TCA on the grid these tests were written
     for (1.25 pitches, 3 pairs; side code -1 drive, +1 coast) by the one entry point."""
     res = gj.run_tca(des, mis, side=side, half_pitches=1.25, n_pairs=3, kinematics=False,
-                     strict=strict)
+                     throw=throw)
     return res.path, res.margin, res.multi
 
 
@@ -386,7 +387,7 @@ def sensitivity(crowned):
 def test_misalignment_directions_of_crowned_spur_pair(sensitivity):
     """Directions and sizes of the V-H derivatives of the crowned spur pair (profile crown
     a = 0.002/mm, lead crown b = 0.001/mm, drive flank, at dSigma = 1e-4 rad), by first-
-    order geometry (mounting as defined in gearjax/tca.py: dE along d = +y away from the
+    order geometry (mounting as defined in gearjax/tca/path.py: dE along d = +y away from the
     pinion, dP / dG along the pinion / the (tilted) gear axis, dSigma right-handed about
     +y through the gear centre).
 
@@ -548,7 +549,7 @@ def _fixed_frame_contact(r1, r2, path, i, centre, R, dP):
 def test_misaligned_contact_points_coincide_in_the_fixed_frame(pair, crowned):
     """All four misalignments at once (dE 0.05, dP 0.1, dG -0.2 mm, dSigma 3e-4 rad) on the
     crowned (point-contact) pair: the pinion point and the gear point, each placed by
-    the mounting of gearjax/tca.py typed here (gear centre (0, a + dE, 0) + dG R e_z,
+    the mounting of gearjax/tca/path.py typed here (gear centre (0, a + dE, 0) + dG R e_z,
     R = Ry(dSigma) right-handed about d = +y), coincide and their normals are
     collinear (measured 5e-15 mm, 1e-15; tolerance 1e-9); the reported point is that
     point (9e-16 mm).  The bearing: axial1 = dSigma cos alpha/(2b) to 7.7e-4 (the dE, dP
@@ -599,7 +600,7 @@ def test_strict_mode_raises_when_the_flanks_do_not_touch(pair):
     mis = Misalignment.create(dE=40.0)
     with pytest.raises(NoContactError):
         involute_tca(des, mis)
-    path, margin, multi = involute_tca(des, mis, strict=False)
+    path, margin, multi = involute_tca(des, mis, throw=False)
     assert not np.any((np.asarray(margin) >= 0.0) & np.asarray(path.converged))
     assert issubclass(NoContactError, ConvergenceError)
 
@@ -636,7 +637,7 @@ def test_pinion_angle_grid_of_the_adapters():
     """The adapters' shared grid: 2 round(half_pitches steps_per_pitch) + 1 angles,
     step 2 pi/(z1 steps_per_pitch), centred on phi1_ref (exactly: the middle angle
     is phi1_ref + 0); phi1_ref may be traced (one program for any reference)."""
-    from gearjax.tca import pinion_angle_grid
+    from gearjax.tca.path import pinion_angle_grid
     g = np.asarray(pinion_angle_grid(0.3, 17, 8, 1.25))
     assert g.shape == (21,) and g[10] == 0.3
     np.testing.assert_allclose(np.diff(g), 2 * np.pi / (17 * 8), rtol=1e-12)
@@ -657,7 +658,7 @@ def test_points_continued_from_a_failed_reference_are_not_converged(pair):
     from it with the path's predictor, converge on their own in two steps."""
     from gearjax.gears.involute.tca import (crowned_pinion_flank, involute_assembly,
                                             reference_guess)
-    from gearjax.tca import pinion_angle_grid, relative_to_start
+    from gearjax.tca.path import pinion_angle_grid, relative_to_start
     des = InvoluteTCA.create(pair, 20.0)
     x_ref, phi1_ref, _ = reference_guess(des, -1, True)
     r1 = crowned_pinion_flank(des, -1, True)
@@ -686,7 +687,7 @@ def test_whole_gear_turns_are_taken_out_of_the_te():
     is the TE less 2 pi k and phi2 moves by ratio_sign 2 pi k (a KHK 12/24 spur pair at 8
     steps per pitch had tip-edge contacts at 50-150 rad of TE that 'led' the mesh; the
     end-to-end check is tests/test_cli_efficiency.py's packaged design file)."""
-    from gearjax.tca import whole_turns_removed
+    from gearjax.tca.path import whole_turns_removed
     te = jnp.array([3e-5, 2 * np.pi * 8 + 3e-5, -2 * np.pi * 3 - 1e-4, np.pi - 1e-3])
     ph2 = jnp.array([1.0, 1.0 - 16 * np.pi, 1.0 + 6 * np.pi, 0.5])
     for sign in (1.0, -1.0):

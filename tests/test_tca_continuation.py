@@ -1,4 +1,4 @@
-"""The continuation of gearjax.tca (one lax.scan over the pinion angles): every solve
+"""The continuation of gearjax.tca.path (one lax.scan over the pinion angles): every solve
 starts from the linear predictor of the two previous points of the path (the first
 from the tangent at the reference); a failed step keeps the previous solution and
 drops the predictor for the next step."""
@@ -7,7 +7,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax.tca import _solve_grid, path_tangent
+from gearjax.tca.path import _solve_grid, path_tangent
 
 
 def _F(x, phi):

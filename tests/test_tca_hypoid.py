@@ -14,7 +14,8 @@ import pytest
 
 from gearjax.gears.hypoid.design_file import load_design
 from gearjax.gears.hypoid import tca as th
-from gearjax.tca import ARCSEC, Misalignment, NoContactError
+from gearjax.tca.path import ARCSEC, NoContactError
+from gearjax.tca.assembly import Misalignment
 
 STEPS, HALF = 8, 1.5          # 25 grid positions, 1.5 pitches each side
 MID = int(round(STEPS * HALF))
@@ -55,7 +56,7 @@ def point_tca(conjugate):
 
 def test_crown_gear_complementary_pair_is_conjugate(conjugate):
     res = th.hypoid_tca(conjugate, line_contact=True, steps_per_pitch=STEPS, half_pitches=HALF,
-                        n_pairs=3, strict=False)
+                        n_pairs=3, throw=False)
     p = res.path
     assert bool(np.all(np.asarray(p.converged)))
     te = np.abs(np.asarray(p.te)) / ARCSEC
@@ -163,10 +164,10 @@ def test_a_prepared_pair_is_labelled_by_its_flanks(conjugate, coast):
             gj.run_tca(prep.pair, side=other)
         # the program of th.hypoid_tca (no kinematics), compiled by the tests above
         res = gj.run_tca(prep, line_contact=True, steps_per_pitch=STEPS, half_pitches=HALF,
-                         n_pairs=3, kinematics=False, strict=False)
+                         n_pairs=3, kinematics=False, throw=False)
         assert res.side == side and res.family == "hypoid"
     d = load_design("example:spiral_bevel_10x30")
-    fam = gj.family_of(d).fam
+    fam = gj.tca.family_of(d).fam
     for side in ("drive", "coast"):
         prep, found = fam.setup(d, side)
         assert found == side
@@ -193,7 +194,7 @@ def test_coast_complementary_pair_is_conjugate(conjugate, coast):
     assert coast.drive != conjugate.drive
     assert coast.pair.pinion.cutter.sign == -conjugate.pair.pinion.cutter.sign
     res = th.hypoid_tca(coast, line_contact=True, steps_per_pitch=STEPS, half_pitches=HALF,
-                        n_pairs=3, strict=False)
+                        n_pairs=3, throw=False)
     p = res.path
     on = np.asarray(res.margin) >= 0.0
     assert on.sum() >= 6 and bool(np.all(np.asarray(p.converged)))
@@ -301,7 +302,7 @@ def test_augmented_contact_system_equals_the_nested_solve(conjugate, point_tca):
     1e-13; tolerance 1e-9), and the path's psi are the flanks' envelope solves at the
     contact (measured 1e-15 rad)."""
     from gearjax.newton import newton_solve
-    from gearjax.tca import contact_equations
+    from gearjax.tca.path import contact_equations
     pair = _modified(conjugate, 2.0, 0.02)
     mis = Misalignment(*(jnp.asarray(v, float) for v in (0.05, 0.1, -0.1, 2e-4)))
     p = point_tca(pair, mis).path

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 import gearjax as gj
-from gearjax.tca import ContactPath, MultiPair
-from gearjax.tca_result import TCAResult, check_side
+from gearjax.tca.path import ContactPath, MultiPair
+from gearjax.tca.result import TCAResult, check_side
 
 Z1, Z2, M, ALPHA, B = 25, 41, 2.0, 20.0, 20.0
 
@@ -74,7 +74,7 @@ def test_contact_ratio_is_not_found_when_pair_0_leaves_before_it_enters():
     """multi_pair: pair 0 on the flanks at both ends of the grid and off between (edge
     contacts can do that): its first entry follows its last exit -- no contact ratio
     (NaN, flagged), not a negative one; one interval inside the grid gives its length."""
-    from gearjax.tca import multi_pair
+    from gearjax.tca.path import multi_pair
     phi = jnp.linspace(-1.0, 1.0, N)
     path = _result(np.ones(N), np.zeros((3, N)), np.ones((3, N), bool), [0.0, 0.0],
                    1.0).path._replace(phi1=phi)
@@ -118,8 +118,8 @@ def test_low_contact_ratio_and_off_flank_reference_and_failed_solve():
 
 @pytest.fixture(scope="module")
 def spur():
-    pair = gj.InvolutePair.create(Z1, Z2, M, ALPHA)
-    des = gj.InvoluteTCA.create(pair, B)
+    pair = gj.involute.InvolutePair.create(Z1, Z2, M, ALPHA)
+    des = gj.involute.InvoluteTCA.create(pair, B)
     return pair, {side: gj.run_tca(des, side=side, steps_per_pitch=12) for side in gj.SIDES}
 
 
@@ -131,7 +131,7 @@ def test_spur_kinematics_equal_the_line_of_action_closed_form(spur, side):
     alpha_wt), the effective radius ``rho1 rho2/(rho1 + rho2)``.  Pinion = member 1."""
     pair, res = spur
     r = res[side]
-    geo = gj.pair_geometry(pair)
+    geo = gj.involute.pair_geometry(pair)
     on = np.asarray(r.on_flank)
     assert on.sum() >= 8
     rho1 = np.sqrt(np.asarray(r.path.radial1) ** 2 - float(geo["rb1"]) ** 2)
@@ -158,7 +158,7 @@ def test_spur_result_quantities_and_flags(spur):
     for side, r in res.items():
         assert r.side == side and r.family == "involute"
         assert float(r.ptp) < 1e-3 * gj.ARCSEC                # conjugate: no TE
-        geo = gj.pair_geometry(gj.InvolutePair.create(Z1, Z2, M, ALPHA))
+        geo = gj.involute.pair_geometry(gj.involute.InvolutePair.create(Z1, Z2, M, ALPHA))
         assert abs(float(r.contact_ratio) - float(geo["contact_ratio"])) < 0.02
         f = r.flags()
         assert f["converged"] and f["reference_on_flank"] and not f["low_contact_ratio"]

@@ -1,4 +1,4 @@
-"""Tooth compliance (gearjax.tooth_compliance, docs/compliance.md) against independent routes.
+"""Tooth compliance (gearjax.loading.tooth_compliance, docs/compliance.md) against independent routes.
 
 Expected values come from closed forms computed here (uniform cantilever, ISO 21771
 tooth thickness, Hertz), from the ISO 6336-1 formulas ([ISO6336-1], docs/references.md)
@@ -12,7 +12,8 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from gearjax import tooth_compliance as tc
+from gearjax.loading import pair_stiffness as ps
+from gearjax.loading import tooth_compliance as tc
 
 ALPHA = np.deg2rad(20.0)
 E, NU = 206000.0, 0.3
@@ -84,7 +85,7 @@ def test_undercut_flag_follows_the_rack_limit():
 
 # (b) single-pair stiffness against ISO 6336-1 -----------------------------------------
 
-_cmax = jax.jit(jax.vmap(lambda z1, z2, x1, x2: tc.single_pair_stiffness(z1, z2, 4.0, ALPHA,
+_cmax = jax.jit(jax.vmap(lambda z1, z2, x1, x2: ps.single_pair_stiffness(z1, z2, 4.0, ALPHA,
                                                                          x1, x2)[0]))
 
 
@@ -98,7 +99,7 @@ def test_single_pair_stiffness_against_iso6336():
     just above the measured spread; the model is not fitted to the standard.
     """
     c_model = np.asarray(_cmax(*PAIRS.T)) * 1e-3       # N/(mm um)
-    iso = tc.iso6336_single_stiffness(PAIRS[:, 0], PAIRS[:, 1], PAIRS[:, 2], PAIRS[:, 3])
+    iso = ps.iso6336_single_stiffness(PAIRS[:, 0], PAIRS[:, 1], PAIRS[:, 2], PAIRS[:, 3])
     # the standard's numbers, evaluated here from its formula
     C = (0.04723, 0.15551, 0.25791, -0.00635, -0.11654, -0.00193, -0.24188, 0.00529, 0.00182)
     z1, z2, x1, x2 = PAIRS.T
@@ -114,13 +115,13 @@ def test_single_pair_stiffness_against_iso6336():
 # (c) mean mesh stiffness / single stiffness -----------------------------------------
 
 def _mesh_ratio(z1, z2, x1, x2):
-    path = tc.path_of_contact(z1, z2, 4.0, ALPHA, x1, x2)
+    path = ps.path_of_contact(z1, z2, 4.0, ALPHA, x1, x2)
     xg, wg = np.polynomial.legendre.leggauss(40)
     half = 0.5 * (path.s_end - path.s_start)
     s = 0.5 * (path.s_start + path.s_end) + half * xg
-    c = tc.pair_compliance(s, z1, z2, 4.0, ALPHA, x1, x2).stiffness
+    c = ps.pair_compliance(s, z1, z2, 4.0, ALPHA, x1, x2).stiffness
     mean = jnp.sum(half * wg * c) / path.p_b       # time average of the pairs in contact
-    cmax = tc.single_pair_stiffness(z1, z2, 4.0, ALPHA, x1, x2)[0]
+    cmax = ps.single_pair_stiffness(z1, z2, 4.0, ALPHA, x1, x2)[0]
     return mean / cmax, path.eps_alpha
 
 
@@ -153,9 +154,9 @@ def test_compliance_grows_toward_the_tip():
     q = jax.jit(jax.vmap(lambda rr: tc.tooth_compliance(rr, z, m, ALPHA, x).total))(r)
     assert np.all(np.diff(np.asarray(q)) > 0)
     # and the pair compliance is largest at the ends of the path
-    p = tc.path_of_contact(z, 50, m, ALPHA, x, 0.0)
+    p = ps.path_of_contact(z, 50, m, ALPHA, x, 0.0)
     s = jnp.linspace(p.s_start, p.s_end, 11)
-    qs = np.asarray(jax.jit(lambda v: tc.pair_compliance(v, z, 50, m, ALPHA, x, 0.0).total)(s))
+    qs = np.asarray(jax.jit(lambda v: ps.pair_compliance(v, z, 50, m, ALPHA, x, 0.0).total)(s))
     assert qs.argmax() in (0, 10) and 0 < qs.argmin() < 10
 
 
@@ -170,7 +171,7 @@ def test_compliance_per_width_is_independent_of_module(k):
     tooth = jax.jit(lambda rr, mm: jnp.stack(tc.tooth_compliance(rr, z, mm, ALPHA, x)[:5]))
     np.testing.assert_allclose(np.asarray(tooth(k * r, k * m)), np.asarray(tooth(r, m)), rtol=1e-10)
     s = jnp.array([-1.0, 0.0, 1.7])
-    pair = jax.jit(lambda ss, mm, w: tc.pair_compliance(ss, z, 41, mm, ALPHA, x, -0.1,
+    pair = jax.jit(lambda ss, mm, w: ps.pair_compliance(ss, z, 41, mm, ALPHA, x, -0.1,
                                                          load_per_width=w).total)
     np.testing.assert_allclose(np.asarray(pair(k * s, k * m, 200.0 * k)),
                                np.asarray(pair(s, m, 200.0)), rtol=1e-10)
@@ -211,7 +212,7 @@ def test_gradients_match_central_differences(name):
 
 def test_pair_gradient_in_shift_and_load():
     def q(x1, w):
-        return tc.pair_compliance(0.7, 21.0, 47.0, 2.5, ALPHA, x1, 0.0, load_per_width=w).total
+        return ps.pair_compliance(0.7, 21.0, 47.0, 2.5, ALPHA, x1, 0.0, load_per_width=w).total
 
     gx, gw = (float(v) for v in jax.jit(jax.grad(q, argnums=(0, 1)))(0.3, 250.0))
     qj = jax.jit(q)
@@ -224,7 +225,7 @@ def test_pair_gradient_in_shift_and_load():
 def test_vmap_over_positions_equals_the_broadcast_call():
     s = jnp.linspace(-3.0, 3.0, 7)
     def f(v):
-        return tc.pair_compliance(v, 19, 33, 3.0, ALPHA, 0.1, 0.0).total
+        return ps.pair_compliance(v, 19, 33, 3.0, ALPHA, 0.1, 0.0).total
 
     batch = jax.jit(f)(s)
     one = jax.jit(jax.vmap(f))(s)
@@ -237,18 +238,18 @@ def test_vmap_over_positions_equals_the_broadcast_call():
 def test_virtual_teeth_of_helical_and_bevel_members():
     beta, delta = np.deg2rad(25.0), np.deg2rad(30.0)
     bb = np.arcsin(np.sin(beta) * np.cos(ALPHA))
-    np.testing.assert_allclose(float(tc.normal_section_teeth(20.0, beta, ALPHA)),
+    np.testing.assert_allclose(float(ps.normal_section_teeth(20.0, beta, ALPHA)),
                                20 / (np.cos(bb) ** 2 * np.cos(beta)), rtol=1e-14)
-    v = tc.virtual_cylindrical_teeth(20.0, delta, beta, ALPHA)
+    v = ps.virtual_cylindrical_teeth(20.0, delta, beta, ALPHA)
     np.testing.assert_allclose(float(v.z_v), 20 / np.cos(delta), rtol=1e-14)
     np.testing.assert_allclose(float(v.z_vn), 20 / np.cos(delta) / (np.cos(bb) ** 2 * np.cos(beta)),
                                rtol=1e-14)
     # a cylindrical gear (delta = 0) is its own virtual gear
-    np.testing.assert_allclose(float(tc.virtual_cylindrical_teeth(20.0, 0.0, beta, ALPHA).z_vn),
-                               float(tc.normal_section_teeth(20.0, beta, ALPHA)), rtol=1e-14)
+    np.testing.assert_allclose(float(ps.virtual_cylindrical_teeth(20.0, 0.0, beta, ALPHA).z_vn),
+                               float(ps.normal_section_teeth(20.0, beta, ALPHA)), rtol=1e-14)
     # a helical pair is its normal-section virtual spur pair
-    zn1, zn2 = (float(tc.normal_section_teeth(z, beta, ALPHA)) for z in (20.0, 45.0))
-    pair = jax.jit(lambda z1, z2, b: tc.pair_compliance(0.3, z1, z2, 2.0, ALPHA, 0.1, 0.0,
+    zn1, zn2 = (float(ps.normal_section_teeth(z, beta, ALPHA)) for z in (20.0, 45.0))
+    pair = jax.jit(lambda z1, z2, b: ps.pair_compliance(0.3, z1, z2, 2.0, ALPHA, 0.1, 0.0,
                                                          beta=b).total)
     a = pair(20.0, 45.0, beta)
     b = pair(zn1, zn2, 0.0)
@@ -276,7 +277,7 @@ def test_path_of_contact_of_a_shifted_pair_against_iso21771():
     aw = (rb1 + rb2) / math.cos(a_w)
     eps = (math.sqrt(ra1 ** 2 - rb1 ** 2) + math.sqrt(ra2 ** 2 - rb2 ** 2)
            - aw * math.sin(a_w)) / p_b
-    path = tc.path_of_contact(z1, z2, m, ALPHA, x1, x2)
+    path = ps.path_of_contact(z1, z2, m, ALPHA, x1, x2)
     np.testing.assert_allclose(float(path.alpha_w), a_w, rtol=1e-12)
     np.testing.assert_allclose(float(path.p_b), p_b, rtol=1e-14)
     np.testing.assert_allclose(float(path.eps_alpha), eps, rtol=1e-12)

@@ -320,7 +320,7 @@ def test_bearing_pushed_past_either_face_end_leaves_the_flank(pair, tca_runs):
     only inside both faces, at the heel (+) and at the toe (-).  Same compiled program
     as ``tca_runs`` (the misalignment is traced).  Planted bug caught: a face-width
     margin that checks one end only (the toe side never out of the face)."""
-    opts = dict(kinematics=False, face_ends=False, strict=False)
+    opts = dict(kinematics=False, face_ends=False, throw=False)
     runs = {s: gj.run_tca(pair, gj.Misalignment.create(dSigma_deg=s * 0.663, dP=s * 5.0),
                           **opts) for s in (1.0, -1.0)}
     conv = np.asarray(runs[1.0].path.converged) & np.asarray(runs[-1.0].path.converged)
@@ -359,7 +359,7 @@ def test_seed_hertz_formula_matches_exact_hertz():
     point contact agree (1e-8 relative) for the elongated ellipses of VH-CATT pairs."""
     for F, Rx, Ry in ((2000.0, 6.7, 16000.0), (500.0, 2.5, 9000.0), (1000.0, 10.0, 60.0)):
         Ep = 203e3 / (1 - 0.09)
-        hz = gj.hertz_point(F, Rx, Ry, Ep)
+        hz = gj.tribology.hertz_point(F, Rx, Ry, Ep)
         a, b = _timoshenko(F, Rx, Ry, Ep)
         assert abs(float(hz.a) - a) / a < 1e-8 and abs(float(hz.b) - b) / b < 1e-8
 
@@ -376,7 +376,7 @@ def _data(**pair_over):
 def test_design_file(design):
     assert design.data["pair"]["cutter_radius1_mm"] == 400.0 and design.defaults_lines() == []
     assert abs(design.e_prime_MPa() - 203e3 / 0.91) < 1e-9
-    assert gj.family_of(design).family == "vh_catt"
+    assert gj.tca.family_of(design).family == "vh_catt"
     d = _data()
     del d["pair"]["blade_offset_mm"]
     with pytest.raises(ValueError, match="blade_offset_mm"):

@@ -1,5 +1,5 @@
 """Sub-commands of the ``gearjax`` CLI, one module each (see ``gearjax/cli.py``), and
-their shared output helpers: :func:`print_json` (strict JSON on stdout) and
+their shared output helpers: :func:`print_json` (throw JSON on stdout) and
 :func:`warn_nonfinite` (one stderr warning line for results that are not finite)."""
 
 from __future__ import annotations

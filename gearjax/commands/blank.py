@@ -4,7 +4,7 @@ DESIGN is a path or ``example:NAME``; its ``[blank]`` table goes verbatim to
 :meth:`gearjax.gears.hypoid.blank.BlankInput.from_dict` and
 :func:`~gearjax.gears.hypoid.blank.blank_geometry` computes the blank.  The table is
 followed by the documented defaults the design relies on (keys left out of the
-file, :meth:`gearjax.HypoidDesign.defaults_applied`); ``--json`` prints
+file, :meth:`gearjax.hypoid.HypoidDesign.defaults_applied`); ``--json`` prints
 the blank data only."""
 
 from __future__ import annotations
@@ -24,9 +24,10 @@ def register(sub):
 
 
 def run(args) -> int:
-    from gearjax import blank_geometry, load_design
+    from gearjax.hypoid import blank_geometry
+    from gearjax import load_design
     from gearjax.progress import Progress
-    from gearjax import HYPOID_KINDS
+    from gearjax.hypoid import KINDS as HYPOID_KINDS
     design = load_design(args.design, kinds=HYPOID_KINDS)
     with Progress(1, "blank") as bar, bar.phase("blank solve"):
         data = blank_geometry(design.blank_input())

@@ -51,7 +51,7 @@ def parse_kv(text, allowed, what):
 
 def involute_design(text):
     """``(keys, InvoluteTCA)`` of an inline ``involute:...`` DESIGN (validated)."""
-    from gearjax import InvolutePair, InvoluteTCA
+    from gearjax.involute import InvolutePair, InvoluteTCA
     from gearjax.errors import check_range
 
     kv = parse_kv(text[len(INVOLUTE_PREFIX):], INVOLUTE_KEYS, "design")

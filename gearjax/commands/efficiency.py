@@ -1,20 +1,20 @@
 """``gearjax efficiency``: loaded contact, friction along the path of contact and mesh
-efficiency of a gear pair at one operating point (see :mod:`gearjax.mesh_efficiency`).
+efficiency of a gear pair at one operating point (see :mod:`gearjax.loading.mesh_efficiency`).
 
 DESIGN as for ``gearjax tca`` (:mod:`gearjax.commands.designs`): an inline involute
 pair or a hypoid/spiral-bevel design file / ``example:NAME``.  The oil, surface and
 film options are those of ``gearjax friction`` (:func:`gearjax.commands.friction.
 add_lubricant_options`, same ranges).  The pinion torque (N m) and speed (rpm) are
-checked against :data:`gearjax.TORQUE_RANGE_NM` and :data:`gearjax.RPM_RANGE`.  The
-material (:mod:`gearjax.materials`): ``--E-prime-MPa`` if given, else the design's own
+checked against :data:`gearjax.loading.TORQUE_RANGE_NM` and :data:`gearjax.loading.RPM_RANGE`.  The
+material (:mod:`gearjax.loading.materials`): ``--E-prime-MPa`` if given, else the design's own
 ``[material]`` (VH-CATT), else steel; it sets E' and the tooth compliance, and the
 output names its source (``input.material_source``).  ``--compliance`` has the default
-of :func:`gearjax.mesh_efficiency` (:data:`gearjax.DEFAULT_COMPLIANCE`).
+of :func:`gearjax.loading.mesh_efficiency` (:data:`gearjax.loading.DEFAULT_COMPLIANCE`).
 
 Exit status as ``gearjax tca``: 0 with a result (problems of the result -- TCA
 quality flags, positions whose load balance or friction solve did not converge, a
 loaded edge contact, a grid too short, implausible results (``plausibility`` of
-:mod:`gearjax.mesh_efficiency`), a partial cycle (summaries over the valid positions
+:mod:`gearjax.loading.mesh_efficiency`), a partial cycle (summaries over the valid positions
 only) -- are ``gearjax: warning:`` lines on stderr
 and ``valid``/``warnings`` in the output); 2 bad input, refused before any work; 3
 no position of the cycle is valid (the result is printed, with one error line).
@@ -105,10 +105,10 @@ def register(sub):
         epilog=EFFICIENCY_KEYS_DOC, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("design", help="involute:z1=..,z2=..,m=..,alpha=..,b=..[,...], or a "
                                   "hypoid/spiral-bevel design file or example:NAME")
-    lo, hi = gj.TORQUE_RANGE_NM
+    lo, hi = gj.loading.TORQUE_RANGE_NM
     p.add_argument("--torque-Nm", type=float, required=True,
                    help=f"pinion torque (N m, in [{lo:g}, {hi:g}])")
-    lo, hi = gj.RPM_RANGE
+    lo, hi = gj.loading.RPM_RANGE
     p.add_argument("--rpm", type=float, required=True,
                    help=f"pinion speed (rpm, in [{lo:g}, {hi:g}])")
     add_lubricant_options(p, e_prime_help=(
@@ -119,10 +119,10 @@ def register(sub):
     p.add_argument("--side", choices=["drive", "coast"], default="drive")
     p.add_argument("--misalign", default="",
                    help="dE=mm,dP=mm,dG=mm,dSigma=deg (any subset; default all 0)")
-    p.add_argument("--compliance", choices=list(gj.COMPLIANCE_MODELS),
-                   default=gj.DEFAULT_COMPLIANCE,
+    p.add_argument("--compliance", choices=list(gj.loading.COMPLIANCE_MODELS),
+                   default=gj.loading.DEFAULT_COMPLIANCE,
                    help=f"tooth compliance model of the load sharing, as "
-                        f"gearjax.mesh_efficiency: {gj.COMPLIANCE_HELP}")
+                        f"gearjax.loading.mesh_efficiency: {gj.loading.COMPLIANCE_HELP}")
     p.add_argument("--positions", type=float, default=None,
                    help=f"positions per mesh cycle (one pinion pitch), integer "
                         f"{POSITIONS_RANGE[0]}..{POSITIONS_RANGE[1]} (default 24 involute, "
@@ -183,7 +183,7 @@ def _position_stats(eff):
 
 
 def _output(eff, res, inp, warn_lines, plot):
-    """The JSON object of the result (strict JSON: NaN -> null by print_json)."""
+    """The JSON object of the result (throw JSON: NaN -> null by print_json)."""
     from gearjax import ARCSEC
     from gearjax.tribology import REGIMES
 
@@ -281,8 +281,8 @@ def run(args) -> int:
     from gearjax.progress import Progress
 
     # every input is checked before any work (one line naming it, status 2)
-    T = check_range("--torque-Nm", args.torque_Nm, *gj.TORQUE_RANGE_NM, unit="N m")
-    n = check_range("--rpm", args.rpm, *gj.RPM_RANGE, unit="rpm")
+    T = check_range("--torque-Nm", args.torque_Nm, *gj.loading.TORQUE_RANGE_NM, unit="N m")
+    n = check_range("--rpm", args.rpm, *gj.loading.RPM_RANGE, unit="rpm")
     gj.check_operating_point(T, n)
     mis_kv, mis = parse_misalign(args.misalign)
     opts = _grid_options(args)
@@ -294,7 +294,7 @@ def run(args) -> int:
         oil, surf, _ = lubricant_from_args(args)   # E': the material below
     design = (involute_design(args.design)[1] if is_involute(args.design)
               else gj.load_design(args.design))
-    opts_all = {**gj.family_of(design).defaults, **opts}
+    opts_all = {**gj.tca.family_of(design).defaults, **opts}
     # the material: --E-prime-MPa (validated above) > the design's [material] > steel;
     # mesh_efficiency resolves it the same way from the same E_prime argument
     mat = gj.pair_material(design, args.E_prime_MPa, override_source="--E-prime-MPa")

@@ -93,7 +93,7 @@ def ehl_check(eff, oil, surf, E_prime, n_check: int, grid_n: int) -> list[dict]:
                                   row["Ry_mm"], float(oil.eta0), float(oil.alpha) * 1e3,
                                   float(E_prime), float(oil.tau0), float(surf.sigma) * 1e3,
                                   float(surf.density), float(surf.beta) * 1e3, float(surf.f_c),
-                                  float(surf.v_slip), n=grid_n, strict=False)
+                                  float(surf.v_slip), n=grid_n, throw=False)
         except ValueError as e:           # outside the numerical model's range
             row["skipped"] = str(e)
             rows.append(row)

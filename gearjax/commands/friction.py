@@ -92,7 +92,7 @@ def add_lubricant_options(p, e_prime_help: str = E_PRIME_HELP):
     --E-prime-MPa (its default differs between commands)."""
     g = p.add_mutually_exclusive_group(required=True)
     g.add_argument("--oil", help="example oil: mineral_vg100 | mineral_vg220 | pao_vg100 "
-                                 "(gearjax.OILS)")
+                                 "(gearjax.tribology.OILS)")
     g.add_argument("--eta0", type=float, help="inlet viscosity (Pa·s, in (6.31e-5, 100])")
     p.add_argument("--alpha-per-GPa", type=float, default=None,
                    help="pressure-viscosity coefficient with --eta0 (1/GPa, in (0, 100], default 20)")

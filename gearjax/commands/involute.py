@@ -67,9 +67,9 @@ def register(sub):
 def run(args) -> int:
     from gearjax.commands import print_json, warn_nonfinite
     from gearjax.errors import check_int, check_range
-    from gearjax import InvolutePair, pair_geometry
-    from gearjax import involute_path_kinematics as path_kinematics
-    from gearjax import involute_path_table as path_table
+    from gearjax.involute import InvolutePair, pair_geometry
+    from gearjax.involute import path_kinematics
+    from gearjax.involute import path_table
 
     pair = InvolutePair.create(args.z1, args.z2, args.module, args.pressure_angle, args.helix,
                                args.x1, args.x2)

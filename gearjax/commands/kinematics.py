@@ -61,7 +61,7 @@ def run(args) -> int:
     check_range("--cutter-shift (cutter_shift_mm)", args.cutter_shift, -20.0, 20.0, unit="mm")
     if args.plot is not None:
         check_output_path(args.plot, "--plot", (".png",))
-    from gearjax import HYPOID_KINDS
+    from gearjax.hypoid import KINDS as HYPOID_KINDS
     design = load_design(args.design, kinds=HYPOID_KINDS)
     inp = design.blank_input()
     if inp.method == "iso23509-method0" or float(inp.offset) <= 0.0:

@@ -1,4 +1,4 @@
-"""``gearjax tca``: unloaded tooth contact analysis (see :mod:`gearjax.tca`).
+"""``gearjax tca``: unloaded tooth contact analysis (see :mod:`gearjax.tca.path`).
 
 DESIGN is either an involute pair given inline,
 ``involute:z1=25,z2=41,m=2,alpha=20,b=20[,helix=0,x1=0,x2=0,dalpha=0,crown=0,lead_crown=0]``
@@ -98,14 +98,14 @@ def _family_side(design, mis, m, side_name, half, pairs, kin):
     import gearjax as gj
     res = gj.run_tca(design, mis, side=side_name, steps_per_pitch=m, half_pitches=half,
                      n_pairs=pairs, kinematics=kin)
-    outline = getattr(gj.family_of(design), "outline", None)
+    outline = getattr(gj.tca.family_of(design), "outline", None)
     return res, (outline(design, side_name) if outline is not None else None)
 
 
 def _side_json(res):
     from gearjax import ARCSEC
     path, multi = res.path, res.multi
-    from gearjax import EDGE_NAMES
+    from gearjax.tca import EDGE_NAMES
     conv = np.asarray(path.converged)
     on = np.asarray(res.on_flank)
     edge = np.asarray(res.edge_points)
@@ -163,11 +163,11 @@ FAILED_SIDE_STATUS = 3
 def _failure(side, exc, args) -> str:
     """One actionable line for a failed side: what failed, on which side, what to try.
 
-    The library's own hint about the ``strict`` keyword is dropped: the command has
+    The library's own hint about the ``throw`` keyword is dropped: the command has
     no such option."""
     from gearjax import NoContactError
 
-    detail = re.sub(r"\s*;?\s*pass strict=False[^;]*$", "", str(exc)).strip().rstrip(".;")
+    detail = re.sub(r"\s*;?\s*pass throw=False[^;]*$", "", str(exc)).strip().rstrip(".;")
     tries = []
     if args.misalign.strip():
         tries.append("smaller or fewer --misalign values")
@@ -199,7 +199,8 @@ def run(args) -> int:
     if args.plot:
         check_output_path(args.plot, "--plot", (".png",))
     sides = ["drive", "coast"] if args.side == "both" else [args.side]
-    from gearjax import family_of, load_design
+    from gearjax.tca import family_of
+    from gearjax import load_design
     # validated before any tracing
     design = (involute_design(args.design)[1] if args.design.startswith("involute:")
               else load_design(args.design))

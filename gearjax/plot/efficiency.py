@@ -1,5 +1,5 @@
 """Mesh-efficiency figure: load sharing, friction coefficient and sliding power loss
-along one mesh cycle (:func:`gearjax.mesh_efficiency`).
+along one mesh cycle (:func:`gearjax.loading.mesh_efficiency`).
 
 Three stacked panels against the pinion angle (deg): the torque share of each tooth
 pair, μ of each loaded pair, and the power loss P_f (W) with the mean mesh

@@ -3,7 +3,7 @@
 The contact pattern is drawn on the axial projection of the pinion flank (axial
 coordinate = body z, radial = distance from the body axis, mm): the path of
 contact and the instantaneous contact ellipses (semi-axes from
-:func:`gearjax.tca.ellipse_from_weingarten`, projected from the tangent plane),
+:func:`gearjax.tca.path.ellipse_from_weingarten`, projected from the tangent plane),
 with the flank limits (face ends = toe/heel, form circle = root, tip circle =
 tip) marked; only positions whose contact converged on the flank are drawn, and
 the ellipses and the path are clipped to the flank outline.  A conjugate pair's
@@ -19,7 +19,7 @@ import io as _io
 import numpy as np
 
 from gearjax.plot.style import DPI, MIN_WIDTH_IN, clip_to, report_style, te_axis_limits
-from gearjax.tca import ARCSEC
+from gearjax.tca.path import ARCSEC
 
 __all__ = ["ellipse_outline_axial", "flank_outline", "on_flank_mask", "plot_tca", "save_tca_plot"]
 

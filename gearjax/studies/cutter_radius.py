@@ -77,8 +77,7 @@ from gearjax.surfaces import curvature_in_direction, local_geometry
 __all__ = ["STUDY_BLANK", "STUDY_CUTTERS", "study_blank_input", "StudySettings",
            "PitchSetup", "pitch_setup", "FlankFields", "point_fields", "flank_fields", "field_stats",
            "euler_bertrand", "limit_report", "FIELDS", "conjugate_check", "grid_uv", "STAT_NAMES",
-           "flank_statistics", "statistics_gradient", "cutter_radius_sweep",
-           "OPT_BOUNDS", "design_objective", "optimise_design"]
+           "flank_statistics", "statistics_gradient", "cutter_radius_sweep", "study_statistics"]
 
 _DEG = math.pi / 180.0
 
@@ -402,14 +401,14 @@ _fields_jit = jax.jit(_fields, static_argnums=(0, 2, 3, 4))
 
 
 def flank_fields(inp: BlankInput, settings: StudySettings, flank: str = "convex",
-                 shape=(31, 15), extend: float = 1.0, *, strict: bool = True):
+                 shape=(31, 15), extend: float = 1.0, *, throw: bool = True):
     """[Eigenfunctions] fields over a ``shape = (n_depth, n_face)`` grid of the gear flank.
 
     Returns ``(setup, fields)``: :class:`PitchSetup` and :class:`FlankFields` with
     leading grid axes.  jitted (static: ``inp``, ``flank``, ``shape``, ``extend``);
-    differentiable in ``settings``.  ``strict`` (concrete values only): raise
+    differentiable in ``settings``.  ``throw`` (concrete values only): raise
     :class:`gearjax.errors.ConvergenceError` when the blank or any meshing-equation
-    solve did not converge; with ``strict=False`` inspect ``fields.converged`` and
+    solve did not converge; with ``throw=False`` inspect ``fields.converged`` and
     ``setup.blank['converged']``.
     """
     if flank not in _FLANKS:
@@ -418,7 +417,7 @@ def flank_fields(inp: BlankInput, settings: StudySettings, flank: str = "convex"
     if len(shape) != 2 or min(shape) < 2:
         raise ValueError(f"shape = {shape} must be two integers >= 2")
     s, f = _fields_jit(inp, settings, flank, shape, float(extend))
-    if strict and not isinstance(f.phi, jax.core.Tracer):
+    if throw and not isinstance(f.phi, jax.core.Tracer):
         require_converged(np.asarray(s.blank["converged"]) > 0.5, "cutter-radius study blank",
                           s.blank["residual"])
         require_converged(np.all(np.asarray(f.converged)), "meshing equation (gear roll)",
@@ -501,11 +500,13 @@ def _stats(f: FlankFields):
             "min_phi_I": jnp.min(sI * f.phi_I), "min_phi_II": jnp.min(sII * f.phi_II)}
 
 
-def _stats_fn(inp, settings, flank, shape):
+def study_statistics(inp, settings, flank, shape):
+    """:data:`STAT_NAMES` of the flank fields on a ``shape`` grid (traceable in
+    ``settings``; the un-jitted core of :func:`flank_statistics`)."""
     return _stats(_fields(inp, settings, flank, shape, 1.0)[1])
 
 
-_stats_jit = jax.jit(_stats_fn, static_argnums=(0, 2, 3))
+_stats_jit = jax.jit(study_statistics, static_argnums=(0, 2, 3))
 
 
 def flank_statistics(inp: BlankInput, settings: StudySettings, flank: str = "convex",
@@ -517,7 +518,7 @@ def flank_statistics(inp: BlankInput, settings: StudySettings, flank: str = "con
 
 
 def _stats_jac(inp, settings, flank, shape):
-    return jax.jacfwd(lambda st: _stats_fn(inp, st, flank, shape))(settings)
+    return jax.jacfwd(lambda st: study_statistics(inp, st, flank, shape))(settings)
 
 
 _stats_jac_jit = jax.jit(_stats_jac, static_argnums=(0, 2, 3))
@@ -534,8 +535,8 @@ def statistics_gradient(inp: BlankInput, settings: StudySettings, flank: str = "
 def _sweep(inp, r0s, flank, shape):
     def one(r0):
         st = StudySettings(r0, 0.0 * r0, 0.0 * r0)
-        val = _stats_fn(inp, st, flank, shape)
-        der = jax.jacfwd(lambda x: _stats_fn(inp, StudySettings(x, 0.0 * x, 0.0 * x),
+        val = study_statistics(inp, st, flank, shape)
+        der = jax.jacfwd(lambda x: study_statistics(inp, StudySettings(x, 0.0 * x, 0.0 * x),
                                              flank, shape))(r0)
         return val, der
     return jax.vmap(one)(r0s)
@@ -551,56 +552,3 @@ def cutter_radius_sweep(inp: BlankInput, r0s, flank: str = "convex", shape=(15, 
     ``(values, derivatives)``: dicts of arrays over ``r0s``."""
     r0s = jnp.asarray(r0s, float)
     return _sweep_jit(inp, r0s, flank, tuple(int(x) for x in shape))
-
-
-# --------------------------------------------------------------------------- optimisation
-
-#: box of the optimisation variables (mm, deg, mm) and their scales
-OPT_BOUNDS = {"cutter_radius": (60.0, 130.0), "blade_angle_delta_deg": (-3.0, 3.0),
-              "cutter_shift": (-5.0, 5.0)}
-_OPT_SCALE = jnp.array([10.0, 1.0, 1.0])     # x = (r0/10 mm, d_alpha/deg, shift/mm)
-
-
-def _x_to_settings(x):
-    return StudySettings(x[0] * _OPT_SCALE[0], x[1] * _OPT_SCALE[1] * _DEG, x[2] * _OPT_SCALE[2])
-
-
-def design_objective(inp, flank="convex", shape=(9, 7), r_ref=20.0, phi_floor=1.0,
-                     barrier=10.0):
-    """Objective of the optimisation, ``x -> J`` (x scaled: r0/10 mm, blade angle
-    change in degrees, cutter shift in mm):
-
-        J = max|SRR| - min(R_eff)/r_ref
-            + barrier (relu(1 - min Phi_I/phi_floor)^2 + relu(1 - min Phi_II/phi_floor)^2)
-
-    (lower peak slide-to-roll ratio, larger smallest effective radius, both
-    eigenfunctions kept at least ``phi_floor`` away from zero -- with the
-    pitch-point sign -- on the working flank).  Plain max/min: differentiable
-    wherever the extreme grid point is unique."""
-    shape = tuple(int(s) for s in shape)
-
-    def J(x):
-        st = _stats_fn(inp, _x_to_settings(x), flank, shape)
-        pen = (jax.nn.relu(1.0 - st["min_phi_I"] / phi_floor) ** 2
-               + jax.nn.relu(1.0 - st["min_phi_II"] / phi_floor) ** 2)
-        return st["max_abs_srr"] - st["min_r_eff"] / r_ref + barrier * pen
-    return J
-
-
-def optimise_design(inp: BlankInput, start: StudySettings, *, flank="convex", shape=(9, 7),
-                    steps: int = 40, learning_rate: float = 0.05):
-    """Adam (optax, jitted ``lax.scan`` via :func:`gearjax.optimize.minimize_optax`)
-    on :func:`design_objective` over (r0, blade angle change, cutter shift) within
-    :data:`OPT_BOUNDS`; forward-mode gradients.  Returns ``(OptResult, StudySettings)``."""
-    import optax
-
-    from gearjax.optimize import minimize_optax
-    J = design_objective(inp, flank, shape)
-    x0 = jnp.stack([start.cutter_radius / _OPT_SCALE[0],
-                    start.blade_angle_delta / _DEG / _OPT_SCALE[1],
-                    start.cutter_shift / _OPT_SCALE[2]])
-    lo = jnp.array([OPT_BOUNDS[k][0] for k in OPT_BOUNDS]) / _OPT_SCALE
-    hi = jnp.array([OPT_BOUNDS[k][1] for k in OPT_BOUNDS]) / _OPT_SCALE
-    res = minimize_optax(J, x0, optimizer=optax.adam(learning_rate), steps=steps, lower=lo,
-                         upper=hi, mode="fwd")
-    return res, _x_to_settings(res.x)

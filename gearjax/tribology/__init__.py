@@ -12,15 +12,19 @@ The empirical gear friction formulas used only for comparison (Xu–Kahraman,
 ISO/TR 14179-2, Benedict–Kelley) live outside the package, in
 ``experiments/friction_reference.py``; gearjax is not tuned to them.
 
-Hertz contact lives in :mod:`gearjax.contact`.  Units: mm, N, s, MPa; viscosity
+Hertz contact lives in :mod:`gearjax.contact` (its entry points are re-exported here);
+the numerical EHL reference in :mod:`gearjax.tribology.ehl`.  Units: mm, N, s, MPa; viscosity
 Pa·s; speeds mm/s.
 """
 
 from gearjax.tribology.friction import (REGIMES, STEEL_E_PRIME, FrictionResult, Surface,
-                                        friction_coefficient, friction_traced, make_surface)
-from gearjax.tribology.losses import mesh_losses, mesh_losses_traced, stribeck_curve
+                                        friction_coefficient, make_surface)
+from gearjax.tribology.losses import mesh_losses, stribeck_curve
 from gearjax.tribology.lubricant import OILS, Oil, get_oil, make_oil
+from gearjax.tribology.ehl import solve_ehl
+from gearjax.contact import HertzResult, hertz_line, hertz_point
 
 __all__ = ["REGIMES", "STEEL_E_PRIME", "FrictionResult", "Surface", "friction_coefficient",
-           "friction_traced", "make_surface", "mesh_losses", "mesh_losses_traced",
-           "stribeck_curve", "OILS", "Oil", "get_oil", "make_oil"]
+           "make_surface", "mesh_losses",
+           "stribeck_curve", "OILS", "Oil", "get_oil", "make_oil", "solve_ehl", "HertzResult",
+           "hertz_line", "hertz_point"]

@@ -50,7 +50,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from gearjax.contact import E_PRIME_MAX_MPA, LOAD_MAX_N, MAX_LOG_RATIO, hertz_exact
-from gearjax.errors import check_range, require_converged
+from gearjax.errors import any_traced, check_range, require_converged
 from gearjax.fields import float64_array
 from gearjax.tribology.asperity import load_sharing_traced
 from gearjax.tribology.lubricant import (LN_ETA_CAP, LN_ETA_INF, P_ROELANDS_MPA, PA_S_TO_MPA_S, Oil,
@@ -388,8 +388,14 @@ def warn_validity(out: FrictionResult, film_method: str, viscosity_model: str):
 
 def friction_coefficient(F, u_e, u_s, Rx, Ry, oil: Oil, surface: Surface, E_prime=STEEL_E_PRIME,
                          *, viscosity_model="roelands", film_method="auto",
-                         strict=True) -> FrictionResult:
-    """Mixed-lubrication friction at contact points (validated public entry point).
+                         throw=True) -> FrictionResult:
+    """Mixed-lubrication friction at contact points: the one entry point, concrete or traced.
+
+    With concrete inputs it validates them first (a one-line ``ValueError`` naming the
+    parameter and its range), runs one compiled kernel on padded arrays and raises
+    :class:`~gearjax.errors.ConvergenceError` on a failed solve when ``throw``.  Inside
+    ``jax.jit``, ``jax.grad`` or ``jax.vmap`` (any input traced) it is the traced kernel
+    itself: no validation, no exception, the ``converged`` mask in the result.
 
     Parameters (arrays broadcast together)
     ----------
@@ -403,18 +409,21 @@ def friction_coefficient(F, u_e, u_s, Rx, Ry, oil: Oil, surface: Surface, E_prim
     viscosity_model : ``"roelands"`` (default) or ``"barus"``.
     film_method : ``"auto"`` (default), ``"point"`` or ``"line"`` (see
         :mod:`gearjax.tribology.film`).
-    strict : raise ConvergenceError if any solve failed (default); else return
+    throw : raise ConvergenceError if any solve failed (default); else return
         the ``converged`` mask.
 
     Returns :class:`FrictionResult`.
     """
+    if any_traced(F, u_e, u_s, Rx, Ry, E_prime, oil, surface):
+        return friction_traced(F, u_e, u_s, Rx, Ry, oil, surface, E_prime,
+                               viscosity_model=viscosity_model, film_method=film_method)
     validate_contact_inputs(F, u_e, u_s, Rx, Ry, E_prime)
     if viscosity_model not in ("roelands", "barus"):
         raise ValueError(f"viscosity_model = {viscosity_model!r} must be 'roelands' or 'barus'")
     if film_method not in ("auto", "point", "line"):
         raise ValueError(f"film_method = {film_method!r} must be 'auto', 'point' or 'line'")
     out = friction_padded(F, u_e, u_s, Rx, Ry, oil, surface, E_prime, viscosity_model, film_method)
-    if strict:
+    if throw:
         require_converged(out.converged, "friction (Hertz / load-sharing solves)")
     warn_validity(out, film_method, viscosity_model)
     return out

@@ -28,7 +28,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax.errors import check_positive, require_converged
+from gearjax.errors import any_traced, check_positive, require_converged
 from gearjax.tribology.friction import (STEEL_E_PRIME, FrictionResult, Surface, friction_padded,
                                         warn_validity, friction_traced, validate_contact_inputs)
 from gearjax.tribology.lubricant import Oil
@@ -95,14 +95,22 @@ def mesh_losses_traced(F, u_s, u_e, Rx, Ry, oil: Oil, surface: Surface, power_in
 
 def mesh_losses(F, u_s, u_e, Rx, Ry, oil: Oil, surface: Surface, power_in_W,
                 E_prime=STEEL_E_PRIME, weights=None, *, viscosity_model="roelands",
-                film_method="auto", strict=True) -> MeshLoss:
-    """Power loss and mesh efficiency over a mesh cycle (validated entry point).
+                film_method="auto", throw=True) -> MeshLoss:
+    """Power loss and mesh efficiency over a mesh cycle: the one entry point, concrete or
+    traced.
 
     ``F`` (N, ≥ 0; 0 marks an inactive point), ``u_s`` (mm/s, signed), ``u_e``
     (mm/s, > 0 where active), ``Rx``, ``Ry`` (mm) broadcast to shape
     (n_positions, n_points); ``power_in_W`` scalar or (n_positions,);
-    ``weights`` optional (n_positions,) non-negative time weights.
+    ``weights`` optional (n_positions,) non-negative time weights.  Concrete inputs are
+    validated first and a failed solve raises when ``throw``; inside ``jax.jit``,
+    ``jax.grad`` or ``jax.vmap`` (any input traced) it runs the traced computation
+    without validation or exception (the ``converged`` flags are in the result).
     """
+    if any_traced(F, u_s, u_e, Rx, Ry, power_in_W, E_prime, weights, oil, surface):
+        return mesh_losses_traced(F, u_s, u_e, Rx, Ry, oil, surface, power_in_W, E_prime,
+                                  weights, viscosity_model=viscosity_model,
+                                  film_method=film_method)
     F_arr = np.asarray(F, float)
     if F_arr.ndim != 2:
         raise ValueError(f"load must have shape (n_positions, n_points), got {F_arr.shape}")
@@ -127,7 +135,7 @@ def mesh_losses(F, u_s, u_e, Rx, Ry, oil: Oil, surface: Surface, power_in_W,
     fr = friction_padded(F_safe, ue_safe, us, Rx, Ry, oil, surface, E_prime, viscosity_model,
                           film_method)
     out = _assemble(fr, F_arr, u_s, power_in_W, wt)
-    if strict:
+    if throw:
         require_converged(out.friction.converged, "mesh friction (Hertz / load-sharing solves)")
     warn_validity(out.friction, film_method, viscosity_model)
     eta = np.asarray(out.efficiency, float)
@@ -164,7 +172,7 @@ def stribeck_traced(F, Rx, Ry, srr, u_e, oil, surface, E_prime=STEEL_E_PRIME,
 
 
 def stribeck_curve(F, Rx, Ry, srr, u_e, oil, surface, E_prime=STEEL_E_PRIME, *,
-                   viscosity_model="roelands", film_method="auto", strict=True) -> StribeckCurve:
+                   viscosity_model="roelands", film_method="auto", throw=True) -> StribeckCurve:
     """Validated Stribeck sweep: ``u_e`` array (mm/s, > 0), SRR ≥ 0, scalar F, Rx, Ry."""
     from gearjax.errors import check_range
     check_range("srr", srr, 0.0, 2.0)
@@ -173,7 +181,7 @@ def stribeck_curve(F, Rx, Ry, srr, u_e, oil, surface, E_prime=STEEL_E_PRIME, *,
     fr = friction_padded(F, ue, srr * ue, Rx, Ry, oil, surface, E_prime, viscosity_model,
                           film_method)
     out = StribeckCurve(jnp.asarray(ue), oil.eta0 * (ue * 1e-3) / F, fr.lam_smooth, fr.mu, fr)
-    if strict:
+    if throw:
         require_converged(out.friction.converged, "Stribeck sweep")
     warn_validity(out.friction, film_method, viscosity_model)
     return out

@@ -433,7 +433,7 @@ def blank_core(inp: BlankInput, ratio):
         rule = "method1"
     else:
         sol = pitch_cones.solve_pitch_cones(u, Sigma, E, de2, b2, beta, rc0,
-                                            spiral_member=inp.spiral_member, strict=False)
+                                            spiral_member=inp.spiral_member, throw=False)
         pc = dict(delta1=sol.delta1, delta2=sol.delta2, Rm1=sol.R1, Rm2=sol.R2,
                   beta_m1=sol.beta1, beta_m2=sol.beta2, c_be2=0.5 + z, rho_lim=sol.rho_lim,
                   residual=sol.residual, steps=sol.steps, converged=sol.converged)
@@ -472,13 +472,13 @@ def blank_core(inp: BlankInput, ratio):
 _core_jit = jax.jit(blank_core)
 
 
-def blank_geometry(inp: BlankInput, *, strict: bool = True):
+def blank_geometry(inp: BlankInput, *, throw: bool = True):
     """Blank geometry for ``inp`` as a :class:`BlankData` (mm, rad).
 
     Pure and jit/jacfwd/vmap-friendly (``jax.jit(blank_geometry)`` works; the
     method and tooth numbers are static).  Nothing is validated inside; use
     :meth:`BlankInput.from_dict` or :meth:`BlankInput.validate` for designer input.
-    With ``strict=True`` and concrete values a non-converged root finding raises
+    With ``throw=True`` and concrete values a non-converged root finding raises
     :class:`gearjax.errors.ConvergenceError`, and an undefined blank (non-finite
     outputs, e.g. a cutter too small for the face width and spiral angle, ISO 23509
     (183)) raises ``ValueError``; otherwise check ``converged`` (1/0) and the values.
@@ -486,7 +486,7 @@ def blank_geometry(inp: BlankInput, *, strict: bool = True):
     out = _core_jit(inp, inp.z2 / inp.z1)
     data = BlankData(**out, method=inp.method)
     conv = data.converged
-    if strict and not isinstance(conv, jax.core.Tracer):
+    if throw and not isinstance(conv, jax.core.Tracer):
         require_converged(np.asarray(conv) > 0.5, f"blank geometry ({inp.method})",
                           data.residual)
         bad = [n for n, _, _ in OUTPUTS if n not in _MAY_BE_NONFINITE

@@ -1,6 +1,6 @@
 """Rolling, sliding and curvature at the contact points of a hypoid/spiral-bevel TCA.
 
-For every point of a :class:`~gearjax.tca.ContactPath` of a
+For every point of a :class:`~gearjax.tca.path.ContactPath` of a
 :class:`~gearjax.gears.hypoid.tca.HypoidPair` this module computes the quantities of
 [Eigenfunctions] §1 (see docs/references.md) twice:
 
@@ -44,8 +44,9 @@ from gearjax.gears.hypoid.flank import work_point
 from gearjax.frames import matrix_z
 from gearjax.kinematics import Kinematics, Mesh, eigen_kinematics
 from gearjax.surfaces import GeneratedSurface, curvature_in_direction
-from gearjax.tca import ContactPath, Misalignment, relative_curvature
-from gearjax.tca_result import contact_motion
+from gearjax.tca.path import ContactPath, relative_curvature
+from gearjax.tca.assembly import Misalignment
+from gearjax.tca.result import contact_motion
 
 __all__ = ["PathKinematics", "path_kinematics"]
 

@@ -434,14 +434,14 @@ def _flank_points_jit(fl, n_xi, n_s):
     return flank_points(fl, n_xi, n_s)
 
 
-def flank_surface(fl: FlankSpec, n_xi: int = 21, n_s: int = 11, *, strict: bool = True) -> FlankGrid:
+def flank_surface(fl: FlankSpec, n_xi: int = 21, n_s: int = 11, *, throw: bool = True) -> FlankGrid:
     """Validated, jitted :func:`flank_points`; raises ConvergenceError unless every point
-    converged (``strict=False`` returns the grid with its ``converged`` mask)."""
+    converged (``throw=False`` returns the grid with its ``converged`` mask)."""
     n_xi = check_int("n_xi", n_xi, 2, 2001)
     n_s = check_int("n_s", n_s, 2, 2001)
     from gearjax.gears.hypoid.pair import program_pair   # one program per grid size
     g = _flank_points_jit(program_pair(fl), n_xi, n_s)
-    if strict:
+    if throw:
         require_converged(g.converged, "hypoid flank grid", g.residual)
     return g
 

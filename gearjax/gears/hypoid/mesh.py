@@ -1,12 +1,12 @@
 """The spiral-bevel/hypoid pair as the loaded-contact models see it
-(:class:`~gearjax.loaded_contact.MeshTeeth`).
+(:class:`~gearjax.loading.loaded_contact.MeshTeeth`).
 
 Each member is the virtual cylindrical gear of its normal section at the mean point
 ([ISO10300-1]): mean cone distance ``R_m = A_o - F/2``, mean normal module
 ``m_mn = 2 R_m sin(delta_1) cos(beta_m1) / z1`` (of the pinion; the gear's from its
 own data), virtual tooth numbers ``z_v = z / cos(delta)``, ``z_vn = z_v / (cos^2(beta_vb)
 cos(beta_m))``, ``sin(beta_vb) = sin(beta_m) cos(alpha_n)`` ([ISO10300-1];
-:func:`gearjax.tooth_compliance.virtual_cylindrical_teeth`; each member with its own
+:func:`gearjax.loading.pair_stiffness.virtual_cylindrical_teeth`; each member with its own
 mean spiral angle).  Addendum and dedendum at the mean point
 ``h_am, h_fm`` give the tooth form: ``x = (h_am - h_fm) / (2 m_mn)``,
 ``h_a* = h_f* = (h_am + h_fm) / (2 m_mn)``.  The contact point maps onto the virtual
@@ -27,9 +27,9 @@ from __future__ import annotations
 import jax.numpy as jnp
 
 from gearjax.gears.hypoid.pair import HypoidPair, mean_dedendum
-from gearjax.loaded_contact import MeshTeeth
-from gearjax.tca_result import TCAResult
-from gearjax.tooth_compliance import virtual_cylindrical_teeth
+from gearjax.loading.loaded_contact import MeshTeeth
+from gearjax.tca.result import TCAResult
+from gearjax.loading.pair_stiffness import virtual_cylindrical_teeth
 
 __all__ = ["hypoid_mesh_teeth"]
 
@@ -49,7 +49,7 @@ def _member(spec, h):
 
 
 def hypoid_mesh_teeth(pair: HypoidPair, res: TCAResult, drive: bool) -> MeshTeeth:
-    """:class:`~gearjax.loaded_contact.MeshTeeth` of the pair along the path of ``res``
+    """:class:`~gearjax.loading.loaded_contact.MeshTeeth` of the pair along the path of ``res``
     (traceable; module docstring)."""
     z1, m1, b1, x1, h1, r1 = _member(pair.pinion, res.coords["h1"])
     z2, m2, b2, x2, h2, r2 = _member(pair.gear, res.coords["h2"])

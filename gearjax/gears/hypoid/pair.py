@@ -68,7 +68,8 @@ from gearjax.gears.hypoid.flank import (FlankSpec, face_cone_gap, mid_estimate, 
                                         root_cone_gap, solve_tip, work_point)
 from gearjax.gears.hypoid.machine import MachineSettings, cutter_to_cradle
 from gearjax.surfaces import GeneratedSurface
-from gearjax.tca import Assembly, ContactPath
+from gearjax.tca.assembly import Assembly
+from gearjax.tca.path import ContactPath
 
 __all__ = ["SIDES", "HypoidPair", "program_pair", "pair_flanks", "mean_dedendum", "complementary_pinion",
            "with_point_radius", "flank_function", "hypoid_assembly", "mean_point",
@@ -284,7 +285,7 @@ def flank_function(fl: FlankSpec, crossing):
 
 
 def hypoid_assembly(pair: HypoidPair) -> Assembly:
-    """Nominal mounting as a core :class:`~gearjax.tca.Assembly` (module docstring)."""
+    """Nominal mounting as a core :class:`~gearjax.tca.assembly.Assembly` (module docstring)."""
     R0 = matrix_x(-pair.hand * pair.shaft_angle)
     c0 = jnp.stack([pair.offset, 0.0 * pair.offset, 0.0 * pair.offset])
     return Assembly(R0, c0, jnp.array([1.0, 0.0, 0.0]), pair.z1, pair.z2, -1)
@@ -328,7 +329,7 @@ def _member_margins(fl: FlankSpec, crossing, p_body):
 
 
 def hypoid_face_ends(pair: HypoidPair):
-    """``(margin_parts, g1, g2, (t1, t2))`` of :func:`gearjax.edge_contact.face_end_contact`:
+    """``(margin_parts, g1, g2, (t1, t2))`` of :func:`gearjax.tca.edge_contact.face_end_contact`:
     each member's boundary margins (mm) -- face width, face cone (tip) and fillet
     (root), as in :func:`_member_margins` -- at body points, the face-end functions
     ``g(q, e) = (F/2) (xi(q) - e)`` (toe ``e = -1``, heel ``e = +1``) and the tip-edge

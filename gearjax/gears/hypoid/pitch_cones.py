@@ -240,7 +240,7 @@ def _state(x, th, spiral_member, wheel_radius):
 
 
 def solve_pitch_cones(u, Sigma, E, de2, b2, beta, rc0, *, spiral_member="pinion",
-                      wheel_radius="mid-face", r2=None, strict=True):
+                      wheel_radius="mid-face", r2=None, throw=True):
     """[Tangent-cones] pitch cones: two-variable Newton in the pitch angles.
 
     The Newton unknowns are ``(delta1, gamma)``, ``gamma = n . x_f``, a smooth
@@ -260,8 +260,8 @@ def solve_pitch_cones(u, Sigma, E, de2, b2, beta, rc0, *, spiral_member="pinion"
     :func:`gearjax.newton.newton_solve` (implicit derivatives).  Start: ISO 23509
     Method 1 for the same data (the root does not depend on it).
 
-    ``strict=True`` raises :class:`gearjax.errors.ConvergenceError` on concrete
-    non-converged results; under tracing, or with ``strict=False``, check the
+    ``throw=True`` raises :class:`gearjax.errors.ConvergenceError` on concrete
+    non-converged results; under tracing, or with ``throw=False``, check the
     ``converged`` field.
     """
     if spiral_member not in ("pinion", "gear"):
@@ -273,7 +273,7 @@ def solve_pitch_cones(u, Sigma, E, de2, b2, beta, rc0, *, spiral_member="pinion"
     r2_fixed = jnp.asarray(0.0 if r2 is None else r2, dtype=float)
     sol = _solve(u, Sigma, E, de2, b2, beta, rc0, r2_fixed, spiral_member, wheel_radius)
     conv = sol.converged
-    if strict and not isinstance(conv, jax.core.Tracer):
+    if throw and not isinstance(conv, jax.core.Tracer):
         require_converged(conv, "pitch-cone tangency solve", sol.residual)
     return sol
 

@@ -83,7 +83,7 @@ transversal whenever the path direction is near its target.
    difference to ``beta*`` is wrapped into (-90, 90] degrees; 0 = lengthwise (along
    the face width), 90 = along the profile;
 6. contact-ellipse semi-major axis at the reference (mm, elastic approach
-   :data:`~gearjax.tca.DEFAULT_APPROACH`) minus the target.
+   :data:`~gearjax.tca.path.DEFAULT_APPROACH`) minus the target.
 
 Residuals are divided by the scales :data:`SCALES` (0.1 mm, 1 arcsec, 1 arcsec,
 1 arcsec, 1 deg, 0.1 mm); converged when every scaled residual is <= ``tol`` (default 1e-3,
@@ -94,7 +94,7 @@ i.e. 0.1 um, 0.001 arcsec, 0.001 deg).
 steps per pitch, 5 pairs) of the synthesised pair; the bearing position is read off
 where its path crosses the ``zeta = 0`` line (linear interpolation), the TE level
 as the TE of the envelope's apex (3-point parabola) minus the TE of pair 0 at the
-transfer points of :class:`~gearjax.tca.MultiPair`.
+transfer points of :class:`~gearjax.tca.path.MultiPair`.
 
 Units: mm, rad inside; arc-seconds and degrees at the output boundary.
 Reference: Litvin & Fuentes, *Gear Geometry and Applied Theory*, 2nd ed., ch. 9
@@ -118,7 +118,8 @@ from gearjax.gears.hypoid.pair import program_pair
 from gearjax.errors import ConvergenceError, check_int, check_range
 from gearjax.gears.hypoid.formate import generating_gear_pinion
 from gearjax.newton import newton_solve
-from gearjax.tca import ARCSEC, Misalignment, contact_equations, contact_path
+from gearjax.tca.path import ARCSEC, contact_equations, contact_path
+from gearjax.tca.assembly import Misalignment
 
 __all__ = ["VARIABLES", "DEFAULT_FREE", "SCALES", "RESIDUAL_NAMES", "Targets", "Start",
            "SynthesisResult", "conjugate_start", "start", "apply_variables", "mean_working_height",
@@ -407,7 +408,7 @@ class SynthesisResult:
 
 def synthesise(st: Start, targets: Targets | None = None, *, free=DEFAULT_FREE, v0=None,
                tol: float = 1e-3, max_iter: int = 40, steps_per_pitch: int = 8,
-               strict: bool = True) -> SynthesisResult:
+               throw: bool = True) -> SynthesisResult:
     """Least-squares local synthesis (module docstring) by Levenberg-Marquardt.
 
     ``st`` : :func:`start` of a design side; ``targets`` : :class:`Targets` (validated
@@ -416,7 +417,7 @@ def synthesise(st: Start, targets: Targets | None = None, *, free=DEFAULT_FREE, 
     :data:`DEFAULT_X0`: +2 mm point radius, 2C = 0.02 -- a localised pair; the
     conjugate start itself has a singular point-contact system); ``max_iter`` :
     accepted steps at most.  Raises :class:`~gearjax.errors.ConvergenceError` when
-    the scaled residuals do not reach ``tol`` (``strict=False`` returns the result
+    the scaled residuals do not reach ``tol`` (``throw=False`` returns the result
     with ``converged=False`` and its ``status``/``message``).
 
     Solver: :func:`gearjax.optimize.least_squares_lm`, all iterations in one jitted
@@ -471,11 +472,11 @@ def synthesise(st: Start, targets: Targets | None = None, *, free=DEFAULT_FREE, 
     res = SynthesisResult(replace(st.pair, pinion=pin), st, v, free, tgt, r * SCALES, achieved,
                           it, evals, converged, sv, y, history, seconds, status,
                           optimize.status_message(status))
-    if strict and not converged:
+    if throw and not converged:
         raise ConvergenceError(
             f"local synthesis did not converge ({res.message}) after {it} steps: max scaled "
             f"residual {history[-1]:.3g} > tol = {tol:g} (residuals "
-            f"{dict(zip(RESIDUAL_NAMES, r * SCALES))}); pass strict=False to get the last iterate")
+            f"{dict(zip(RESIDUAL_NAMES, r * SCALES))}); pass throw=False to get the last iterate")
     return res
 
 

@@ -1,9 +1,9 @@
 """Tooth contact analysis of face-milled hypoid and spiral-bevel pairs: the family for the
-one driver (:mod:`gearjax.family`).
+one driver (:mod:`gearjax.tca.family`).
 
 Builds, for a pinion flank and a gear flank of :mod:`gearjax.gears.hypoid.flank`
 (:class:`~gearjax.gears.hypoid.flank.FlankSpec`: cutter blade, machine settings, blank),
-everything the generic core :mod:`gearjax.tca` needs:
+everything the generic core :mod:`gearjax.tca.path` needs:
 
 * Flank functions, mounting and flank boundaries: :mod:`gearjax.gears.hypoid.pair`.
 
@@ -28,19 +28,20 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax.family import DriverAdapter, GearFamily, tca_parts
+from gearjax.tca.family import DriverAdapter, GearFamily, tca_parts
 from gearjax.gears.hypoid.design_file import HypoidDesign
 from gearjax.gears.hypoid.flank import face_apex_offset, root_apex_offset
 from gearjax.gears.hypoid.pair import (SIDES, HypoidPair, complementary_pinion, flank_coordinates,
                                        flank_function, hypoid_assembly, hypoid_face_ends,
                                        hypoid_margin, mean_dedendum, mean_point, pair_flanks,
                                        program_pair, with_point_radius)
-from gearjax.loaded_contact import TeethOf
+from gearjax.loading.loaded_contact import TeethOf
 from gearjax.newton import newton_solve
 from gearjax.surfaces import GeneratedSurface
-from gearjax.tca import (DEFAULT_APPROACH, ContactPath, Misalignment, MultiPair,
-                         NoContactError, contact_system)
-from gearjax.tca_result import register_family
+from gearjax.tca.path import (DEFAULT_APPROACH, ContactPath, MultiPair, NoContactError,
+                              contact_system)
+from gearjax.tca.assembly import Misalignment
+from gearjax.tca.result import register_family
 
 __all__ = ["mean_dedendum", "HypoidPair", "pair_flanks", "complementary_pinion",
            "hypoid_assembly", "flank_function", "reference_guess", "hypoid_margin",
@@ -96,7 +97,7 @@ def _mean_point_contact(r1, r2, pair: HypoidPair, mis: Misalignment, x_guess, ph
     """Where the pinion's point ``uv1 = x_guess[:2]`` meets the gear flank: position
     coincidence and one normal equation for ``(phi1, theta2, s2, phi2)``, with the
     motion parameters of the generated flanks and their meshing equations beside
-    them (:func:`~gearjax.tca.contact_system`).  Returns the Newton result (``x[0]``
+    them (:func:`~gearjax.tca.path.contact_system`).  Returns the Newton result (``x[0]``
     = phi1, differentiable), the contact system and the 5-vector ``x1``."""
     cs = contact_system(r1, r2, hypoid_assembly(pair), mis, False)
     x_guess = jax.lax.stop_gradient(jnp.asarray(x_guess, float))
@@ -145,9 +146,9 @@ def reference_contact(pair: HypoidPair, mis: Misalignment, x_guess, phi1_guess):
 class HypoidTCA(NamedTuple):
     """Result of a hypoid/spiral-bevel TCA.
 
-    path : :class:`~gearjax.tca.ContactPath` of tooth pair 0 (TE in rad).
+    path : :class:`~gearjax.tca.path.ContactPath` of tooth pair 0 (TE in rad).
     margin : (N,) boundary margin (mm, >= 0 on both working flanks).
-    multi : :class:`~gearjax.tca.MultiPair` (consecutive pairs, envelope, ptp,
+    multi : :class:`~gearjax.tca.path.MultiPair` (consecutive pairs, envelope, ptp,
         transfer points, contact ratio).
     coords : ``{xi1, h1, xi2, h2}`` face-width position (-1 toe .. +1 heel) and
         height above the root cone (mm) of the contact on pinion (1) and gear (2).
@@ -178,7 +179,7 @@ def prepare(pair: HypoidPair, n_search: int = 181) -> Prepared:
 
     ``drive`` is True when the pinion flank pushes the gear for increasing ``phi1``:
     ``(e_z x p1) . n1 > 0`` at the reference point, ``n1`` the pinion normal out of
-    its material.  Raises :class:`~gearjax.tca.NoContactError` when no hand and no
+    its material.  Raises :class:`~gearjax.tca.path.NoContactError` when no hand and no
     body rotations bring the mean points of the flanks within ``MAX_GAP`` with
     normals within ``MAX_ANGLE`` of opposite (the flanks cannot mesh).
     """
@@ -246,7 +247,7 @@ def pinion_outline(pair: HypoidPair) -> dict:
     return {"outline": np.array(pts + [pts[0]])}
 
 
-# -- the family for the one driver (gearjax.family) -------------------------------------
+# -- the family for the one driver (gearjax.tca.family) -------------------------------------
 
 @jax.tree_util.register_dataclass
 @dataclass(frozen=True)
@@ -384,7 +385,7 @@ def hypoid_tca_traced(pair: HypoidPair, mis: Misalignment, x_ref, phi1_ref, *,
                       steps_per_pitch: int = 16, half_pitches: float = 2.0,
                       line_contact: bool = False, n_pairs: int = 5, drive=True,
                       approach=DEFAULT_APPROACH, face_ends: bool = True) -> HypoidTCA:
-    """Traceable TCA of a flank pair by the one driver (:func:`gearjax.family.tca_parts`;
+    """Traceable TCA of a flank pair by the one driver (:func:`gearjax.tca.family.tca_parts`;
     see :class:`HypoidFamily`): ``x_ref, phi1_ref`` from :func:`prepare`, ``drive`` its
     sense of rotation.  With ``face_ends`` (default) the contacts at the toe and heel,
     the tip edges and their corners are solved too, and the contact made at each
@@ -397,11 +398,11 @@ def hypoid_tca_traced(pair: HypoidPair, mis: Misalignment, x_ref, phi1_ref, *,
 
 
 def hypoid_tca(pair: HypoidPair | Prepared, mis: Misalignment | None = None, *,
-               strict: bool = True, **options) -> HypoidTCA:
+               throw: bool = True, **options) -> HypoidTCA:
     """Jitted TCA of a flank pair (``pair`` a :class:`HypoidPair`, prepared here, or a
     :class:`Prepared`) without the kinematics, as a :class:`HypoidTCA`: the program of
-    :func:`gearjax.run_tca` (options and ``strict`` as there)."""
-    res = ADAPTER.run(pair, mis, strict=strict, **{**options, "kinematics": False})
+    :func:`gearjax.run_tca` (options and ``throw`` as there)."""
+    res = ADAPTER.run(pair, mis, throw=throw, **{**options, "kinematics": False})
     return HypoidTCA(res.path, res.margin, res.multi, res.coords)
 
 

@@ -18,7 +18,7 @@ units: mm and degrees.  Tables and keys:
   ``inv α_wt = 2 tan α_n (x1 + x2)/(z1 + z2) + inv α_t`` (ISO 21771).
 * ``[material]`` (optional table; both keys required when it is given):
   ``youngs_modulus_GPa`` (50..500), ``poisson`` (0..0.5) of both members -- E′ and the
-  tooth compliance of the loaded contact (:mod:`gearjax.materials`); without it steel.
+  tooth compliance of the loaded contact (:mod:`gearjax.loading.materials`); without it steel.
 * ``[modification]`` (optional table, every key optional, default 0): the pinion rack's
   ``pressure_angle_change_deg`` (-5..5), ``profile_crown_per_mm`` and
   ``lead_crown_per_mm`` (0..0.1) of :class:`gearjax.gears.involute.tca.InvoluteTCA`.
@@ -42,7 +42,7 @@ from gearjax.gears.involute.geometry import InvolutePair
 from gearjax.gears.involute.tca import ADAPTER, InvoluteTCA
 from gearjax.io import (DesignFileMixin, check_integer, check_keys, check_number, check_string,
                         register_design_kind, require_key)
-from gearjax.tca_result import register_family
+from gearjax.tca.result import register_family
 
 __all__ = ["InvoluteFile", "read_involute", "KIND", "PAIR_KEYS", "MODIFICATION_KEYS"]
 
@@ -75,9 +75,9 @@ class InvoluteFile(DesignFileMixin):
         return out
 
     def material(self):
-        """The file's ``[material]`` (:class:`gearjax.materials.Material`), or None (the
+        """The file's ``[material]`` (:class:`gearjax.loading.materials.Material`), or None (the
         documented steel default applies)."""
-        from gearjax.materials import SOURCE_DESIGN, Material
+        from gearjax.loading.materials import SOURCE_DESIGN, Material
         m = self.data.get("material")
         if m is None:
             return None

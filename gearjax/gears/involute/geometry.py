@@ -439,13 +439,13 @@ _path_jit = jax.jit(path_kinematics_traced, static_argnames=("side",))
 
 
 def path_kinematics(pair: InvolutePair, points: int = 21, side: int = -1, omega1: float = 1.0,
-                    strict: bool = True, t=None) -> PathResult:
+                    throw: bool = True, t=None) -> PathResult:
     """Eigenfunction kinematics at ``points`` equally spaced positions on the path of contact
     (or at the path fractions ``t`` in [0, 1] when given).  ``omega1`` is the pinion
     speed in rad/s, in (0, 10472] (up to 1e5 rpm); velocities come out in mm/s.
 
     Raises :class:`~gearjax.errors.ConvergenceError` if any contact solve failed
-    (``strict=False`` returns the result with its ``converged`` mask instead).
+    (``throw=False`` returns the result with its ``converged`` mask instead).
     """
     if side not in (-1, 1):
         raise ValueError(f"side = {side!r} must be -1 or +1")
@@ -458,7 +458,7 @@ def path_kinematics(pair: InvolutePair, points: int = 21, side: int = -1, omega1
     if t.ndim != 1 or not np.all((t >= 0.0) & (t <= 1.0)):
         raise ValueError("t must be path fractions in the allowed range [0, 1]")
     res = _path_jit(pair, jnp.asarray(t), side=side, omega1=omega1)
-    if strict:
+    if throw:
         require_converged(res.converged, "involute path of contact", res.residual)
     return res
 

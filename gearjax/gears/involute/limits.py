@@ -17,7 +17,7 @@ import jax
 import jax.numpy as jnp
 
 from gearjax.gears.involute.geometry import pair_geometry
-from gearjax.tca import ContactPath
+from gearjax.tca.path import ContactPath
 
 __all__ = ["MemberLimits", "signed_roll", "flank_limits", "involute_margin",
            "involute_face_ends", "involute_limits"]
@@ -119,7 +119,7 @@ def involute_margin(des, path: ContactPath):
 
 
 def involute_face_ends(des):
-    """``(margin_parts, g1, g2, (t1, t2))`` of :func:`gearjax.edge_contact.face_end_contact`:
+    """``(margin_parts, g1, g2, (t1, t2))`` of :func:`gearjax.tca.edge_contact.face_end_contact`:
     the boundary margins (face width, tip circle, form circle; :func:`_margins`) of each
     member at body points and their flank parameters, the face-end functions
     ``g(q, e) = q_z - e b/2`` of pinion and gear and their tip-edge functions

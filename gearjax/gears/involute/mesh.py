@@ -1,4 +1,4 @@
-"""The involute pair as the loaded-contact models see it (:class:`~gearjax.loaded_contact.MeshTeeth`).
+"""The involute pair as the loaded-contact models see it (:class:`~gearjax.loading.loaded_contact.MeshTeeth`).
 
 Each member is the spur gear of its normal section, ``z_n = z / (cos^2(beta_b)
 cos(beta))`` with the normal module and pressure angle ([ISO6336-1] virtual gear);
@@ -21,8 +21,8 @@ from __future__ import annotations
 import jax.numpy as jnp
 
 from gearjax.gears.involute.geometry import pair_geometry
-from gearjax.loaded_contact import MeshTeeth
-from gearjax.tca_result import TCAResult
+from gearjax.loading.loaded_contact import MeshTeeth
+from gearjax.tca.result import TCAResult
 
 __all__ = ["involute_mesh_teeth", "check_mesh_supported", "ohlendorf_loss_factor"]
 
@@ -37,7 +37,7 @@ def check_mesh_supported(des, line_contact: bool) -> None:
 
 def involute_mesh_teeth(des, res: TCAResult, line_contact: bool,
                         drive: bool) -> MeshTeeth:
-    """:class:`~gearjax.loaded_contact.MeshTeeth` of the involute pair along the path of
+    """:class:`~gearjax.loading.loaded_contact.MeshTeeth` of the involute pair along the path of
     ``res`` (traceable; module docstring)."""
     p = des.pair
     geo = pair_geometry(p)

@@ -6,7 +6,7 @@ says "concrete".
 **Preset TE.**  The pinion point ``t`` of the modified curve reaches the pitch line at
 ``phi1 = t + phase - s kappa (t - t_m)^2`` while the gear point conjugate to the
 unmodified curve is there at ``phi2 = -(z1/z2)(t + phase)``; in gearjax's TE (gear
-angle, :mod:`gearjax.tca`) the preset is therefore
+angle, :mod:`gearjax.tca.path`) the preset is therefore
 
     TE_preset(phi1) = s (z1/z2) kappa x^2,   x - s kappa x^2 = phi1 - phi1_ref,
     x = 2 y / (1 + sqrt(1 - 4 s kappa y)),   y = phi1 - phi1_ref,
@@ -45,8 +45,8 @@ import jax.numpy as jnp
 import numpy as np
 
 from gearjax.gears.preset_bevel.geometry import PresetBevelDesign, cone_distances
-from gearjax.tca import ARCSEC
-from gearjax.tca_result import TCAResult
+from gearjax.tca.path import ARCSEC
+from gearjax.tca.result import TCAResult
 
 __all__ = ["preset_te", "preset_deviation", "interp_uniform", "margin_crossings",
            "transfer_gaps", "transfer_jump", "sliding_ratio", "contact_ends", "smooth_max"]

@@ -40,8 +40,8 @@ from gearjax.gears.preset_bevel.geometry import (PresetBevelDesign, cone_distanc
 from gearjax.io import (DesignFileMixin, FlankGrid, check_integer, check_keys, check_number,  # noqa: F401
                         register_design_kind, require_key)
 from gearjax.newton import newton_solve
-from gearjax.tca import ARCSEC
-from gearjax.tca_result import register_family
+from gearjax.tca.path import ARCSEC
+from gearjax.tca.result import register_family
 
 __all__ = ["KIND", "PresetBevelFile", "read_preset_bevel", "validate_fields", "FlankGrid",
            "flank_grid", "SCHEMA"]

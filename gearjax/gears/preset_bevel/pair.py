@@ -1,7 +1,7 @@
 """The preset-TE bevel pair mounted for tooth contact analysis: assembly, sides, flank
 boundaries, reference contact ([Preset-TE-bevel]).
 
-**Mounting** (:class:`gearjax.tca.Assembly`): fixed frame = pinion frame at phi1 = 0
+**Mounting** (:class:`gearjax.tca.assembly.Assembly`): fixed frame = pinion frame at phi1 = 0
 (apex at the origin, pinion axis z); gear body -> fixed ``R0 = Rx(-Sigma)``, crossing
 point ``c0 = 0`` (the apex), common perpendicular ``d = x`` (the direction of an offset
 ``dE``; ``dSigma`` turns the gear axis about it), nominal ratio ``-z1/z2``
@@ -20,7 +20,7 @@ tip and root lines the heights ``h = r cos delta - z sin delta`` (signed distanc
 the pitch cone, r the distance from the member's axis) ``h = +addendum`` and
 ``h = -dedendum``; margin = the smallest distance to them (mm, >= 0 inside).
 
-**Edge contact** (:func:`preset_face_ends`, for :func:`gearjax.edge_contact.face_end_contact`):
+**Edge contact** (:func:`preset_face_ends`, for :func:`gearjax.tca.edge_contact.face_end_contact`):
 the face-end functions ``g(q, e) = |q| - A_m - e b/2`` (mm; zero on the toe sphere
 ``|q| = A_i`` for ``e = -1`` and on the heel sphere ``|q| = A_o`` for ``e = +1``) and the
 tip functions ``t(q) = addendum - h(q)`` (mm; zero on the face cone, > 0 below it).
@@ -37,7 +37,7 @@ import numpy as np
 from gearjax.gears.preset_bevel.geometry import (PresetBevelDesign, cone_distances, curve_range,
                                                  gear_assembly_rotation, gear_flank,
                                                  pinion_flank, pitch_angles)
-from gearjax.tca import Assembly
+from gearjax.tca.assembly import Assembly
 
 __all__ = ["SIDE_FLANKS", "preset_assembly", "side_flanks", "side_phase", "drives_forward", "side_code",
            "flank_coordinates", "preset_margin", "reference_contact",
@@ -103,7 +103,7 @@ def preset_margin(des: PresetBevelDesign, p1_body, p2_body):
 
 
 def preset_face_ends(des: PresetBevelDesign):
-    """``(margin_parts, g1, g2, (t1, t2))`` of :func:`gearjax.edge_contact.face_end_contact`
+    """``(margin_parts, g1, g2, (t1, t2))`` of :func:`gearjax.tca.edge_contact.face_end_contact`
     (module docstring): each member's margins (mm, >= 0 inside) to its face ends (the
     nearer of toe and heel), tip (face cone) and root at body points (N, 3), the face-end
     functions ``g_k(q, e)`` and the tip-edge functions ``t_k(q)`` of pinion and gear."""

@@ -1,20 +1,20 @@
 """TCA of pure-rolling bevel pairs with a preset TE: the family as data for the one
-TCA driver (:mod:`gearjax.family`).
+TCA driver (:mod:`gearjax.tca.family`).
 
 The flanks are explicit functions ``S_C1(u, t)``, ``S_C2(v, t)``
 (:mod:`gearjax.gears.preset_bevel.geometry`; not envelopes), mounted as in
 :mod:`gearjax.gears.preset_bevel.pair`.  The contact is a point contact (profile arcs
 of radii rho1, rho2 convex against each other): the 5x5 system of
-:func:`gearjax.tca.contact_path` in ``(u1, t1, v2, t2, phi2)``, continued over a
+:func:`gearjax.tca.path.contact_path` in ``(u1, t1, v2, t2, phi2)``, continued over a
 uniform grid of pinion angles ``phi1_ref + k 2 pi/(z1 steps_per_pitch)``, centred on
 the mid-face contact of the unmodified pair.  For ``kappa = 0`` and no misalignment
 the solution is known in closed form (``u = v = 0``, ``t = phi1 - phase``, ``phi2 =
 -(z1/z2) phi1``: contact along the pitch line, TE = 0); the tests compare with it.
 
-The result is the common :class:`gearjax.tca_result.TCAResult` (``family =
+The result is the common :class:`gearjax.tca.result.TCAResult` (``family =
 "preset_bevel"``), ``coords`` = cone distance and height above the pitch cone of the
 contact on both members (``L1, h1, L2, h2``, mm) and the flank parameters ``t1``,
-``t2``.  Edge contact is solved (:func:`gearjax.edge_contact.face_end_contact`
+``t2``.  Edge contact is solved (:func:`gearjax.tca.edge_contact.face_end_contact`
 with :func:`gearjax.gears.preset_bevel.pair.preset_face_ends`): where the toe or heel
 edge (sphere ``|q| = A_i, A_o``) or the tip edge (face cone) of a member touches the
 mating flank ahead of the surface contact, or carries the load where the surface
@@ -30,16 +30,17 @@ from __future__ import annotations
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax.family import DriverAdapter, GearFamily, result_traced
+from gearjax.tca.family import DriverAdapter, GearFamily, result_traced
 from gearjax.gears.preset_bevel.geometry import PresetBevelDesign, cone_distances, pitch_angles
 from gearjax.gears.preset_bevel.pair import (drives_forward, preset_assembly, preset_face_ends,
                                              preset_margin, reference_contact, side_flanks)
-from gearjax.loaded_contact import TeethOf
-from gearjax.tca import DEFAULT_APPROACH, Misalignment
-from gearjax.tca_result import TCAResult, register_family
+from gearjax.loading.loaded_contact import TeethOf
+from gearjax.tca.path import DEFAULT_APPROACH
+from gearjax.tca.assembly import Misalignment
+from gearjax.tca.result import TCAResult, register_family
 
-__all__ = ["PresetBevelFamily", "preset_result_traced", "preset_tca", "preset_outline",
-           "SUMMARY_KEYS", "preset_summary", "preset_sensitivity", "DEFAULTS", "ADAPTER"]
+__all__ = ["PresetBevelFamily", "preset_result_traced", "preset_outline",
+           "SUMMARY_KEYS", "preset_summary", "DEFAULTS", "ADAPTER"]
 
 #: default TCA grid of the family
 DEFAULTS = dict(steps_per_pitch=24, half_pitches=1.0, n_pairs=3)
@@ -137,7 +138,7 @@ def preset_result_traced(des: PresetBevelDesign, mis: Misalignment, x_ref, phi1_
                          half_pitches: float = 1.0, n_pairs: int = 3,
                          approach=DEFAULT_APPROACH, kinematics: bool = True,
                          face_ends: bool = True) -> TCAResult:
-    """Traceable TCA of ``side`` (the driver's :func:`~gearjax.family.tca_parts` for this
+    """Traceable TCA of ``side`` (the driver's :func:`~gearjax.tca.family.tca_parts` for this
     family).  ``x_ref, phi1_ref`` from :func:`~gearjax.gears.preset_bevel.pair.
     reference_contact` (concrete, fixed: the grid does not move with the design).
     ``face_ends``: solve the edge contacts (default; ``False``: surface contact only,
@@ -145,17 +146,3 @@ def preset_result_traced(des: PresetBevelDesign, mis: Misalignment, x_ref, phi1_
     return result_traced(FAMILY, des, mis, x_ref, phi1_ref, side, approach,
                          steps_per_pitch=steps_per_pitch, half_pitches=half_pitches,
                          n_pairs=n_pairs, kinematics=kinematics, face_ends=face_ends)
-
-
-def preset_tca(des: PresetBevelDesign, mis: Misalignment | None = None, *, side="drive",
-               **options) -> TCAResult:
-    """Validated, jitted TCA of the pair (what ``gearjax.run_tca`` runs; options as
-    there, :mod:`gearjax.family`)."""
-    return ADAPTER.run(des, mis, side=side, **options)
-
-
-def preset_sensitivity(des: PresetBevelDesign, mis: Misalignment | None = None, *,
-                       side="drive", **options):
-    """V-H sensitivity ``(values, table)`` of :data:`SUMMARY_KEYS` to dE, dP, dG (per
-    mm) and dSigma (per rad) by ``jax.jacfwd`` (implicit derivatives of every solve)."""
-    return ADAPTER.sensitivity(des, mis, side=side, **options)

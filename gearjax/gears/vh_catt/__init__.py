@@ -1,1 +1,13 @@
-"""VH-CATT cylindrical gears (variable hyperbolic circular-arc tooth trace), [VH-CATT]."""
+"""VH-CATT cylindrical gears (variable hyperbolic circular-arc tooth trace), [VH-CATT]:
+``gearjax.vh_catt``.
+
+The pair (:class:`VHCattPair`: flanks as envelopes of the dual-blade cutter carried by
+the generating roll) and its design file (``[design] kind = "vh_catt"``,
+:class:`VHCattDesign`, with its ``[material]``).  Its TCA and mesh efficiency run
+through :func:`gearjax.run_tca` and :func:`gearjax.mesh_efficiency` like every family.
+"""
+
+from gearjax.gears.vh_catt.geometry import VHCattPair
+from gearjax.gears.vh_catt.design_file import VHCattDesign
+
+__all__ = ["VHCattPair", "VHCattDesign"]

@@ -14,9 +14,9 @@ File units: mm, degrees, GPa.  Tables and keys (all required unless marked):
     trace radii R_T -+ (w/2 + e); 0 = the plain dual-blade head).
 * ``[material]`` ``youngs_modulus_GPa`` (50..500), ``poisson`` (0..0.5): both members.
   It sets the loaded contact's reduced modulus E' = E/(1 - nu^2) (Hertz, film,
-  asperities) and the tooth compliance (E, nu) of :func:`gearjax.mesh_efficiency`,
+  asperities) and the tooth compliance (E, nu) of :func:`gearjax.loading.mesh_efficiency`,
   :func:`gearjax.efficiency_function` and ``gearjax efficiency``
-  (:meth:`VHCattDesign.material`, :mod:`gearjax.materials`); an explicit E'
+  (:meth:`VHCattDesign.material`, :mod:`gearjax.loading.materials`); an explicit E'
   (``E_prime=`` / ``--E-prime-MPa``) overrides it, with the file's nu.
 
 Every number must be a finite TOML number (tooth numbers TOML integers); unknown
@@ -39,7 +39,7 @@ from gearjax.gears.vh_catt.geometry import VHCattPair, flank_grid
 from gearjax.gears.vh_catt.tca import ADAPTER
 from gearjax.io import (FlankGrid, check_integer, check_keys, check_number, check_string,
                         register_design_kind, require_key)
-from gearjax.tca_result import register_family
+from gearjax.tca.result import register_family
 
 __all__ = ["VHCattDesign", "design_from_dict", "FlankGrid", "KIND", "flank_sigma"]
 
@@ -76,11 +76,11 @@ class VHCattDesign:
         return []
 
     def material(self):
-        """The ``[material]`` table as a :class:`gearjax.materials.Material` (E in MPa,
+        """The ``[material]`` table as a :class:`gearjax.loading.materials.Material` (E in MPa,
         ν; both members): it sets E′ = E/(1 − ν²) and the tooth compliance of
-        :func:`gearjax.mesh_efficiency` and ``gearjax efficiency`` unless E′ is given
-        explicitly (:func:`gearjax.materials.pair_material`)."""
-        from gearjax.materials import SOURCE_DESIGN, Material
+        :func:`gearjax.loading.mesh_efficiency` and ``gearjax efficiency`` unless E′ is given
+        explicitly (:func:`gearjax.loading.materials.pair_material`)."""
+        from gearjax.loading.materials import SOURCE_DESIGN, Material
         m = self.data["material"]
         return Material(float(m["youngs_modulus_GPa"]) * 1e3, float(m["poisson"]),
                         SOURCE_DESIGN)

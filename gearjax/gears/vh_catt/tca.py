@@ -1,4 +1,4 @@
-"""TCA of VH-CATT pairs: the family as data for the one TCA driver (:mod:`gearjax.family`).
+"""TCA of VH-CATT pairs: the family as data for the one TCA driver (:mod:`gearjax.tca.family`).
 
 Mounting (as the involute family): pinion (member 1) about +z through the origin,
 gear (member 2) about +z through ``(0, a + dE, 0)``, ``a = r1 + r2`` (standard
@@ -8,7 +8,7 @@ the pinion's concave flank (outside blade, trace radius ``R_T1 + w/2``) against 
 gear's convex flank (inside blade, ``R_T2 - w/2``); ``sigma = +1`` the coast side
 (pinion convex ``R_T1 - w/2`` against gear concave ``R_T2 + w/2``).  The traces
 differ, so the flanks touch at a point (point-contact TCA, 5 contact equations and
-the two meshing equations, :func:`gearjax.tca.contact_system`).
+the two meshing equations, :func:`gearjax.tca.path.contact_system`).
 
 Reference contact: the pitch point of the middle section (blade coordinates
 u = v = 0 on both members, which generate the pitch-radius point of z = 0); each
@@ -21,7 +21,7 @@ move the contact off the middle section, where the sections are not involutes.
 Flank boundaries: tip circles ``r + m``, form circles of the straight blades
 (:func:`gearjax.gears.vh_catt.geometry.pair_geometry`; those of the middle section,
 which the other sections follow to within the trace's small tangential extent) and
-the face ends ``|z| <= b/2``.  Edge contact (:mod:`gearjax.edge_contact`): the face
+the face ends ``|z| <= b/2``.  Edge contact (:mod:`gearjax.tca.edge_contact`): the face
 ends, the tip edges on the addendum cylinders ``t_k = r_ak - |q_xy|`` and the corners
 where they meet (premature/prolonged contact of a mismatched pair; the corners lead
 where the TE along a tip edge is lowest in the middle section, as found for a pinion
@@ -36,14 +36,15 @@ from __future__ import annotations
 import jax
 import jax.numpy as jnp
 
-from gearjax.family import DriverAdapter, GearFamily, result_traced, tca_parts
+from gearjax.tca.family import DriverAdapter, GearFamily, tca_parts
 from gearjax.gears.vh_catt.geometry import VHCattPair, generated_flank, pair_geometry
-from gearjax.loaded_contact import TeethOf
-from gearjax.tca import DEFAULT_APPROACH, Assembly, ContactPath, Misalignment
-from gearjax.tca_result import TCAResult, register_family
+from gearjax.loading.loaded_contact import TeethOf
+from gearjax.tca.path import DEFAULT_APPROACH, ContactPath
+from gearjax.tca.assembly import Assembly, Misalignment
+from gearjax.tca.result import register_family
 
 __all__ = ["vh_assembly", "vh_flanks", "reference_guess", "vh_margin", "vh_tca_traced", "margin_parts",
-           "vh_result_traced", "SUMMARY_KEYS", "tca_summary", "pair_of",
+           "SUMMARY_KEYS", "tca_summary", "pair_of",
            "VHCattFamily", "ADAPTER"]
 
 
@@ -121,12 +122,12 @@ def vh_margin(pair: VHCattPair, path: ContactPath, pinion: VHCattPair | None = N
 def margin_parts(pair: VHCattPair):
     """``margin_parts(q1, q2, uv1, uv2) -> (face1, tip1, root1, face2, tip2, root2)``:
     the boundary margins (mm, >= 0 inside) of pinion and gear at body points with their
-    flank parameters (:func:`gearjax.edge_contact.face_end_contact`)."""
+    flank parameters (:func:`gearjax.tca.edge_contact.face_end_contact`)."""
     return _face_ends(pair)[0]
 
 
 def _face_ends(pair: VHCattPair, pinion: VHCattPair | None = None):
-    """``(margin_parts, g1, g2, (t1, t2))`` of :func:`gearjax.edge_contact.face_end_contact`:
+    """``(margin_parts, g1, g2, (t1, t2))`` of :func:`gearjax.tca.edge_contact.face_end_contact`:
     the margins of face width ``b/2 - |q_z|``, tip ``r_a - |q_xy|`` and form circle
     (:func:`_root_margin`) of each member, the face ends ``g(q, e) = q_z - e b/2`` and
     the tip edges ``t_k(q) = r_ak - |q_xy|`` (mm): the blank of a VH-CATT member is the
@@ -251,22 +252,11 @@ ADAPTER = DriverAdapter(FAMILY)
 register_family(VHCattPair, ADAPTER)
 
 
-def vh_result_traced(pair: VHCattPair, mis: Misalignment, *, side: str = "drive",
-                     steps_per_pitch: int = 24, half_pitches: float = 1.25, n_pairs: int = 3,
-                     approach=DEFAULT_APPROACH, kinematics: bool = True,
-                     face_ends: bool = True) -> TCAResult:
-    """The driver's TCA of this family as a :class:`~gearjax.tca_result.TCAResult`
-    (traceable)."""
-    return result_traced(FAMILY, pair, mis, None, None, side, approach,
-                         steps_per_pitch=steps_per_pitch, half_pitches=half_pitches,
-                         n_pairs=n_pairs, kinematics=kinematics, face_ends=face_ends)
-
-
 def vh_tca_traced(pair: VHCattPair, mis: Misalignment, code, *, steps_per_pitch: int = 24,
                   half_pitches: float = 1.25, n_pairs: int = 3, approach=DEFAULT_APPROACH,
                   face_ends: bool = True, pinion: VHCattPair | None = None):
     """Traceable point-contact TCA ``(path, margin, multi)`` of side ``code`` (-1 drive,
-    +1 coast; may be traced) by the one driver (:func:`gearjax.family.tca_parts`), on
+    +1 coast; may be traced) by the one driver (:func:`gearjax.tca.family.tca_parts`), on
     the uniform grid of pinion angles ``phi1_ref + k 2 pi/(z1 steps_per_pitch)``,
     ``|k| <= round(half_pitches steps_per_pitch)``; with ``face_ends`` the edge
     contacts (face ends, tip edges, corners) are solved too.

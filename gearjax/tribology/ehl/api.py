@@ -121,7 +121,7 @@ def _check_grid_inputs(n, angle_deg):
 def solve_ehl(F, u_e, u_s, Rx, Ry, eta0, alpha_per_GPa, E_prime=226373.6, tau0_MPa=5.0,
               sigma_um=0.0, density_per_mm2=1.0e4, beta_um=10.0, f_c=0.1, v_slip_mm_s=1.0,
               *, n=128, angle_deg=0.0, mixed=None, continuation="auto", tol=None,
-              max_steps=60, strict=True, upwind=0.0,
+              max_steps=60, throw=True, upwind=0.0,
               limiter="none") -> tuple[EHLResult, EHLCase, EHLGrid]:
     """Numerical EHL point contact (validated entry point).
 
@@ -140,9 +140,9 @@ def solve_ehl(F, u_e, u_s, Rx, Ry, eta0, alpha_per_GPa, E_prime=226373.6, tau0_M
     ``tol`` : convergence tolerance on max|R| (p_h units and relative load error);
     None (default) takes :func:`default_tol` of the grid (1e-9 up to 128², 1e-6 above).
 
-    Returns ``(result, case, grid)``.  With ``strict=True`` (default) a solve that
+    Returns ``(result, case, grid)``.  With ``throw=True`` (default) a solve that
     did not converge raises :class:`gearjax.errors.ConvergenceError`; with
-    ``strict=False`` check ``result.converged`` yourself.
+    ``throw=False`` check ``result.converged`` yourself.
     """
     if isinstance(n, bool) or not float(n).is_integer():
         raise ValueError(f"n = {n!r} must be an integer in [16, 1024]")
@@ -173,11 +173,11 @@ def solve_ehl(F, u_e, u_s, Rx, Ry, eta0, alpha_per_GPa, E_prime=226373.6, tau0_M
                 break
     if auto and int(n) <= NESTED_ABOVE and not bool(res.converged) and int(n) // 2 >= 32:
         res = _nested(locals(), grid) or res
-    if strict and not bool(res.converged):
+    if throw and not bool(res.converged):
         raise ConvergenceError(
             f"EHL solve did not converge (residual {float(res.residual):.3g} > tol {tol:g}, "
             f"{int(res.steps)} Newton steps); refine the grid, add continuation stages or "
-            "pass strict=False to inspect the state")
+            "pass throw=False to inspect the state")
     return res, case, grid
 
 
@@ -211,7 +211,7 @@ def _nested(a, grid):
                                  angle_deg=a["angle_deg"], mixed=a["mixed"],
                                  continuation="auto", tol=a["tol_arg"],
                                  max_steps=a["max_steps"],
-                                 strict=False, upwind=a["upwind"], limiter=a["limiter"])
+                                 throw=False, upwind=a["upwind"], limiter=a["limiter"])
     if not bool(coarse.converged):
         return None
     x0 = _prolong(coarse.x, cgrid, grid, bool(a["mixed"]))

@@ -4,7 +4,7 @@ Pair ``k`` is pair 0's contact path shifted by ``k`` angular pitches of the pini
 (``steps_per_pitch`` grid steps); at each pinion angle the pair that carries the contact
 is the one furthest ahead in the sense of the load (drive: the largest TE, coast: the
 smallest), and the envelope of those TEs is the unloaded transmission error of the mesh
-([Litvin2004] ch. 9).  Split out of :mod:`gearjax.tca` (which re-exports every name
+([Litvin2004] ch. 9).  Split out of :mod:`gearjax.tca.path` (which re-exports every name
 here); the contact path itself is solved there.
 """
 
@@ -16,7 +16,7 @@ import jax.numpy as jnp
 import numpy as np
 
 if TYPE_CHECKING:
-    from gearjax.tca import ContactPath
+    from gearjax.tca.path import ContactPath
 
 __all__ = ["MultiPair", "multi_pair", "pair_arrays"]
 

@@ -1,5 +1,5 @@
 """Validation of the operating inputs of the mesh-efficiency entry points
-(:func:`gearjax.mesh_efficiency.mesh_efficiency`, ``efficiency_function``): torque, pinion
+(:func:`gearjax.loading.mesh_efficiency.mesh_efficiency`, ``efficiency_function``): torque, pinion
 speed, E′, ν, the oil's and the surface's fields and the model names, checked on
 concrete values before any work, as the command line does (one-line ``ValueError``
 naming the parameter, its value and the allowed range; traced values pass).
@@ -15,7 +15,7 @@ import math
 import numpy as np
 
 from gearjax.errors import check_range, is_traced
-from gearjax.loaded_contact import COMPLIANCE_MODELS
+from gearjax.loading.loaded_contact import COMPLIANCE_MODELS
 
 __all__ = ["TORQUE_RANGE_NM", "RPM_RANGE", "check_operating_point", "check_efficiency_inputs",
            "check_models"]
@@ -63,7 +63,7 @@ def check_efficiency_inputs(torque_Nm, pinion_rpm, oil, surface, E_prime, poisso
     refused), ν in [0, 0.5], the oil and surface fields in the ranges of
     :func:`gearjax.tribology.make_oil` / :func:`~gearjax.tribology.make_surface`, and
     the model names.  Traced values are not checked.  One-line ValueError."""
-    from gearjax.materials import POISSON_RANGE, check_e_prime
+    from gearjax.loading.materials import POISSON_RANGE, check_e_prime
 
     check_operating_point(torque_Nm, pinion_rpm)
     check_e_prime(E_prime)

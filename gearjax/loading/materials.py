@@ -9,7 +9,7 @@ For the two members of one material (the only case the design files describe: a
 VH-CATT file's ``[material]`` table holds E and ν of both members) this is
 ``E′ = E/(1 − ν²)``, the plane-strain modulus; steel (E = 206 000 MPa, ν = 0.3) gives
 E′ = 226 374 MPa (:data:`gearjax.tribology.STEEL_E_PRIME`).  The tooth compliance
-(:mod:`gearjax.tooth_compliance`: Weber/Cornell cantilever, Sainsot foundation, Weber
+(:mod:`gearjax.loading.tooth_compliance`: Weber/Cornell cantilever, Sainsot foundation, Weber
 line contact; ISO 6336's single stiffness scaled by ``E/E_st``) takes E and ν of the
 same material, so a stiffer material shortens both the Hertz approach and the tooth
 deflection.
@@ -35,7 +35,7 @@ from __future__ import annotations
 from typing import NamedTuple
 
 from gearjax.errors import check_range, is_traced
-from gearjax.tooth_compliance import E_STEEL, NU_STEEL
+from gearjax.loading.tooth_compliance import E_STEEL, NU_STEEL
 
 __all__ = ["Material", "STEEL", "E_PRIME_RANGE_MPA", "YOUNGS_MODULUS_RANGE_MPA",
            "POISSON_RANGE", "reduced_modulus", "pair_material", "check_e_prime",

@@ -3,10 +3,10 @@
 A family says *what* its pair is -- flanks, mounting, flank boundaries, edges,
 reference contact, summary -- by implementing :class:`GearFamily`; the driver here
 says *how* a TCA is run, once for every family: the grid of pinion angles, the
-continued contact solve (:func:`gearjax.tca.contact_path`), the edge contacts
-(:func:`gearjax.edge_contact.face_end_contact`), the consecutive tooth pairs and the
-TE envelope (:func:`gearjax.multi_pair.multi_pair`), the rolling/sliding kinematics
-(:func:`gearjax.tca_result.contact_kinematics`) and the :class:`TCAResult`.  One
+continued contact solve (:func:`gearjax.tca.path.contact_path`), the edge contacts
+(:func:`gearjax.tca.edge_contact.face_end_contact`), the consecutive tooth pairs and the
+TE envelope (:func:`gearjax.tca.multi_pair.multi_pair`), the rolling/sliding kinematics
+(:func:`gearjax.tca.result.contact_kinematics`) and the :class:`TCAResult`.  One
 compiled program per family class and static option set serves both sides and every
 design of the family (the family object is a static argument; the pair a pytree).
 
@@ -16,13 +16,13 @@ on the drive side), so that both sides share one program.  Which sense of rotati
 side's flank pushes the gear for is the family's :meth:`GearFamily.forward`: True
 where the pinion flank pushes the gear for increasing ``phi1``, so that the TE
 envelope is the maximum over the tooth pairs (the ``drive`` argument of
-:func:`~gearjax.edge_contact.face_end_contact` and
-:func:`~gearjax.multi_pair.multi_pair`).
+:func:`~gearjax.tca.edge_contact.face_end_contact` and
+:func:`~gearjax.tca.multi_pair.multi_pair`).
 
 **Options** (same names, meaning and checks in every family): ``steps_per_pitch``,
 ``half_pitches``, ``n_pairs`` (defaults: :attr:`GearFamily.defaults`), ``approach``
 (mm, Hertz approach of the contact ellipse), ``kinematics`` (default True),
-``face_ends`` (default True: solve the edge contacts), ``strict`` (``run`` only).
+``face_ends`` (default True: solve the edge contacts), ``throw`` (``run`` only).
 ``line_contact`` is accepted where the family supports it (:attr:`GearFamily.
 line_contact_modes`) and refused in one line elsewhere; an unknown option is refused
 in one line naming it; an option given as None takes the family's default.
@@ -39,11 +39,12 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax.edge_contact import face_end_contact
-from gearjax.multi_pair import multi_pair
-from gearjax.tca import (DEFAULT_APPROACH, Misalignment, check_on_flank_converged,
-                         check_tca_options, contact_path, pinion_angle_grid)
-from gearjax.tca_result import TCAResult, check_side, contact_kinematics, strong_float64
+from gearjax.tca.edge_contact import face_end_contact
+from gearjax.tca.multi_pair import multi_pair
+from gearjax.tca.path import (DEFAULT_APPROACH, check_on_flank_converged, check_tca_options,
+                              contact_path, pinion_angle_grid)
+from gearjax.tca.assembly import Misalignment
+from gearjax.tca.result import TCAResult, check_side, contact_kinematics, strong_float64
 
 __all__ = ["GearFamily", "DriverAdapter", "tca_parts", "result_traced", "sensitivity_table",
            "OPTION_NAMES"]
@@ -137,7 +138,7 @@ class GearFamily:
     def flanks(self, pair, drive, line_contact=False):
         """``(r1, r2)``: pinion and gear flank functions ``uv -> (3,)`` (body frames, mm)
         of the side ``drive`` (traced bool); with ``line_contact`` parametrised so that
-        the solved contact line's section is ``uv[1] = 0`` (:mod:`gearjax.tca`)."""
+        the solved contact line's section is ``uv[1] = 0`` (:mod:`gearjax.tca.path`)."""
         raise NotImplementedError
 
     def refine_reference(self, pair, mis, r1, r2, x_ref, phi1_ref, line_contact):
@@ -151,7 +152,7 @@ class GearFamily:
         return drive
 
     def assembly(self, pair):
-        """The nominal mounting (:class:`gearjax.tca.Assembly`)."""
+        """The nominal mounting (:class:`gearjax.tca.assembly.Assembly`)."""
         raise NotImplementedError
 
     def pinion_teeth(self, pair):
@@ -165,7 +166,7 @@ class GearFamily:
     def path_position(self, pair, path, coords):
         """(N,) the position of the contact along its path in the family's own
         coordinate (``coords["path_position"]``, the objective of the same name of
-        :meth:`~gearjax.tca_result.TCAResult.objectives`): by default the radius on the
+        :meth:`~gearjax.tca.result.TCAResult.objectives`): by default the radius on the
         pinion (mm)."""
         return path.radial1
 
@@ -175,7 +176,7 @@ class GearFamily:
         return {}
 
     def edges(self, pair):
-        """``(margin_parts, g1, g2, tips)`` of :func:`~gearjax.edge_contact.face_end_contact`,
+        """``(margin_parts, g1, g2, tips)`` of :func:`~gearjax.tca.edge_contact.face_end_contact`,
         or None (no edge contact solved)."""
         return None
 
@@ -266,7 +267,7 @@ def _result(fam, pair, mis, x_ref, phi1_ref, approach, side, static) -> TCAResul
 
 def sensitivity_table(keys, vals, jac):
     """``(values, table)`` of concrete summary values ``vals`` and their derivatives by
-    the misalignment (``jac``, a :class:`~gearjax.tca.Misalignment` of arrays):
+    the misalignment (``jac``, a :class:`~gearjax.tca.assembly.Misalignment` of arrays):
     ``values[key]``, ``table[key] = {"dE": .., "dP": .., "dG": .., "dSigma": ..}``."""
     values = {k: float(v) for k, v in zip(keys, np.asarray(vals))}
     table = {k: {n: float(np.asarray(getattr(jac, n))[i]) for n in ("dE", "dP", "dG", "dSigma")}
@@ -275,7 +276,7 @@ def sensitivity_table(keys, vals, jac):
 
 
 class DriverAdapter:
-    """The registry entry (:func:`gearjax.tca_result.register_family`) of a family
+    """The registry entry (:func:`gearjax.tca.result.register_family`) of a family
     ported to the driver: ``run``, ``traced``, ``sensitivity``, ``mesh``, ``outline``
     and ``check`` written once for every family."""
 
@@ -302,7 +303,7 @@ class DriverAdapter:
         """``(approach, static options)`` with the family's defaults for the concrete
         ``pair`` (:meth:`GearFamily.default_options`), validated: an unknown option or
         an unsupported contact mode is a one-line ValueError."""
-        allowed = set(OPTION_NAMES) | ({"strict"} if run else set())
+        allowed = set(OPTION_NAMES) | ({"throw"} if run else set())
         unknown = sorted(set(options) - allowed)
         if unknown:
             raise ValueError(f"unknown TCA option {unknown[0]!r} for {self.fam.name} pairs "
@@ -310,7 +311,7 @@ class DriverAdapter:
         o = {"line_contact": self.fam.line_contact_modes[0],
              **self.fam.default_options(pair), "approach": DEFAULT_APPROACH,
              "kinematics": True, "face_ends": True,
-             **{k: v for k, v in options.items() if k != "strict" and v is not None}}
+             **{k: v for k, v in options.items() if k != "throw" and v is not None}}
         lc = bool(o["line_contact"])
         if lc not in self.fam.line_contact_modes:
             why = f": {self.fam.contact_mode_reason}" if self.fam.contact_mode_reason else ""
@@ -334,17 +335,17 @@ class DriverAdapter:
         return self.fam.setup(design, None if side is None else check_side(side))
 
     def run(self, design, mis=None, *, side=None, **options) -> TCAResult:
-        """Validated, jitted TCA; ``strict`` (default True) raises
+        """Validated, jitted TCA; ``throw`` (default True) raises
         :class:`~gearjax.errors.ConvergenceError` (``NoContactError``) when a solve
         failed on the working flank or no grid point is on both flanks."""
-        strict = options.get("strict", True)
+        throw = options.get("throw", True)
         setup, side = self._setup(design, side)
         approach, static = self.options(options, setup, run=True)
         mis = Misalignment.zero() if mis is None else mis
         x_ref, phi1_ref = self._reference(setup, side)
         pair = self.fam.program_pair(self.fam.user_pair(setup), setup)
         res = _result(self.fam, pair, mis, x_ref, phi1_ref, approach, side, static)
-        if strict:
+        if throw:
             check_on_flank_converged(res.path, res.margin)
         return res
 
@@ -382,7 +383,7 @@ class DriverAdapter:
         differentiable pair and the set-up to run the TCA of (``options`` those of the
         TCA: the contact mode decides the teeth)."""
         setup, side = self._setup(design, side)
-        lc = self.options({k: v for k, v in options.items() if k != "strict"},
+        lc = self.options({k: v for k, v in options.items() if k != "throw"},
                           setup)[1]["line_contact"]
         teeth_of, p = self.fam.teeth(setup, side, line_contact=lc)
         return teeth_of, p, setup

@@ -1,19 +1,8 @@
 """Tooth contact analysis (TCA) of two tooth surfaces — the generic core.
 
 Two tooth surfaces, each given in its own body frame whose rotation axis is the
-body z axis, are mounted in one fixed frame:
-
-    pinion (member 1):  r1f = Rz(phi1) r1(u1, v1) + dP e_z
-    gear   (member 2):  r2f = c + R Rz(phi2) r2(u2, v2)
-                        R = Rot(d, dSigma) R0,   c = c0 + dE d + dG (R e_z)
-
-``R0`` maps the gear body frame to the fixed frame at phi2 = 0, ``c0`` is the
-point of the gear axis on the common perpendicular (the crossing point) and ``d``
-the unit common perpendicular (for parallel axes: the centre line).  The
-misalignments (:class:`Misalignment`, mm and rad) are: ``dE`` shift of the gear
-along ``d`` (change of offset / centre distance), ``dP`` axial shift of the pinion
-along its axis, ``dG`` axial shift of the gear along its axis, ``dSigma`` rotation
-of the gear axis about ``d`` through the crossing point (change of shaft angle).
+body z axis, are mounted in one fixed frame with the misalignments dE, dP, dG,
+dSigma (:mod:`gearjax.tca.assembly`: the mounting equations and their definition).
 
 **Contact equations** (Litvin & Fuentes, *Gear Geometry and Applied Theory*, 2nd
 ed., ch. 9): for a given pinion angle phi1, unknowns x = (u1, v1, u2, v2, phi2),
@@ -72,17 +61,17 @@ Units: mm, rad inside; arc-seconds only in keys/fields named ``*_arcsec``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from typing import Callable, NamedTuple
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax.frames import matrix_axis, matrix_z
+from gearjax.frames import matrix_z
 from gearjax.errors import ConvergenceError, check_int, check_range, require_converged
 from gearjax.newton import newton_solve
-from gearjax.multi_pair import MultiPair, multi_pair, pair_arrays  # re-exported
+from gearjax.tca.assembly import Assembly, Misalignment, gear_mount, rotation_about  # re-exported
+from gearjax.tca.multi_pair import MultiPair, multi_pair, pair_arrays  # re-exported
 from gearjax.surfaces import GeneratedSurface, local_geometry, unit_normal
 
 __all__ = ["pair_arrays", "Misalignment", "Assembly", "contact_equations", "contact_system", "ContactSystem",
@@ -101,73 +90,6 @@ class NoContactError(ConvergenceError):
 ARCSEC = np.pi / (180.0 * 3600.0)   # rad per arc-second
 DEFAULT_APPROACH = 0.00632          # mm, elastic approach of the contact ellipse
 
-
-@jax.tree_util.register_dataclass
-@dataclass(frozen=True)
-class Misalignment:
-    """Assembly errors (differentiable): dE, dP, dG in mm, dSigma in rad.
-
-    See the module docstring for their definition.  ``Misalignment.zero()`` is the
-    nominal assembly.
-    """
-
-    dE: jnp.ndarray
-    dP: jnp.ndarray
-    dG: jnp.ndarray
-    dSigma: jnp.ndarray
-
-    @classmethod
-    def zero(cls):
-        z = jnp.asarray(0.0, float)
-        return cls(z, z, z, z)
-
-    @classmethod
-    def create(cls, dE=0.0, dP=0.0, dG=0.0, dSigma_deg=0.0):
-        """Validated constructor (mm, mm, mm, degrees) for user input: finite numbers
-        (not bool or str) with |dE|, |dP|, |dG| <= 50 mm, |dSigma| <= 5 deg; ValueError
-        names the parameter, the value and the range.  Traced values (inside
-        ``jax.grad``) pass through."""
-        for k, v in (("dE", dE), ("dP", dP), ("dG", dG), ("dSigma", dSigma_deg)):
-            if v is None or isinstance(v, (bool, np.bool_, str, bytes, list, tuple, dict)):
-                raise ValueError(f"{k} = {v!r} must be a number, got {type(v).__name__}")
-        vals = [check_range(k, v, -lim, lim, unit=u) for k, v, lim, u in
-                (("dE", dE, 50.0, "mm"), ("dP", dP, 50.0, "mm"), ("dG", dG, 50.0, "mm"),
-                 ("dSigma", dSigma_deg, 5.0, "deg"))]
-        return cls(*(jnp.asarray(v, float) for v in vals[:3]),
-                   jnp.asarray(vals[3] * (np.pi / 180.0), float))
-
-
-@jax.tree_util.register_dataclass
-@dataclass(frozen=True)
-class Assembly:
-    """Nominal mounting of the gear (see module docstring).
-
-    R0 : (3,3) gear body frame -> fixed frame at phi2 = 0.
-    c0 : (3,) crossing point on the gear axis (mm).
-    d : (3,) unit common perpendicular (direction of dE, axis of dSigma).
-    z1, z2 : tooth numbers (data, so that pairs of other tooth numbers share a compiled
-        program: they only enter the nominal ratio); ratio_sign : sign of the nominal
-        rho (static).
-    """
-
-    R0: jnp.ndarray
-    c0: jnp.ndarray
-    d: jnp.ndarray
-    z1: jnp.ndarray
-    z2: jnp.ndarray
-    ratio_sign: int = field(metadata=dict(static=True), default=-1)
-
-
-def rotation_about(axis, angle):
-    """Rodrigues rotation matrix about ``axis`` by ``angle`` (rad); :func:`gearjax.frames.matrix_axis`."""
-    return matrix_axis(axis, angle)
-
-
-def gear_mount(asm: Assembly, mis: Misalignment):
-    """Misaligned gear mounting ``(R, c)``: r2f = c + R Rz(phi2) r2."""
-    R = rotation_about(asm.d, mis.dSigma) @ asm.R0
-    c = asm.c0 + mis.dE * asm.d + mis.dG * R[:, 2]
-    return R, c
 
 
 class ContactPath(NamedTuple):
@@ -195,7 +117,7 @@ class ContactPath(NamedTuple):
         generated flank (:class:`~gearjax.surfaces.GeneratedSurface`; NaN for another
         flank), solved with the contact (:func:`contact_system`).
     edge_kind : (N,) int, -1 where the contact is a tangency of the two flanks, else
-        the edge (face end or tip) carrying it (index into :data:`gearjax.edge_contact.EDGE_NAMES`;
+        the edge (face end or tip) carrying it (index into :data:`gearjax.tca.edge_contact.EDGE_NAMES`;
         there the semi-axes are NaN: no Hertz ellipse at an edge).  ``None`` where face ends were not examined.
     newton_work : () int, the Newton iterations the solves of this path executed, each
         ``vmap``-ed batch counted as its number of lanes times the iterations of its
@@ -584,7 +506,7 @@ def require_path(path: ContactPath, what: str = "tooth contact analysis") -> Non
 
 def check_on_flank_converged(path: ContactPath, margin) -> None:
     """Raise ConvergenceError if a solve failed between on-flank points, and
-    :class:`~gearjax.tca.NoContactError` if no grid point is on both flanks (concrete)."""
+    :class:`~gearjax.tca.path.NoContactError` if no grid point is on both flanks (concrete)."""
     conv = np.asarray(path.converged)
     inside = np.asarray(margin) >= 0.0
     mid = conv.shape[0] // 2
@@ -594,7 +516,7 @@ def check_on_flank_converged(path: ContactPath, margin) -> None:
     idx = np.nonzero(inside & conv)[0]
     if idx.size == 0:
         raise NoContactError("no contact inside the flank boundaries at any grid position "
-                             "(the flanks do not touch); pass strict=False to get the masks")
+                             "(the flanks do not touch); pass throw=False to get the masks")
     if idx.size:
         sl = slice(idx[0], idx[-1] + 1)
         require_converged(path.converged[sl], "tooth contact analysis on the flank",

@@ -3,17 +3,17 @@ the kinematics at its contact points.
 
 :class:`TCAResult` is a pytree (``jax.grad`` and ``jit`` pass through it) holding
 
-* ``path`` -- :class:`~gearjax.tca.ContactPath` of tooth pair 0 on the grid of
+* ``path`` -- :class:`~gearjax.tca.path.ContactPath` of tooth pair 0 on the grid of
   pinion angles: TE (rad), the contact point on both flanks (body frames and
   fixed frame), the contact ellipses, residuals and converged flags;
 * ``margin`` -- (N,) distance of the contact from the nearest flank boundary of
   either member (mm, >= 0 on both working flanks);
-* ``multi`` -- :class:`~gearjax.tca.MultiPair`: TE of the neighbouring pairs, the
+* ``multi`` -- :class:`~gearjax.tca.path.MultiPair`: TE of the neighbouring pairs, the
   unloaded TE envelope, its peak-to-peak, the transfer points, the contact ratio;
 * ``coords`` -- family-specific coordinates of the contact on the flanks (hypoid:
   ``xi1, h1, xi2, h2``; involute: the six boundary margins, and the overlap ratio in
   line contact; ...), a dict, and in every family ``path_position`` (the contact's
-  position along its path in the family's own coordinate, :mod:`gearjax.family`);
+  position along its path in the family's own coordinate, :mod:`gearjax.tca.family`);
 * ``kinematics`` -- :class:`ContactKinematics` at every point of the path, or
   ``None`` when not requested;
 * ``side`` (static) -- ``"drive"`` or ``"coast"``, the one side convention of
@@ -38,7 +38,7 @@ theory, oriented along the entrainment (``u_e >= 0``); along ``t``::
 
 (mm/s per rad/s of pinion speed) plus the side-slip ``u_s_side = (w1 - w2) . e_major``
 and the angle of the entrainment vector ``(w1 + w2)/2`` from ``t``.  Curvature:
-the relative curvature tensor ``B`` of the two flanks (:func:`~gearjax.tca.
+the relative curvature tensor ``B`` of the two flanks (:func:`~gearjax.tca.path.
 relative_curvature`, oriented so that its trace is >= 0), ``R_x = 1/(t.B.t)``
 across the ellipse (the effective radius of the EHL theory) and
 ``R_y = 1/(e_major.B.e_major)`` along it (``inf`` for line contact).  For a line
@@ -61,12 +61,13 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax.edge_contact import CORNER_KINDS, EDGE_NAMES, FACE_END_KINDS, TIP_KINDS
+from gearjax.tca.edge_contact import CORNER_KINDS, EDGE_NAMES, FACE_END_KINDS, TIP_KINDS
 from gearjax.fields import strong_float64
 from gearjax.frames import matrix_z
 from gearjax.surfaces import local_geometry
-from gearjax.tca import (ARCSEC, Assembly, ContactPath, Misalignment, MultiPair, contact_equations,
-                         contact_system, gear_mount, relative_curvature)
+from gearjax.tca.path import (ARCSEC, ContactPath, MultiPair, contact_equations, contact_system,
+                              relative_curvature)
+from gearjax.tca.assembly import Assembly, Misalignment, gear_mount
 
 __all__ = ["SIDES", "check_side", "check_design",
            "TCAResult", "ContactKinematics", "contact_kinematics",
@@ -137,8 +138,8 @@ def contact_motion(r1: Callable, r2: Callable, asm: Assembly, mis: Misalignment,
     flanks' Weingarten maps in the fixed frame for the common normal ``n`` (computed
     here unless given as ``W12``, e.g. those of the contact path).  With ``psi12``,
     the generating motions of the contact on generated flanks (those of the contact
-    path), the derivative is taken of :func:`~gearjax.tca.contact_system` (explicit,
-    no envelope solve); without, of :func:`~gearjax.tca.contact_equations` (the
+    path), the derivative is taken of :func:`~gearjax.tca.path.contact_system` (explicit,
+    no envelope solve); without, of :func:`~gearjax.tca.path.contact_equations` (the
     nested envelope solves).  Also returns the gear mount ``(R, c)``."""
     R, c = gear_mount(asm, mis)
     ez = jnp.array([0.0, 0.0, 1.0])
@@ -359,14 +360,14 @@ class TCAResult:
             Also raised with ``face_end_contact``.
         face_end_contact : pair 0 carries the load (it is the active pair of the
             envelope) at a face end of a flank -- toe or heel of pinion or gear
-            (``path.edge_kind``, :mod:`gearjax.edge_contact`): the bearing has run
+            (``path.edge_kind``, :mod:`gearjax.tca.edge_contact`): the bearing has run
             off the face, e.g. an uncrowned pair under a shaft-angle error.
         tip_contact : pair 0 carries the load at the tip edge of pinion or gear
             (corner contact off the line of action: premature contact at the start
             of mesh or prolonged contact at its end, e.g. under a base-pitch
             mismatch), or at a corner where the tip edge meets a face end (a tip
             contact under a misalignment that tilts the tip edge against the mating
-            flank: ``path.edge_kind`` in :data:`~gearjax.edge_contact.CORNER_KINDS`).
+            flank: ``path.edge_kind`` in :data:`~gearjax.tca.edge_contact.CORNER_KINDS`).
             Also raises ``edge_contact``.
         low_contact_ratio : contact ratio below 1 (or not found): gaps in the
             envelope, the motion is not transmitted continuously.
@@ -416,7 +417,7 @@ class TCAResult:
                     large_te=bool(np.isfinite(ptp) and ptp > LARGE_TE_ARCSEC))
 
     def edges_loaded(self) -> list[str]:
-        """Names (:data:`gearjax.edge_contact.EDGE_NAMES`) of the edges (face ends and
+        """Names (:data:`gearjax.tca.edge_contact.EDGE_NAMES`) of the edges (face ends and
         tips) at which tooth pair 0 carries the load somewhere on the grid (concrete;
         empty if none)."""
         kinds = self.path.edge_kind

@@ -15,7 +15,7 @@ pair answers with the normal load ``F_k(w_k)`` of its compliance,
 
 ``q_k`` (mm/N) the linear compliance of the two teeth (bending, shear, fillet
 foundation; for a line contact also the contact, [Weber1949]/[Sainsot2004], see
-:mod:`gearjax.tooth_compliance`) divided by the width that carries the load, and
+:mod:`gearjax.loading.tooth_compliance`) divided by the width that carries the load, and
 ``c_k F^(2/3)`` the Hertz approach of a point contact (``c_k`` = approach at 1 N of
 :func:`gearjax.contact.hertz_exact` for the flanks' principal radii; the local
 ease-off across the ellipse enters through them).  Equilibrium of the pinion,
@@ -45,14 +45,13 @@ from typing import NamedTuple
 
 import jax
 import jax.numpy as jnp
-import numpy as np
 
 from gearjax.contact import hertz_exact, hertz_line_traced
 from gearjax.newton import newton_solve
-from gearjax.tca import pair_arrays
-from gearjax.tooth_compliance import (E_STEEL, NU_STEEL, contact_compliance,
-                                      iso6336_single_stiffness, tooth_compliance,
-                                      tooth_geometry)
+from gearjax.tca.path import pair_arrays
+from gearjax.loading.tooth_compliance import (E_STEEL, NU_STEEL, contact_compliance,
+                                              tooth_compliance, tooth_geometry)
+from gearjax.loading.pair_stiffness import iso6336_single_stiffness
 
 __all__ = ["LoadedContact", "MeshTeeth", "TeethOf", "pair_compliance", "COMPLIANCE_MODELS",
            "hertz_coefficient", "contact_stress", "force_from_approach", "share_torque", "pair_arrays",
@@ -274,15 +273,15 @@ def pair_compliance(teeth: MeshTeeth, r_x, load_per_width, model: str = "weber",
     docstring; the Hertz term of a point contact is added by the caller).
 
     ``E`` (MPa) and ``nu``: Young's modulus and Poisson's ratio of both members (the
-    pair's material, :mod:`gearjax.materials`; default steel, 206 000 MPa and 0.3).
+    pair's material, :mod:`gearjax.loading.materials`; default steel, 206 000 MPa and 0.3).
     Every term is that of linear elasticity, so ``q`` scales as ``1/E`` at fixed ν.
 
     ``"weber"`` (default): both teeth as cantilevers of the virtual spur gears --
     bending, shear and axial compression of the variable section plus the fillet
-    foundation ([Weber1949], [Sainsot2004]; :func:`gearjax.tooth_compliance.tooth_compliance`)
+    foundation ([Weber1949], [Sainsot2004]; :func:`gearjax.loading.tooth_compliance.tooth_compliance`)
     -- per unit width, over the width carrying the load; a line contact adds Weber's
     contact compliance of the line at ``load_per_width`` (N/mm) with the reduced
-    radius ``r_x`` (:func:`gearjax.tooth_compliance.contact_compliance`), a point
+    radius ``r_x`` (:func:`gearjax.loading.tooth_compliance.contact_compliance`), a point
     contact gets the Hertz approach instead (nonlinear, :func:`hertz_coefficient`).
 
     ``"iso6336"``: the single stiffness ``c'`` of [ISO6336-1] method B, constant along

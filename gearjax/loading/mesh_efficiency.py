@@ -3,7 +3,7 @@
 The chain, every step a JAX function of the design::
 
     TCAResult (unloaded TE of each tooth pair, contact points, kinematics)
-      -> load sharing at each mesh position        gearjax.loaded_contact
+      -> load sharing at each mesh position        gearjax.loading.loaded_contact
       -> at each loaded contact: entrainment and sliding vectors, R_x/R_y along and
          across the entrainment, the load -> mixed-lubrication friction
                                                    gearjax.tribology (mu, film, lambda)
@@ -11,7 +11,7 @@ The chain, every step a JAX function of the design::
 
 **Positions.**  One mesh cycle = one angular pitch of the pinion: the
 ``steps_per_pitch`` grid positions centred on the reference.  Tooth pair ``k`` at a
-position is pair 0 shifted by ``k`` pitches (:func:`gearjax.tca.pair_arrays`),
+position is pair 0 shifted by ``k`` pitches (:func:`gearjax.tca.path.pair_arrays`),
 exactly as the unloaded TE envelope of :func:`gearjax.tca.multi_pair`.
 
 **Velocities.**  ``ContactKinematics`` gives per rad/s of pinion speed the surface
@@ -36,7 +36,7 @@ equivalent ellipse whose major semi-axis is ``L/2``:
 
 **Material.**  The reduced modulus E′ of the Hertz contact, film and asperities and
 the Young's modulus and Poisson's ratio of the tooth compliance are those of one
-material (:mod:`gearjax.materials`): an explicit ``E_prime`` (MPa), else the design's
+material (:mod:`gearjax.loading.materials`): an explicit ``E_prime`` (MPa), else the design's
 own material (a VH-CATT file's ``[material]``), else steel (E 206 000 MPa, ν 0.3,
 E′ = 226 374 MPa); with an explicit E′ the compliance uses E = E′ (1 − ν²).
 
@@ -44,7 +44,7 @@ E′ = 226 374 MPa); with an explicit E′ the compliance uses E = E′ (1 − �
 the docs): :data:`DEFAULT_COMPLIANCE` = ``"weber"`` (Weber/Cornell cantilever +
 Sainsot foundation + the contact: Hertz approach of a point contact, Weber's line
 contact); ``"iso6336"``: ISO 6336-1's constant single stiffness
-(:func:`gearjax.loaded_contact.pair_compliance`).
+(:func:`gearjax.loading.loaded_contact.pair_compliance`).
 
 Units: torque N m, pinion speed **rpm** in every public function (the keyword is
 ``pinion_rpm``: :func:`mesh_efficiency`, the ``f`` of :func:`efficiency_function`,
@@ -65,15 +65,19 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax.efficiency_inputs import (RPM_RANGE, TORQUE_RANGE_NM, check_models,  # noqa: F401
-                                       check_efficiency_inputs, check_operating_point)
-from gearjax.loaded_contact import (LoadedContact, MeshTeeth, contact_stress,
-                                    hertz_coefficient,
-                                    lever_arms, pair_arrays, pair_compliance, share_torque)
-from gearjax.tca_result import TCAResult, family_of
-from gearjax.tooth_compliance import NU_STEEL
+from gearjax.loading.efficiency_inputs import (RPM_RANGE, TORQUE_RANGE_NM, check_models,
+                                               check_efficiency_inputs, check_operating_point)
+from gearjax.loading.loaded_contact import (LoadedContact, MeshTeeth, contact_stress,
+                                            hertz_coefficient, lever_arms, pair_arrays,
+                                            pair_compliance, share_torque)
+from gearjax.tca.result import TCAResult, family_of
+from gearjax.loading.tooth_compliance import NU_STEEL
 from gearjax.tribology.friction import FILM_MIN_MM, STEEL_E_PRIME, FrictionResult, Surface
 from gearjax.tribology.losses import mesh_losses_traced
+from gearjax.loading.efficiency_checks import (DEFLECTION_MAX_PITCH, HERTZ_SIZE_MAX,  # re-exported
+                                               MAX_RADIUS_RATIO, MU_MAX, P_MAX_LIMIT_MPA,
+                                               EfficiencyGuard, Plausibility, efficiency_guard,
+                                               efficiency_warnings, plausibility)
 from gearjax.tribology.lubricant import Oil
 
 __all__ = ["MeshEfficiency", "mesh_efficiency", "DEFAULT_COMPLIANCE", "COMPLIANCE_HELP",
@@ -83,8 +87,6 @@ __all__ = ["MeshEfficiency", "mesh_efficiency", "DEFAULT_COMPLIANCE", "COMPLIANC
            "MU_MAX", "P_MAX_LIMIT_MPA", "DEFLECTION_MAX_PITCH", "HERTZ_SIZE_MAX", "FILM_MIN_MM",
            "EfficiencyGuard", "efficiency_guard"]
 
-#: largest accepted r_y / r_x of a point contact (beyond: degenerate, flagged)
-MAX_RADIUS_RATIO = 1e4
 
 #: the default tooth compliance model of every route (Python and the command line)
 DEFAULT_COMPLIANCE = "weber"
@@ -96,35 +98,13 @@ COMPLIANCE_HELP = ("weber (the default): Weber/Cornell tooth cantilever + Sainso
                    "method B, scaled by E/206000 MPa")
 
 
-# -- plausibility of the results (:func:`plausibility`; docs/efficiency.md) ----------
-#: largest plausible friction coefficient of a lubricated steel contact: boundary
-#: friction of steel on steel under oil is 0.1-0.15, dry steel ~0.6; above 0.3 the
-#: mixed-lubrication model is outside anything it was fitted to
-MU_MAX = 0.3
-#: largest plausible maximum Hertz pressure (MPa) of a steel gear contact: far above
-#: the contact-fatigue allowables of case-hardened steel (~1500 MPa) and at the onset
-#: of gross subsurface yield, where the elastic Hertz/EHL model no longer holds
-P_MAX_LIMIT_MPA = 5000.0
-#: largest plausible loaded fall-back ``y`` of the gear behind the unloaded TE envelope,
-#: as a fraction of the pinion's angular pitch (2 % of a pitch: ~0.25 mm of arc at
-#: m = 4; elastic tooth deflections at rated load are tens of micrometres)
-DEFLECTION_MAX_PITCH = 0.02
-#: largest plausible Hertz half-width (semi-minor axis) of a loaded contact relative to
-#: its radius R_x along the entrainment: Hertz theory needs a contact small against the
-#: radii (a few per cent at rated load); half the radius means a contact as wide as the
-#: tooth flank, an approach beyond what the tooth allows
-HERTZ_SIZE_MAX = 0.5
-#: FILM_MIN_MM (gearjax.tribology.friction): the thinnest film inside the film model's
-#: range (a warning, not a failure)
-
-
 class MeshEfficiency(NamedTuple):
     """Efficiency of a pair over one mesh cycle (module docstring).
 
     Shapes: (K, M) per tooth pair and position, (M,) per position.
 
     phi1 : (M,) pinion angles of the positions (rad).
-    loaded : :class:`~gearjax.loaded_contact.LoadedContact` (loads, shares, p_max,
+    loaded : :class:`~gearjax.loading.loaded_contact.LoadedContact` (loads, shares, p_max,
         ellipses, loaded TE, balance).
     u_e, u_s : magnitudes of the entrainment and sliding vectors (mm/s).
     r_x, r_y : radii along and across the entrainment as given to the friction model (mm).
@@ -218,97 +198,6 @@ def cycle_summary(power_loss, power_in, mu, load, u_s, p_max, te_loaded, valid) 
                         jnp.where(some, te_hi - te_lo, nan), n_valid)
 
 
-class EfficiencyGuard(NamedTuple):
-    """The efficiency objective of an optimisation on a fixed set of positions
-    (:func:`efficiency_guard`)."""
-
-    mean_efficiency: jax.Array
-    n_lost: jax.Array
-
-
-def efficiency_guard(eff, nominal_valid) -> EfficiencyGuard:
-    """η̄ over a fixed nominal set of positions, with a lost position counted as a total
-    loss, so that an optimiser cannot raise it by invalidating positions (traceable).
-
-    ``nominal_valid`` (M,) bool: the positions valid at the start (``eff0.valid`` of the
-    nominal design), kept fixed during the run -- like the mask of
-    :meth:`gearjax.TCAResult.objectives`.  With ``V0`` that set and ``valid`` the
-    positions valid now::
-
-        eta_guard = 1 - sum_{i in V0} (valid_i ? P_f,i : P_in) / (|V0| P_in)
-        n_lost    = |{i in V0 : not valid_i}|
-
-    On a run that keeps every nominal position valid ``eta_guard`` is the plain η̄ of
-    those positions (:func:`cycle_summary` over V0) and its gradient is the gradient of
-    the modelled losses.  A position that leaves the valid set (off the flank, load
-    balance or friction not converged, implausible) counts as ``P_f = P_in`` (η = 0 there),
-    the worst case, instead of dropping out of the mean: ``eta_guard`` then falls by at
-    least ``(P_in − P_f,i)/(|V0| P_in)`` ≈ 1/|V0|, whereas the plain η̄ over the valid
-    positions rises when the position left was a lossy one.  The step is not
-    differentiable (the masks are constants of the derivative): add the C¹ penalty of
-    ``res.mask_check(on0)`` to push contacts back onto the flank before they leave, and
-    accept an end point only with ``n_lost == 0`` -- otherwise the run is a flagged
-    failure (docs/efficiency.md, "Objectives that cannot be gamed").
-    """
-    v0 = jnp.asarray(nominal_valid, bool)
-    valid = jnp.asarray(eff.valid, bool)
-    pin = jnp.asarray(eff.power_in, float)
-    loss = jnp.where(valid, jnp.where(v0, eff.power_loss, 0.0), jnp.where(v0, pin, 0.0))
-    n0 = jnp.sum(v0)
-    eta = 1.0 - jnp.sum(loss) / (jnp.maximum(n0, 1) * pin)
-    return EfficiencyGuard(jnp.where(n0 > 0, eta, jnp.nan), jnp.sum(v0 & ~valid))
-
-
-class Plausibility(NamedTuple):
-    """(M,) per position: the result passes each plausibility check
-    (:func:`plausibility`)."""
-
-    efficiency: jax.Array
-    mu: jax.Array
-    p_max: jax.Array
-    deflection: jax.Array
-    contact: jax.Array
-
-    @property
-    def all(self):
-        return self.efficiency & self.mu & self.p_max & self.deflection & self.contact
-
-
-#: the reason printed for each failed check of :class:`Plausibility`
-PLAUSIBILITY_TEXT = {
-    "efficiency": "eta_m outside (0, 1]",
-    "mu": f"mu above {MU_MAX:g} (MU_MAX)",
-    "p_max": f"p_max above {P_MAX_LIMIT_MPA:g} MPa (P_MAX_LIMIT_MPA: beyond the elastic "
-             "range of steel)",
-    "deflection": f"loaded fall-back behind the unloaded TE above {DEFLECTION_MAX_PITCH:g} of "
-                  "a pinion pitch (DEFLECTION_MAX_PITCH: beyond what a tooth allows)",
-    "contact": f"Hertz half-width above {HERTZ_SIZE_MAX:g} R_x (HERTZ_SIZE_MAX: an approach "
-               "beyond what the tooth allows, outside Hertz theory)",
-}
-
-
-def plausibility(efficiency, mu, load, p_max, deflection, pitch, semi_minor, r_x
-                 ) -> Plausibility:
-    """Plausibility of the results at each position (traceable; (M,) booleans).
-
-    ``efficiency`` (M,) eta_m, ``mu``, ``load`` (N), ``p_max`` (MPa) (K, M),
-    ``deflection`` (M,) loaded fall-back y (rad), ``pitch`` the pinion angular pitch
-    (rad), ``semi_minor`` (K, M) Hertz half-width and ``r_x`` (K, M) radius along the
-    entrainment (mm).  A position passes when ``0 < eta_m <= 1``, every loaded contact
-    has ``mu <= MU_MAX``, ``p_max <= P_MAX_LIMIT_MPA`` and
-    ``semi_minor <= HERTZ_SIZE_MAX r_x``, and
-    ``y <= DEFLECTION_MAX_PITCH * pitch`` (NaN fails every check).  A position that
-    fails one is not valid (:class:`MeshEfficiency`): its numbers are not a result.
-    """
-    loaded = load > 0.0
-    eff_ok = (efficiency > 0.0) & (efficiency <= 1.0)
-    mu_ok = jnp.all(~loaded | (mu <= MU_MAX), axis=0)
-    p_ok = jnp.all(~loaded | (p_max <= P_MAX_LIMIT_MPA), axis=0)
-    y_ok = deflection <= DEFLECTION_MAX_PITCH * pitch
-    c_ok = jnp.all(~loaded | (semi_minor <= HERTZ_SIZE_MAX * r_x), axis=0)
-    return Plausibility(eff_ok, mu_ok, p_ok, y_ok, c_ok)
-
-
 def _pitch(phi1, steps_per_pitch):
     """The pinion angular pitch (rad) from the grid spacing of the positions."""
     return jnp.abs(phi1[1] - phi1[0]) * steps_per_pitch
@@ -339,7 +228,7 @@ def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, pinion_r
     (traceable; no validation; module docstring).
 
     ``res`` : the TCA result with kinematics; ``teeth`` : the family's
-    :class:`~gearjax.loaded_contact.MeshTeeth` for ``res``; ``steps_per_pitch`` and
+    :class:`~gearjax.loading.loaded_contact.MeshTeeth` for ``res``; ``steps_per_pitch`` and
     ``n_pairs`` : those of the TCA.  Torque on the pinion (N m), pinion speed (rpm;
     ``omega1 = pinion_rpm pi/30`` rad/s inside).  ``E_prime`` (MPa) and ``poisson``:
     the material (module docstring); the tooth compliance takes
@@ -467,9 +356,9 @@ def efficiency_function(design, *, side=None, compliance: str = DEFAULT_COMPLIAN
     (reference guess, sense of rotation, contact mode) is done once here, as for
     :func:`gearjax.tca_function`; ``f.pair`` is the design's pair pytree (the natural
     point to differentiate at).  The material (module docstring) is resolved here,
-    once, by :func:`gearjax.materials.pair_material`: ``E_prime`` (MPa) if given, else
+    once, by :func:`gearjax.loading.materials.pair_material`: ``E_prime`` (MPa) if given, else
     the design's material, else steel; ``f.material`` is the
-    :class:`~gearjax.materials.Material` used.  ``compliance`` defaults to
+    :class:`~gearjax.loading.materials.Material` used.  ``compliance`` defaults to
     :data:`DEFAULT_COMPLIANCE` (as :func:`mesh_efficiency` and the command).
     ``tca_options`` as for :func:`gearjax.run_tca` (``steps_per_pitch``,
     ``half_pitches``, ``n_pairs``, ...).
@@ -478,8 +367,8 @@ def efficiency_function(design, *, side=None, compliance: str = DEFAULT_COMPLIAN
     options here; ``pair``, torque, speed, oil and surface on every call of ``f`` with
     concrete values); traced values (under ``jit``/``grad``/``vmap``) are not.
     """
-    from gearjax.materials import pair_material
-    from gearjax.tca_result import check_design
+    from gearjax.loading.materials import pair_material
+    from gearjax.tca.result import check_design
 
     mat = pair_material(design, E_prime)
     Ep, nu = float(mat.e_prime_MPa), float(mat.poisson)
@@ -515,7 +404,7 @@ def efficiency_function(design, *, side=None, compliance: str = DEFAULT_COMPLIAN
 def mesh_efficiency(design, torque_Nm, pinion_rpm, oil: Oil, surface: Surface, *,
                     misalignment=None, side=None, compliance: str = DEFAULT_COMPLIANCE,
                     E_prime=None, viscosity_model: str = "roelands", film_method: str = "auto",
-                    strict: bool = True, **tca_options):
+                    throw: bool = True, **tca_options):
     """Loaded contact, friction along the path and mesh efficiency of ``design`` at
     pinion torque ``torque_Nm`` (N m) and pinion speed ``pinion_rpm`` (rpm) (module
     docstring).
@@ -524,7 +413,7 @@ def mesh_efficiency(design, torque_Nm, pinion_rpm, oil: Oil, surface: Surface, *
     overrides the design's material; by default (None) the design's own material
     (a VH-CATT file's ``[material]``) or, for families without one, steel (E 206 000
     MPa, nu 0.3: E' = 226 374 MPa) sets E' *and* the tooth compliance
-    (:func:`gearjax.materials.pair_material` says which applied).  ``compliance``, the
+    (:func:`gearjax.loading.materials.pair_material` says which applied).  ``compliance``, the
     same default as the ``gearjax efficiency`` command (:data:`DEFAULT_COMPLIANCE`):
     weber (the default): Weber/Cornell tooth cantilever + Sainsot fillet foundation +
     the contact (Hertz approach of a point contact, Weber's line contact); iso6336: the
@@ -532,18 +421,18 @@ def mesh_efficiency(design, torque_Nm, pinion_rpm, oil: Oil, surface: Surface, *
 
     Every concrete input is validated before any work, as the command line and the
     design-file loaders do (one-line ValueError naming the parameter, its value and
-    the allowed range): the design's fields (:func:`gearjax.tca_result.check_design`:
+    the allowed range): the design's fields (:func:`gearjax.tca.result.check_design`:
     e.g. degrees typed into a radian field), torque, speed, E' (MPa: E' in Pa is
     refused), the oil and surface fields, the model names.
 
     Runs :func:`gearjax.run_tca` (its compiled program is shared with every other
     TCA of the same options) and then one jitted program for the loads, friction
     and losses.  Returns ``(MeshEfficiency, TCAResult)``; check ``eff.valid`` and
-    :func:`efficiency_warnings`.  ``strict``: raise ConvergenceError when the TCA
+    :func:`efficiency_warnings`.  ``throw``: raise ConvergenceError when the TCA
     fails on the working flank (as :func:`gearjax.run_tca`).
     """
-    from gearjax.materials import pair_material
-    from gearjax.tca_result import check_design
+    from gearjax.loading.materials import pair_material
+    from gearjax.tca.result import check_design
 
     mat = pair_material(design, E_prime)
     Ep, nu = float(mat.e_prime_MPa), float(mat.poisson)
@@ -555,7 +444,7 @@ def mesh_efficiency(design, torque_Nm, pinion_rpm, oil: Oil, surface: Surface, *
     opts = _grid_options(ad, design, tca_options)
     kw = {} if side is None else {"side": side}
     teeth_of, pair, run_design = ad.mesh(design, **kw, **opts)
-    res = ad.run(run_design, misalignment, **kw, **opts, kinematics=True, strict=strict)
+    res = ad.run(run_design, misalignment, **kw, **opts, kinematics=True, throw=throw)
     oil = dataclasses.replace(oil, name="")
     # a family whose pair has static fields that only enter arithmetic (the tooth
     # numbers of an involute pair) passes them traced: one program for every pair
@@ -579,79 +468,3 @@ def _post_jit(res, pair, extra, T, n, oil, surface, E_prime, poisson, *, teeth_o
                                   E_prime=E_prime, poisson=poisson, compliance=compliance,
                                   viscosity_model=viscosity_model, film_method=film_method)
 
-
-def efficiency_warnings(eff: MeshEfficiency, res: TCAResult, *, film_method: str = "auto",
-                        viscosity_model: str = "roelands") -> list[str]:
-    """One line per problem of a concrete result: TCA quality flags, load balance or
-    friction solves not converged, grid too short, loaded edge contact, implausible
-    results (:func:`plausibility`: one line per failed check with the worst value), a
-    film below :data:`FILM_MIN_MM`, the film formula outside its fitted ellipticity
-    range and the viscosity law above 3 GPa (``film_method``, ``viscosity_model`` as
-    given to the friction model)."""
-    out = list(res.warnings())
-    valid = np.asarray(eff.valid)
-    F = np.asarray(eff.loaded.load, float)
-    loaded = F > 0.0
-    phi = np.asarray(eff.phi1, float)
-    pl = plausibility(np.asarray(eff.efficiency), np.asarray(eff.friction.mu), F,
-                      np.asarray(eff.loaded.p_max), np.asarray(eff.loaded.deflection),
-                      float(np.abs(phi[1] - phi[0]) * phi.shape[0]) if phi.size > 1 else np.inf,
-                      np.asarray(eff.loaded.semi_minor), np.asarray(eff.r_x))
-    # only where the load sharing converged (elsewhere the values are not results and
-    # the non-convergence is its own warning)
-    conv = np.asarray(eff.loaded.converged, bool)
-    eta = np.asarray(eff.efficiency, float)
-    mu = np.where(loaded, np.asarray(eff.friction.mu, float), -np.inf)
-    pm = np.where(loaded, np.asarray(eff.loaded.p_max, float), -np.inf)
-    y = np.asarray(eff.loaded.deflection, float)
-    hw = np.where(loaded, np.asarray(eff.loaded.semi_minor, float) / np.asarray(eff.r_x, float),
-                  -np.inf)
-    worst = {
-        "efficiency": lambda b: f"eta_m from {np.min(eta[b]):.9g} to {np.max(eta[b]):.9g}",
-        "mu": lambda b: f"mu up to {np.max(mu[:, b]):.4g}",
-        "p_max": lambda b: f"p_max up to {np.max(pm[:, b]):.0f} MPa",
-        "deflection": lambda b: f"fall-back up to {np.max(y[b]) * 206264.80624709636:.0f} arcsec",
-        "contact": lambda b: f"half-width / R_x up to {np.max(hw[:, b]):.3g}",
-    }
-    for name, ok in pl._asdict().items():
-        bad = ~np.asarray(ok) & conv
-        if np.any(bad):
-            out.append(f"implausible result at {int(bad.sum())} of {bad.size} positions: "
-                       f"{PLAUSIBILITY_TEXT[name]}; {worst[name](bad)} (not valid)")
-    h_c = np.asarray(eff.friction.h_c, float)
-    thin = loaded & (h_c < FILM_MIN_MM)
-    if np.any(thin):
-        out.append(f"film h_c down to {1e6 * np.nanmin(np.where(thin, h_c, np.inf)):.3g} nm "
-                   f"at {int(thin.sum())} loaded contacts, below the film/asperity model's range "
-                   f"({1e6 * FILM_MIN_MM:g} nm, FILM_MIN_MM): labelled boundary there; the "
-                   "asperity share and mu there are not reliable")
-    k = np.asarray(eff.friction.k, float)[loaded]
-    if k.size and film_method in ("auto", "point") and np.any(k < 1.0):
-        out.append(f"Hamrock-Dowson film formula used outside its fitted ellipticity range "
-                   f"1 <= k <= 8 (k down to {k.min():.3g})")
-    pmx = np.asarray(eff.loaded.p_max, float)[loaded]
-    if pmx.size and np.any(pmx > 3000.0):
-        out.append(f"{viscosity_model.capitalize()} viscosity law extrapolated above 3 GPa "
-                   f"(p_max up to {pmx.max():.0f} MPa at {int(np.sum(pmx > 3000.0))} loaded "
-                   "contacts); its validity range is about 0-3 GPa")
-    if bool(np.asarray(eff.truncated)):
-        out.append("the TCA grid or the number of tooth pairs does not cover every pair in "
-                   "contact: widen --pitches / raise the number of pairs")
-    if np.any(np.asarray(eff.edge_loaded)):
-        out.append(f"edge contact under load at {int(np.sum(np.asarray(eff.edge_loaded)))} "
-                   "positions (its load is not modelled)")
-    if np.any(np.asarray(eff.degenerate)):
-        out.append(f"contact beyond the edge of regression of a flank (relative curvature not "
-                   f"positive definite, r_y/r_x > {MAX_RADIUS_RATIO:g}) under load at "
-                   f"{int(np.sum(np.asarray(eff.degenerate)))} positions: not modelled")
-    if not np.all(np.asarray(eff.loaded.converged)):
-        out.append("load sharing did not converge at some positions")
-    if not np.all(valid):
-        nv = int(np.sum(valid))
-        if nv:
-            out.append(f"{int(np.sum(~valid))} of {valid.size} positions are not valid "
-                       f"(see the 'valid' flags): eta_bar, mean mu, max p_max and loaded TE "
-                       f"are over the {nv} valid positions only (a partial cycle)")
-        else:
-            out.append(f"none of the {valid.size} positions is valid: no summary")
-    return out

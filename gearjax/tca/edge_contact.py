@@ -1,6 +1,6 @@
 """Edge contact at the face ends (toe, heel) and tip edges of tooth flanks, found by the TCA.
 
-The surface contact of :func:`gearjax.tca.contact_path` is a tangency of the two
+The surface contact of :func:`gearjax.tca.path.contact_path` is a tangency of the two
 flanks.  Where that tangency lies beyond a face end (an uncrowned pair under a
 shaft-angle error, a bearing pushed off the face by a misalignment) the flanks
 do not touch there: the rigid teeth touch first at the *edge* of one tooth, the
@@ -19,7 +19,7 @@ a point ``q`` is ``m_k x grad g_k(q)`` (``m_k`` the flank normal).
 *Gear Geometry and Applied Theory*, 2nd ed., §9.3 and ch. 15, where the crossing
 of the axes of unmodified helical gears causes edge contact): at pinion angle
 ``phi1``, unknowns ``(u1, v1, u2, v2, phi2)`` and the generating motions of the
-generated flanks (as in :func:`gearjax.tca.contact_system`), for an edge of
+generated flanks (as in :func:`gearjax.tca.path.contact_system`), for an edge of
 member ``k`` touching flank ``j``::
 
     r1f - r2f = 0                                        (3)  common point
@@ -60,7 +60,7 @@ At an edge contact no Hertz ellipse exists (one radius of curvature is zero: the
 load concentrates on the edge); the path reports the semi-axes as NaN there and
 marks the point in ``edge_kind`` (its major axis and Weingarten maps are those of
 the surface solve at that angle, kept finite so that no NaN enters a derivative;
-the kinematics at edge points are NaN, :func:`gearjax.tca_result.contact_kinematics`).
+the kinematics at edge points are NaN, :func:`gearjax.tca.result.contact_kinematics`).
 **Tip edges** (with ``tips``).  The same system with the tip function ``t_k(q)``
 (mm, zero on the tip surface -- addendum cylinder ``r_a - |q_xy|`` of an involute
 member, the face cone of a bevel member -- and positive below it) in place of
@@ -103,7 +103,7 @@ inside the mating tip and inside both face widths (to ``CORNER_TOL`` = 1e-8 mm: 
 on a face end by its equations), and where it is a local maximum of the TE over the
 tip's flank (in the sense of the load): the TE at which the flank point ``eps`` from the
 corner touches falls along the tip edge into the face and down the profile from the
-tip (first-order slopes, :func:`_corner_slope`; without this a far branch -- the corner
+tip (first-order slopes, :func:`~gearjax.tca.corners.corner_slope`; without this a far branch -- the corner
 on the mating flank from inside the mating tooth, thousands of arcsec "ahead" -- was
 taken on a localised spiral-bevel pair).  A corner or tip-edge continuation that fails
 two grid steps in a row gives up (``CORNER_GIVE_UP``: its Newton loops would hold the
@@ -128,8 +128,11 @@ import numpy as np
 
 from gearjax.frames import matrix_z
 from gearjax.newton import newton_solve
-from gearjax.tca import (ContactPath, contact_system, flank_at, gear_mount, relative_to_start,
-                         whole_turns_removed, newton_work)
+from gearjax.tca.corners import (CORNER_GIVE_UP, CORNER_TOL, corner_end, corner_leads,
+                                 corner_slope, pose)
+from gearjax.tca.path import (ContactPath, contact_system, flank_at, relative_to_start,
+                              whole_turns_removed, newton_work)
+from gearjax.tca.assembly import gear_mount
 
 __all__ = ["EDGE_NAMES", "FACE_END_KINDS", "TIP_KINDS", "CORNER_KINDS", "EDGE_LEAD",
            "EdgeContact", "edge_contact_system", "face_end_contact"]
@@ -178,17 +181,6 @@ class EdgeContact(NamedTuple):
     residual: jax.Array
 
 
-def _pose(cs, r1, r2, R, z, ph1):
-    """Both flanks' points, normals and flank data at the unknowns ``z`` of the contact
-    system ``cs``, and the members' rotations at pinion angle ``ph1`` (gear mount ``R``):
-    ``(q1, m1, f1, q2, m2, f2, R1, R2)``."""
-    x, psi1, psi2 = cs.split(z)
-    uv1, uv2, ph2 = cs.unpack(x)
-    q1, m1, f1 = flank_at(r1, uv1, psi1)
-    q2, m2, f2 = flank_at(r2, uv2, psi2)
-    return q1, m1, f1, q2, m2, f2, matrix_z(ph1), R @ matrix_z(ph2)
-
-
 def edge_contact_system(r1: Callable, r2: Callable, asm, mis, g1: Callable, g2: Callable,
                         t1: Callable | None = None, t2: Callable | None = None, *,
                         line_contact: bool = False, v1_fixed=0.0):
@@ -205,8 +197,8 @@ def edge_contact_system(r1: Callable, r2: Callable, asm, mis, g1: Callable, g2: 
     the start point.  With ``line_contact`` the tip-edge candidates (not the
     corners) take the line-contact treatment: the edge tangency is replaced by
     ``v1 = v1_fixed`` (one face-width section, that of the surface path).  The unknown
-    ``z`` is packed as in :func:`gearjax.tca.contact_system` (point contact).  Returns
-    ``(F, cs)`` with ``cs`` that :class:`~gearjax.tca.ContactSystem`.
+    ``z`` is packed as in :func:`gearjax.tca.path.contact_system` (point contact).  Returns
+    ``(F, cs)`` with ``cs`` that :class:`~gearjax.tca.path.ContactSystem`.
     """
     R, c = gear_mount(asm, mis)
     cs = contact_system(r1, r2, asm, mis, False)
@@ -226,7 +218,7 @@ def edge_contact_system(r1: Callable, r2: Callable, asm, mis, g1: Callable, g2: 
 
     def F(z, theta):
         ph1, s, g0, pinion, e, tip, g0b, corner = theta
-        q1, m1, f1, q2, m2, f2, R1, R2 = _pose(cs, r1, r2, R, z, ph1)
+        q1, m1, f1, q2, m2, f2, R1, R2 = pose(cs, r1, r2, R, z, ph1)
         uv1 = cs.unpack(cs.split(z)[0])[0]
         p1 = R1 @ q1 + mis.dP * ez
         p2 = c + R2 @ q2
@@ -246,78 +238,6 @@ def edge_contact_system(r1: Callable, r2: Callable, asm, mis, g1: Callable, g2: 
         return jnp.concatenate([p1 - p2, jnp.stack([on_edge, tang])] + mesh)
 
     return F, cs
-
-
-def corner_end(g1: Callable, g2: Callable, q1, q2, e):
-    """``G_e = e max(e g_1(q_1, e), e g_2(q_2, e))`` (mm): the face-end function of a
-    corner at end ``e`` (module docstring, "Corners"); zero where the common point
-    (body points ``q1``, ``q2``) lies on the face end ``e`` of one member and inside
-    the other's, negative beyond one of them on that end (``g_k`` grows into the face
-    from ``e = -1``, out of it at ``e = +1``)."""
-    return e * jnp.maximum(e * g1(q1, e), e * g2(q2, e))
-
-
-#: mm: face-width margin a corner's point may miss by (it lies on a face end by its
-#: equations, solved to 1e-11)
-CORNER_TOL = 1e-8
-
-#: failed angle steps in a row after which a corner's or tip edge's continuation stops
-CORNER_GIVE_UP = 2
-
-
-#: rad/mm: a corner counts where the TE along its tip edge into the face falls (in
-#: the sense of the load) or stays level within this
-CORNER_SLOPE_TOL = 1e-12
-
-
-def _corner_slope(cs, r1, r2, R, c, mis, asm, g1, g2, t1, t2, z, ph1, pinion, e):
-    """``dTE/d(eps)`` (rad/mm, (2,)) at a corner solution ``z`` of the tip edge of the
-    pinion (``pinion`` 1.0) or gear at end ``e``: the TE at which the flank point ``eps``
-    mm from the corner along the tip edge into the face, and down the profile from the
-    tip (in the flank's tangent plane), would touch the mating flank (first order; the
-    mating flank fixed, the gear turned).  With the tip-edge tangent ``u_k = m_k x grad
-    t_k`` (body frame, oriented into the face: ``e grad g_k . u_k < 0``), the mating
-    normal ``n_j`` and the velocity ``w = a_2 x (p - c)`` of the common point ``p`` per
-    unit gear angle: ``dphi2/deps = (n_2 . R_1 u_1)/(n_2 . w)`` for a pinion corner,
-    ``-(n_1 . R_2 u_2)/(n_1 . w)`` for a gear corner; ``dTE = ratio_sign dphi2``
-    (orientation-free: ``n_j`` enters above and below)."""
-    q1, m1, _, q2, m2, _, R1, R2 = _pose(cs, r1, r2, R, z, ph1)
-
-    def directions(m, t, g, q):
-        # along the tip edge into the face, and down the profile (in the flank's
-        # tangent plane, across the tip edge, below the tip: t grows)
-        gt = jax.grad(t)(q)
-        u = jnp.cross(m, gt)
-        u = u / jnp.maximum(jnp.linalg.norm(u), 1e-300)
-        u = jnp.where(e * jnp.dot(jax.grad(lambda qq: g(qq, e))(q), u) > 0.0, -u, u)
-        v = jnp.cross(m, u)
-        v = jnp.where(jnp.dot(gt, v) < 0.0, -v, v)
-        return u, v
-
-    p = R1 @ q1 + mis.dP * jnp.array([0.0, 0.0, 1.0])
-    w = jnp.cross(R[:, 2], p - c)
-    n1, n2 = R1 @ m1, R2 @ m2
-
-    def dte(d1, d2):
-        d_pin = jnp.dot(n2, R1 @ d1) / jnp.dot(n2, w)
-        d_gear = -jnp.dot(n1, R2 @ d2) / jnp.dot(n1, w)
-        return asm.ratio_sign * jnp.where(pinion > 0.5, d_pin, d_gear)
-
-    (u1, v1), (u2, v2) = directions(m1, t1, g1, q1), directions(m2, t2, g2, q2)
-    return jnp.stack([dte(u1, u2), dte(v1, v2)])
-
-
-def corner_leads(slope, drive):
-    """True where a corner candidate leads (module docstring, "Corners"): the TE at the
-    flank points beside the corner -- along its tip edge into the face and down the
-    profile, ``slope = dTE/d(eps)`` (rad/mm, ``(..., 2)``, :func:`_corner_slope`) --
-    falls in the sense of the load, or stays level within ``CORNER_SLOPE_TOL``, in
-    *both* directions: ``max_j(s dTE_j/d eps) <= tol`` with ``s`` +1 on the drive side,
-    -1 on the coast side.  Where it rises in either direction that flank point would
-    pass through the mating flank before the corner, so the corner cannot be the
-    contact."""
-    sgn_load = jnp.where(drive, 1.0, -1.0)
-    return jnp.max(sgn_load * slope, axis=-1) <= CORNER_SLOPE_TOL
 
 
 def neighbour_key(key, steps_per_pitch: int):
@@ -504,7 +424,7 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
     parts = jax.vmap(margin_parts)(q1, q2, uv1, uv2)
     if nc > 6:
         slope = jax.vmap(lambda zz, pk, ek: jax.vmap(
-            lambda z1, p1: _corner_slope(cs, r1, r2, R, c, mis, asm, g1, g2, t1, t2, z1, p1,
+            lambda z1, p1: corner_slope(cs, r1, r2, R, c, mis, asm, g1, g2, t1, t2, z1, p1,
                                          pk, ek))(zz, path.phi1))(
             Z, jnp.asarray(_PINION[:nc]), jnp.asarray(_END[:nc]))
     else:
