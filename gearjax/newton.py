@@ -230,7 +230,7 @@ def newton_solve(F: Callable, x0, theta=(), *, tol: float = 1e-10, xtol: float =
     x0 = jnp.asarray(x0, dtype=jnp.result_type(float))
     if x0.ndim > 1:
         raise ValueError(f"x0 must be a scalar or a 1-D array, got shape {x0.shape}")
-    if _eager(F, theta):
+    if _eager(F, x0, theta):
         # an eager call runs as one jitted program cached on ``F`` (by identity) and
         # the options: a module-level ``F`` is traced and compiled once per process
         # instead of at every call (an eager ``while_loop`` compiles its loop anew)
@@ -248,12 +248,13 @@ def newton_solve(F: Callable, x0, theta=(), *, tol: float = 1e-10, xtol: float =
     return NewtonResult(x, res, steps, conv)
 
 
-def _eager(F, theta) -> bool:
-    """True for a call outside any JAX transformation: nothing is being staged (an
-    array made here is concrete, not a tracer of ``jit``) and neither ``theta`` nor the
-    arrays ``F`` closes over (one closure level deep, and the closures of the
-    functions it closes over) is a tracer of ``grad``/``vmap``.  Public JAX only."""
-    if isinstance(jnp.zeros(()), jax.core.Tracer):
+def _eager(F, x0, theta) -> bool:
+    """True for a call outside any JAX transformation: nothing is being staged (``x0``,
+    made by ``jnp.asarray`` in this call, is concrete, not a tracer of ``jit``) and
+    neither ``theta`` nor the arrays ``F`` closes over (its closure cells, and those of
+    the functions, partials and bound methods it holds) is a tracer of
+    ``grad``/``vmap``.  Public JAX only."""
+    if isinstance(x0, jax.core.Tracer):
         return False
     seen, todo, leaves = set(), [F], list(jax.tree_util.tree_leaves(theta))
     while todo:
