@@ -126,6 +126,11 @@ def test_public_entry_points_are_jit_safe_and_match_the_concrete_call():
     np.testing.assert_allclose(np.asarray(g), fd, rtol=1e-5)
     with pytest.raises(ValueError, match="load = -1 N"):
         friction_coefficient(-1.0, 3000.0, 600.0, 8.0, 80.0, oil, surf)
+    # traced only in the oil or the surface (a study of the lubricant or roughness)
+    mu_s = jax.jit(lambda s: friction_coefficient(*args, oil, s).mu)(surf)
+    mu_o = jax.jit(lambda o: friction_coefficient(*args, o, surf).mu)(oil)
+    np.testing.assert_allclose(np.asarray(mu_s), mu_c, rtol=1e-12)
+    np.testing.assert_allclose(np.asarray(mu_o), mu_c, rtol=1e-12)
     F = np.array([[600.0, 400.0], [1000.0, 0.0]])
     us, ue = np.array([[-900.0, 1500.0], [500.0, 0.0]]), np.array([[4000.0, 4500.0], [4400.0, 1.0]])
     Rx = np.array([[6.0, 9.0], [9.0, 1.0]])
@@ -133,3 +138,6 @@ def test_public_entry_points_are_jit_safe_and_match_the_concrete_call():
     eta_j = float(jax.jit(lambda F: mesh_losses(F, us, ue, Rx, 20 * Rx, oil, surf,
                                                   9000.0).mean_efficiency)(F))
     assert abs(eta_j - eta_c) < 1e-12 and 0.9 < eta_c < 1.0
+    for bad in (0.0, -5.0, float("nan")):     # refused before any work, naming the input
+        with pytest.raises(ValueError, match="power_in"):
+            mesh_losses(F, us, ue, Rx, 20 * Rx, oil, surf, bad)

@@ -190,3 +190,14 @@ def test_every_format_refuses_a_grid_with_a_point_not_converged(tmp_path, design
         assert p.read_text() == "old\n"
     # the intact grid is written (the check refuses only what is wrong)
     assert write_xyz(tmp_path / "ok.xyz", g).exists()
+
+
+def test_design_file_with_a_byte_order_mark_loads(tmp_path):
+    """A design file saved by an editor that writes a UTF-8 byte-order mark reads as the
+    same design (the mark is not TOML)."""
+    text = io.read_toml("example:spiral_bevel_10x30")
+    src = io.example_path("spiral_bevel_10x30").read_text(encoding="utf-8")
+    p = tmp_path / "bom.toml"
+    p.write_bytes(b"\xef\xbb\xbf" + src.encode("utf-8"))
+    assert io.read_toml(str(p)) == text
+    assert load_design(str(p)).to_dict() == load_design("example:spiral_bevel_10x30").to_dict()

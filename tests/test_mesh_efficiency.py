@@ -432,9 +432,12 @@ def test_efficiency_guard_cannot_be_raised_by_invalidating_positions(iso_run):
     assert int(g1.n_lost) == 1
     drop = float(g0.mean_efficiency) - float(g1.mean_efficiency)
     np.testing.assert_allclose(drop, (P_in - P_f[worst]) / (v0.sum() * P_in), rtol=1e-12)
-    # positions outside V0 never count: a position valid now but not at the start
+    # positions outside V0 never count: the gamed position, invalid now, was not in
+    # the nominal set (every position of this run is valid, so the invalid one must be
+    # made: with eff's own flags an "all invalid positions" count would be 0 too)
     extra = v0.copy()
     extra[worst] = False
+    assert int(efficiency_guard(gamed, extra).n_lost) == 0
     assert int(efficiency_guard(eff, extra).n_lost) == 0
     grad = jax.grad(lambda p: efficiency_guard(eff._replace(power_loss=p), v0)
                     .mean_efficiency)(eff.power_loss)
