@@ -11,7 +11,7 @@ be gamed"); :func:`efficiency_warnings` gives one line per problem.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, NamedTuple
+from typing import NamedTuple
 
 import jax
 import jax.numpy as jnp
@@ -19,9 +19,7 @@ import numpy as np
 
 from gearjax.tribology.friction import FILM_MIN_MM
 
-if TYPE_CHECKING:  # annotations only (the result type is built on these checks)
-    from gearjax.loading.mesh_efficiency import MeshEfficiency
-    from gearjax.tca.result import TCAResult
+from gearjax.tca.result import TCAResult
 
 __all__ = ["MAX_RADIUS_RATIO", "MU_MAX", "P_MAX_LIMIT_MPA", "DEFLECTION_MAX_PITCH",
            "HERTZ_SIZE_MAX", "Plausibility", "PLAUSIBILITY_TEXT", "plausibility",
@@ -144,9 +142,11 @@ def plausibility(efficiency, mu, load, p_max, deflection, pitch, semi_minor, r_x
     return Plausibility(eff_ok, mu_ok, p_ok, y_ok, c_ok)
 
 
-def efficiency_warnings(eff: MeshEfficiency, res: TCAResult, *, film_method: str = "auto",
+def efficiency_warnings(eff, res: TCAResult, *, film_method: str = "auto",
                         viscosity_model: str = "roelands") -> list[str]:
-    """One line per problem of a concrete result: TCA quality flags, load balance or
+    """One line per problem of a concrete result (``eff`` a
+    :class:`~gearjax.loading.mesh_efficiency.MeshEfficiency`, ``res`` its TCA): TCA
+    quality flags, load balance or
     friction solves not converged, grid too short, loaded edge contact, implausible
     results (:func:`plausibility`: one line per failed check with the worst value), a
     film below :data:`FILM_MIN_MM`, the film formula outside its fitted ellipticity

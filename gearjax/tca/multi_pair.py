@@ -10,13 +10,10 @@ here); the contact path itself is solved there.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, NamedTuple
+from typing import NamedTuple
 
 import jax.numpy as jnp
 import numpy as np
-
-if TYPE_CHECKING:
-    from gearjax.tca.path import ContactPath
 
 __all__ = ["MultiPair", "multi_pair", "pair_arrays"]
 
@@ -80,12 +77,13 @@ def pair_arrays(arr, steps_per_pitch: int, n_pairs: int, fill, window):
     return jnp.stack(out)
 
 
-def multi_pair(path: ContactPath, margin, steps_per_pitch: int, z1: int, drive: bool = True,
+def multi_pair(path, margin, steps_per_pitch: int, z1: int, drive: bool = True,
                n_pairs: int = 3) -> MultiPair:
     """Shift pair 0 by whole pitches and form the unloaded TE envelope (traceable).
 
-    The grid ``path.phi1`` must be uniform with step ``2 pi/(z1 steps_per_pitch)``
-    so that a shift by one pitch is a shift by ``steps_per_pitch`` grid indices (no
+    ``path`` : the :class:`~gearjax.tca.path.ContactPath` of pair 0.  Its grid
+    ``path.phi1`` must be uniform with step ``2 pi/(z1 steps_per_pitch)`` so that a
+    shift by one pitch is a shift by ``steps_per_pitch`` grid indices (no
     interpolation of the TE curves).  ``margin`` : (N,) boundary margin of pair 0
     (>= 0 inside both flanks, mm).  ``drive`` chooses the max (drive) or min (coast)
     envelope (the flank pushing the gear decides its position).

@@ -49,14 +49,14 @@ Units: mm, rad.  References (docs/references.md): [HFT-hypoid];
 from __future__ import annotations
 
 import functools
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 
 from gearjax import frames
-from gearjax.fields import floats_for_ints
+from gearjax.fields import float64_array, floats_for_ints
 from gearjax.gears.hypoid.cutter import (FaceMillCutter, blade_data, cone_normal, cone_point,
                                          cutter_normal, cutter_point, fillet_start)
 from gearjax.errors import check_int, check_positive, check_range, require_converged
@@ -65,7 +65,7 @@ from gearjax.gears.hypoid.machine import (MachineSettings, cutter_to_cradle, cut
 from gearjax.io import FlankGrid  # noqa: F401  (the shared export grid; exported here)
 from gearjax.newton import newton_solve
 
-__all__ = ["MemberBlank", "FlankSpec", "FlankGrid", "make_member_blank", "mean_cone_distance",
+__all__ = ["MemberBlank", "FlankSpec", "FlankGrid", "program_pair", "make_member_blank", "mean_cone_distance",
            "face_apex_offset", "root_apex_offset", "axial_coords", "pitch_distance", "xi_of",
            "face_cone_gap", "root_cone_gap", "work_point", "meshing_function", "mid_estimate",
            "solve_tip", "solve_point", "flank_points", "flank_surface", "spiral_angle_at",
@@ -439,7 +439,6 @@ def flank_surface(fl: FlankSpec, n_xi: int = 21, n_s: int = 11, *, throw: bool =
     converged (``throw=False`` returns the grid with its ``converged`` mask)."""
     n_xi = check_int("n_xi", n_xi, 2, 2001)
     n_s = check_int("n_s", n_s, 2, 2001)
-    from gearjax.gears.hypoid.pair import program_pair   # one program per grid size
     g = _flank_points_jit(program_pair(fl), n_xi, n_s)
     if throw:
         require_converged(g.converged, "hypoid flank grid", g.residual)
@@ -468,3 +467,30 @@ def spiral_angle_at(fl: FlankSpec, s, xi0, x0):
     nrm = jnp.cos(b.pitch_angle) * e_R - jnp.sin(b.pitch_angle) * e_z     # cone normal
     t = t - jnp.dot(t, nrm) * nrm
     return jnp.arctan2(jnp.linalg.norm(jnp.cross(g, t)), jnp.abs(jnp.dot(g, t)))
+
+
+def program_pair(tree):
+    """``tree`` (a :class:`HypoidPair`, a :class:`FlankSpec` or any pytree holding them)
+    as the argument of a compiled program of this family: every number a strongly
+    typed float64 array -- tooth numbers, the mounting hand and the blade signs
+    included (Python ints and weakly typed floats would each key their own program) --
+    and each blank's hand-of-spiral label set to None (a label no computation reads;
+    :class:`~gearjax.gears.hypoid.flank.MemberBlank`).  One compiled TCA, synthesis
+    or kinematics program then serves every tooth number, hand of spiral, mounting
+    hand and flank side; what stays static is the structure: which members are
+    generated (a generated flank is an envelope, a formate one a cone) and the grid
+    options.  Tracers pass through unchanged; booleans are kept."""
+    def strip(x):
+        return replace(x, hand=None) if isinstance(x, MemberBlank) else x
+
+    def leaf(v):
+        if isinstance(v, jax.core.Tracer) or isinstance(v, (bool, np.bool_)):
+            return v
+        dt = getattr(v, "dtype", None)
+        if isinstance(v, (int, float, np.integer, np.floating)) or (
+                dt is not None and np.issubdtype(dt, np.number)):
+            return float64_array(v)
+        return v
+
+    tree = jax.tree_util.tree_map(strip, tree, is_leaf=lambda x: isinstance(x, MemberBlank))
+    return jax.tree_util.tree_map(leaf, tree)

@@ -65,7 +65,7 @@ from gearjax.fields import float64_array, floats_for_ints
 from gearjax.frames import matrix_x
 from gearjax.gears.hypoid.cutter import FaceMillCutter
 from gearjax.gears.hypoid.flank import (FlankSpec, face_cone_gap, mid_estimate, pitch_distance,
-                                        root_cone_gap, solve_tip, work_point)
+                                        program_pair, root_cone_gap, solve_tip, work_point)
 from gearjax.gears.hypoid.machine import MachineSettings, cutter_to_cradle
 from gearjax.surfaces import GeneratedSurface
 from gearjax.tca.assembly import Assembly
@@ -116,35 +116,6 @@ class HypoidPair:
 
 def _f(v):
     return float64_array(float(v))
-
-
-def program_pair(tree):
-    """``tree`` (a :class:`HypoidPair`, a :class:`FlankSpec` or any pytree holding them)
-    as the argument of a compiled program of this family: every number a strongly
-    typed float64 array -- tooth numbers, the mounting hand and the blade signs
-    included (Python ints and weakly typed floats would each key their own program) --
-    and each blank's hand-of-spiral label set to None (a label no computation reads;
-    :class:`~gearjax.gears.hypoid.flank.MemberBlank`).  One compiled TCA, synthesis
-    or kinematics program then serves every tooth number, hand of spiral, mounting
-    hand and flank side; what stays static is the structure: which members are
-    generated (a generated flank is an envelope, a formate one a cone) and the grid
-    options.  Tracers pass through unchanged; booleans are kept."""
-    from gearjax.gears.hypoid.flank import MemberBlank
-
-    def strip(x):
-        return replace(x, hand=None) if isinstance(x, MemberBlank) else x
-
-    def leaf(v):
-        if isinstance(v, jax.core.Tracer) or isinstance(v, (bool, np.bool_)):
-            return v
-        dt = getattr(v, "dtype", None)
-        if isinstance(v, (int, float, np.integer, np.floating)) or (
-                dt is not None and np.issubdtype(dt, np.number)):
-            return float64_array(v)
-        return v
-
-    tree = jax.tree_util.tree_map(strip, tree, is_leaf=lambda x: isinstance(x, MemberBlank))
-    return jax.tree_util.tree_map(leaf, tree)
 
 
 def check_pair_fields(pair: HypoidPair) -> None:

@@ -24,23 +24,20 @@ from __future__ import annotations
 
 import copy
 import functools
-import math
 from dataclasses import dataclass, field
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax.errors import check_int, check_range
-from gearjax.fields import float64_array
+from gearjax.errors import check_int
 from gearjax.gears.preset_bevel.geometry import (PresetBevelDesign, cone_distances, curve_data,
                                                  curve_parameter, flank_phase, gear_curve,
                                                  gear_flank_point, pinion_flank_point,
-                                                 pitch_angles, preset_kappa)
+                                                 pitch_angles, validate_fields)
 from gearjax.io import (DesignFileMixin, FlankGrid, check_integer, check_keys, check_number,  # noqa: F401
                         register_design_kind, require_key)
 from gearjax.newton import newton_solve
-from gearjax.tca.path import ARCSEC
 from gearjax.tca.result import register_family
 
 __all__ = ["KIND", "PresetBevelFile", "read_preset_bevel", "validate_fields", "FlankGrid",
@@ -62,42 +59,6 @@ SCHEMA = {
     "preset": {"te_arcsec": ("arcsec", 0.0, 600.0)},
 }
 _OPTIONAL = {("flanks", "spiral_R0_mm")}
-
-
-def validate_fields(v: dict) -> PresetBevelDesign:
-    """The design pytree from boundary values (degrees, mm, arc-seconds), validated:
-    ValueError naming the parameter, its value and the allowed range."""
-    z1 = check_int("z1", v["z1"], 3, 200)
-    z2 = check_int("z2", v["z2"], z1, 400)
-    beta = check_range("beta", v["beta_deg"], 5.0, 60.0, unit="deg")
-    an = check_range("alpha_n", v["alpha_n_deg"], 5.0, 35.0, unit="deg")
-    S = check_range("shaft_angle", v["shaft_angle_deg"], 30.0, 150.0, unit="deg")
-    mt = check_range("module_t", v["module_t"], 0.1, 100.0, unit="mm")
-    d1 = math.atan2(math.sin(math.radians(S)), z2 / z1 + math.cos(math.radians(S)))
-    Ao = mt * z1 / (2.0 * math.sin(d1))
-    b = check_range("face_width", v["face_width"], 0.0, 0.5 * Ao, lo_open=True, unit="mm")
-    rho1 = check_range("rho1", v["rho1"], 0.5, 5000.0, unit="mm")
-    rho2 = check_range("rho2", v["rho2"], 0.5, 5000.0, unit="mm")
-    ha = check_range("addendum", v["addendum"], 0.05 * mt, 3.0 * mt, unit="mm")
-    hf = check_range("dedendum", v["dedendum"], 0.05 * mt, 3.0 * mt, unit="mm")
-    Ai = Ao - b
-    R0 = v.get("R0")
-    R0 = (math.sqrt(Ai * Ao) * math.cos(d1) if R0 is None
-          else check_range("R0", R0, 0.0, None, lo_open=True, unit="mm"))
-    f = float64_array
-    des = PresetBevelDesign(f(math.radians(beta)), f(math.radians(an)), f(math.radians(S)),
-                            f(mt), f(b), f(R0), f(0.0), f(rho1), f(rho2), f(ha), f(hf), z1, z2)
-    if v.get("kappa") is not None:
-        if v.get("preset_te_arcsec") is not None:
-            raise ValueError("give the preset as preset_te_arcsec or as kappa, not both")
-        k = check_range("kappa", v["kappa"], 0.0, 1.0, unit="rad")
-    else:
-        te = check_range("preset_te_arcsec", v.get("preset_te_arcsec") or 0.0, 0.0, 600.0,
-                         unit="arcsec")
-        k = float(preset_kappa(des, te * ARCSEC))
-    return PresetBevelDesign(*(getattr(des, n) for n in ("beta", "alpha_n", "shaft_angle",
-                                                        "module_t", "face_width", "R0")),
-                             f(k), des.rho1, des.rho2, des.addendum, des.dedendum, z1, z2)
 
 
 def _grid_point(fn, data, outward_sign, delta, L, H, t0):

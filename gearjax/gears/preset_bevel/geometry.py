@@ -71,8 +71,9 @@ import numpy as np
 
 from gearjax.errors import check_int, check_range, is_traced
 from gearjax.fields import float64_array
+from gearjax.tca.path import ARCSEC
 
-__all__ = ["PresetBevelDesign", "pitch_angles", "spiral_rate", "cone_distances",
+__all__ = ["PresetBevelDesign", "validate_fields", "pitch_angles", "spiral_rate", "cone_distances",
            "curve_range", "curve_parameter", "preset_kappa", "CurveData", "curve_data",
            "curve_point", "curve_frame", "pinion_flank_point", "gear_curve", "gear_flank_point",
            "pinion_flank", "gear_flank", "flank_phase", "FLANK_SIGN", "transform_to_gear",
@@ -119,7 +120,6 @@ class PresetBevelDesign:
         ``preset_te_arcsec`` (pinion rotation at ``t_min`` and ``t_max``, the seed's 36
         arc-seconds) or as ``kappa`` (rad).  ``R0`` defaults to ``sqrt(A_i A_o) cos delta1``
         (then ``t_m = 0``).  ValueError naming the parameter and its range."""
-        from gearjax.gears.preset_bevel.design_file import validate_fields
         return validate_fields(dict(z1=z1, z2=z2, beta_deg=beta_deg, alpha_n_deg=alpha_n_deg,
                                     shaft_angle_deg=shaft_angle_deg, module_t=module_t,
                                     face_width=face_width, rho1=rho1, rho2=rho2,
@@ -335,3 +335,39 @@ def check_design_fields(des: PresetBevelDesign) -> None:
         check_range(n, getattr(des, n), 0.5, 5000.0, unit="mm")
     for n in ("addendum", "dedendum"):
         check_range(n, getattr(des, n), 0.05 * mt, 3.0 * mt, unit="mm")
+
+
+def validate_fields(v: dict) -> PresetBevelDesign:
+    """The design pytree from boundary values (degrees, mm, arc-seconds), validated:
+    ValueError naming the parameter, its value and the allowed range."""
+    z1 = check_int("z1", v["z1"], 3, 200)
+    z2 = check_int("z2", v["z2"], z1, 400)
+    beta = check_range("beta", v["beta_deg"], 5.0, 60.0, unit="deg")
+    an = check_range("alpha_n", v["alpha_n_deg"], 5.0, 35.0, unit="deg")
+    S = check_range("shaft_angle", v["shaft_angle_deg"], 30.0, 150.0, unit="deg")
+    mt = check_range("module_t", v["module_t"], 0.1, 100.0, unit="mm")
+    d1 = math.atan2(math.sin(math.radians(S)), z2 / z1 + math.cos(math.radians(S)))
+    Ao = mt * z1 / (2.0 * math.sin(d1))
+    b = check_range("face_width", v["face_width"], 0.0, 0.5 * Ao, lo_open=True, unit="mm")
+    rho1 = check_range("rho1", v["rho1"], 0.5, 5000.0, unit="mm")
+    rho2 = check_range("rho2", v["rho2"], 0.5, 5000.0, unit="mm")
+    ha = check_range("addendum", v["addendum"], 0.05 * mt, 3.0 * mt, unit="mm")
+    hf = check_range("dedendum", v["dedendum"], 0.05 * mt, 3.0 * mt, unit="mm")
+    Ai = Ao - b
+    R0 = v.get("R0")
+    R0 = (math.sqrt(Ai * Ao) * math.cos(d1) if R0 is None
+          else check_range("R0", R0, 0.0, None, lo_open=True, unit="mm"))
+    f = float64_array
+    des = PresetBevelDesign(f(math.radians(beta)), f(math.radians(an)), f(math.radians(S)),
+                            f(mt), f(b), f(R0), f(0.0), f(rho1), f(rho2), f(ha), f(hf), z1, z2)
+    if v.get("kappa") is not None:
+        if v.get("preset_te_arcsec") is not None:
+            raise ValueError("give the preset as preset_te_arcsec or as kappa, not both")
+        k = check_range("kappa", v["kappa"], 0.0, 1.0, unit="rad")
+    else:
+        te = check_range("preset_te_arcsec", v.get("preset_te_arcsec") or 0.0, 0.0, 600.0,
+                         unit="arcsec")
+        k = float(preset_kappa(des, te * ARCSEC))
+    return PresetBevelDesign(*(getattr(des, n) for n in ("beta", "alpha_n", "shaft_angle",
+                                                        "module_t", "face_width", "R0")),
+                             f(k), des.rho1, des.rho2, des.addendum, des.dedendum, z1, z2)
