@@ -139,3 +139,50 @@ def test_public_api_names_exist_and_tca_entry_points_are_there():
         assert n in gearjax.__all__, n
     assert "flank_surface" in gearjax.hypoid.__all__ and "synthesise" in gearjax.hypoid.__all__
     assert "friction_coefficient" in gearjax.tribology.__all__
+
+
+def _module_of(target: str):
+    """The module (dotted name) an import target refers to: the longest prefix that is a
+    module file or a package of gearjax."""
+    parts = target.split(".")
+    for k in range(len(parts), 0, -1):
+        path = PKG.parent.joinpath(*parts[:k])
+        if path.with_suffix(".py").is_file() or (path / "__init__.py").is_file():
+            return ".".join(parts[:k])
+    return None
+
+
+def test_no_import_circles():
+    """No two modules import each other, directly or round a longer circle -- imports
+    inside functions and type-only imports included (a circle made lazy is still a
+    circle of meaning).  A package's ``__init__`` counts as its own module."""
+    graph = {}
+    for name, path in _modules():
+        if name.endswith(".__init__"):
+            name = name[: -len(".__init__")]
+        edges = graph.setdefault(name, set())
+        for mod, names in _imports(path):
+            # ``from pkg import sub`` imports the submodule, not the package's names
+            subs = [f"{mod}.{n}" for n in names if _module_of(f"{mod}.{n}") == f"{mod}.{n}"]
+            others = len(subs) < len(names) or not names
+            for t in subs + ([mod] if others else []):
+                m = _module_of(t)
+                if m and m != name:
+                    edges.add(m)
+    state, circles = {}, []
+
+    def visit(n, stack):
+        state[n] = 1
+        stack.append(n)
+        for m in sorted(graph.get(n, ())):
+            if state.get(m) == 1:
+                circles.append(stack[stack.index(m):] + [m])
+            elif m not in state:
+                visit(m, stack)
+        stack.pop()
+        state[n] = 2
+
+    for n in sorted(graph):
+        if n not in state:
+            visit(n, [])
+    assert not circles, circles[:5]
