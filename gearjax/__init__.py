@@ -49,6 +49,7 @@ from gearjax.loading.materials import Material, pair_material  # noqa: E402
 from gearjax import hypoid, involute, preset_bevel, vh_catt  # noqa: E402
 from gearjax import tribology  # noqa: E402
 
+
 def run_tca(design, misalignment=None, *, side=None, **options) -> TCAResult:
     """Tooth contact analysis of any family: the one entry point.
 
