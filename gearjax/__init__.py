@@ -42,8 +42,8 @@ from gearjax.optimize import (LMResult, OptResult, least_squares_lm, minimize_lb
 from gearjax.io import design_from_dict, example_path, list_examples, load_design  # noqa: E402
 from gearjax.loading.loaded_contact import LoadedContact  # noqa: E402
 from gearjax.loading.mesh_efficiency import (MeshEfficiency, check_operating_point,  # noqa: E402
-                                             efficiency_function, efficiency_guard,
-                                             efficiency_warnings, mesh_efficiency)
+                                             efficiency_function, mesh_efficiency)
+from gearjax.loading.efficiency_checks import efficiency_guard, efficiency_warnings  # noqa: E402
 from gearjax.loading.materials import Material, pair_material  # noqa: E402
 # -- namespaces (importing the families registers their design kinds and TCA) --------
 from gearjax import hypoid, involute, preset_bevel, vh_catt  # noqa: E402

@@ -256,7 +256,10 @@ def _eager(F, x0, theta) -> bool:
     ``grad``/``vmap``.  Public JAX only."""
     if isinstance(x0, jax.core.Tracer):
         return False
-    seen, todo, leaves = set(), [F], list(jax.tree_util.tree_leaves(theta))
+    theta_leaves = jax.tree_util.tree_leaves(theta)
+    if not all(isinstance(t, jax.Array) for t in theta_leaves):
+        return False
+    seen, todo, leaves = set(), [F], list(theta_leaves)
     while todo:
         f = todo.pop()
         if id(f) in seen:
@@ -277,8 +280,7 @@ def _eager(F, x0, theta) -> bool:
                 todo.append(v)
             else:
                 leaves += jax.tree_util.tree_leaves(v)
-    return all(not isinstance(t, jax.core.Tracer) for t in leaves) and all(
-        isinstance(t, jax.Array) for t in jax.tree_util.tree_leaves(theta))
+    return not any(isinstance(t, jax.core.Tracer) for t in leaves)
 
 
 @partial(jax.jit, static_argnums=(0, 1, 2, 3, 4, 5))

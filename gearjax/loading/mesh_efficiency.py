@@ -74,18 +74,13 @@ from gearjax.tca.result import TCAResult, family_of
 from gearjax.loading.tooth_compliance import NU_STEEL
 from gearjax.tribology.friction import FILM_MIN_MM, STEEL_E_PRIME, FrictionResult, Surface
 from gearjax.tribology.losses import mesh_losses_traced
-from gearjax.loading.efficiency_checks import (DEFLECTION_MAX_PITCH, HERTZ_SIZE_MAX,  # re-exported
-                                               MAX_RADIUS_RATIO, MU_MAX, P_MAX_LIMIT_MPA,
-                                               EfficiencyGuard, Plausibility, efficiency_guard,
-                                               efficiency_warnings, plausibility)
+from gearjax.loading.efficiency_checks import MAX_RADIUS_RATIO, plausibility
 from gearjax.tribology.lubricant import Oil
 
 __all__ = ["MeshEfficiency", "mesh_efficiency", "DEFAULT_COMPLIANCE", "COMPLIANCE_HELP",
            "check_efficiency_inputs", "efficiency_function", "mesh_efficiency_traced",
-           "efficiency_warnings", "cycle_window", "check_operating_point", "cycle_summary",
-           "CycleSummary", "plausibility", "Plausibility", "TORQUE_RANGE_NM", "RPM_RANGE",
-           "MU_MAX", "P_MAX_LIMIT_MPA", "DEFLECTION_MAX_PITCH", "HERTZ_SIZE_MAX", "FILM_MIN_MM",
-           "EfficiencyGuard", "efficiency_guard"]
+           "cycle_window", "check_operating_point", "cycle_summary", "CycleSummary",
+           "TORQUE_RANGE_NM", "RPM_RANGE", "FILM_MIN_MM"]
 
 
 #: the default tooth compliance model of every route (Python and the command line)
@@ -114,7 +109,8 @@ class MeshEfficiency(NamedTuple):
     max_p_max : highest Hertz pressure over the cycle (MPa).
     power_in : P_in (W).
     valid : (M,) every loaded contact converged (load balance, Hertz, load sharing),
-        some pair carries load, and the result is plausible (:func:`plausibility`).
+        some pair carries load, and the result is plausible
+        (:func:`~gearjax.loading.efficiency_checks.plausibility`).
     truncated : the grid or the number of pairs does not cover every pair in contact.
     edge_loaded : (M,) an edge contact would be compressed under the load (its load
         is not modelled: the result is then not valid).
@@ -176,8 +172,8 @@ def cycle_summary(power_loss, power_in, mu, load, u_s, p_max, te_loaded, valid) 
     modelled loss: counting it with ``P_f = 0`` would report a silent 100 %.  Every
     summary is NaN when no position is valid (``n_valid = 0``); when only some are,
     the summaries describe the modelled part of the cycle and the result is flagged
-    (:func:`efficiency_warnings`).  Gradients are finite (the masks are constants of
-    the derivative).
+    (:func:`~gearjax.loading.efficiency_checks.efficiency_warnings`).  Gradients are
+    finite (the masks are constants of the derivative).
     """
     valid = jnp.asarray(valid, bool)
     n_valid = jnp.sum(valid)
@@ -428,8 +424,8 @@ def mesh_efficiency(design, torque_Nm, pinion_rpm, oil: Oil, surface: Surface, *
     Runs :func:`gearjax.run_tca` (its compiled program is shared with every other
     TCA of the same options) and then one jitted program for the loads, friction
     and losses.  Returns ``(MeshEfficiency, TCAResult)``; check ``eff.valid`` and
-    :func:`efficiency_warnings`.  ``throw``: raise ConvergenceError when the TCA
-    fails on the working flank (as :func:`gearjax.run_tca`).
+    :func:`~gearjax.loading.efficiency_checks.efficiency_warnings`.  ``throw``: raise
+    ConvergenceError when the TCA fails on the working flank (as :func:`gearjax.run_tca`).
     """
     from gearjax.loading.materials import pair_material
     from gearjax.tca.result import check_design

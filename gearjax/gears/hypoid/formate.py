@@ -74,7 +74,7 @@ import numpy as np
 
 from gearjax import frames
 from gearjax.gears.hypoid.cutter import FaceMillCutter
-from gearjax.errors import ConvergenceError
+from gearjax.errors import ConvergenceError, any_traced
 from gearjax.gears.hypoid.flank import (FlankSpec, face_cone_gap, mid_estimate, root_cone_gap,
                                         solve_tip, work_point, xi_of)
 from gearjax.gears.hypoid.machine import (MachineSettings, cutter_to_cradle, cutter_to_work,
@@ -91,7 +91,7 @@ def _primal(tree):
     or None when it has none (under ``jax.jit``/``vmap``): checks and discrete choices
     run on this value only, traced values pass through."""
     v = jax.lax.stop_gradient(tree)
-    if any(isinstance(x, jax.core.Tracer) for x in jax.tree_util.tree_leaves(v)):
+    if any_traced(v):
         return None
     return jax.tree_util.tree_map(lambda x: np.asarray(x, dtype=float), v)
 
