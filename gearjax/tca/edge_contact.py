@@ -265,24 +265,27 @@ def _give_up_system(F):
     return G
 
 
-def _continue(F, z0, thetas, fresh, n_homotopy, tol, max_steps, give_up=False):
+def _continue(F, z0, thetas, fresh, restart, n_homotopy, tol, max_steps, give_up=False):
     """Solve ``F(z, theta_i) = 0`` along the scanned ``thetas`` (lax.scan), each solve
     from the linear predictor of the two previous solutions (uniform steps of the
     homotopy level, then of the angle) -- a constant predictor where ``fresh`` (the
-    first angle step after the ``n_homotopy`` homotopy steps).  A failed step keeps the
-    previous solution.  Where the homotopy has not reached its end (its last solve
-    failed) the angle steps are marked not converged.
+    first angle step of each direction).  Where ``restart`` (the first step of the
+    second direction) the continuation starts again from the end of the homotopy.  A
+    failed step keeps the previous solution.  Where the homotopy has not reached its
+    end (its last solve failed) the angle steps are marked not converged.
 
-    With ``give_up`` (traced bool; the tip edges and corners) the continuation stops after the
-    homotopy failed or :data:`CORNER_GIVE_UP` angle steps failed in a row: the
-    remaining steps are marked not converged and solve the trivial ``z - z_prev = 0``
-    instead (one Newton step), so that a lost candidate does not keep the candidates
-    solved beside it in the same ``vmap`` iterating to ``max_steps`` (their Newton
-    loops run as long as the slowest)."""
+    With ``give_up`` (traced bool; the tip edges and corners) a direction's
+    continuation stops after the homotopy failed or :data:`CORNER_GIVE_UP` angle steps
+    failed in a row: its remaining steps are marked not converged and solve the trivial
+    ``z - z_prev = 0`` instead (one Newton step), so that a lost candidate does not keep
+    the candidates solved beside it in the same ``vmap`` iterating to ``max_steps``
+    (their Newton loops run as long as the slowest)."""
 
     def step(carry, inp):
-        x_prev, x_prev2, ok_h, fails = carry
-        theta, new, i = inp
+        x_prev, x_prev2, x_home, ok_h, fails = carry
+        theta, new, again, i = inp
+        x_prev = jnp.where(again, x_home, x_prev)
+        fails = jnp.where(again, 0, fails)
         linear = jax.lax.stop_gradient(2.0 * x_prev - x_prev2)
         pred = jnp.where(new, x_prev, linear)
         dead = give_up & ((fails >= CORNER_GIVE_UP) | ((i >= n_homotopy) & ~ok_h))
@@ -293,11 +296,13 @@ def _continue(F, z0, thetas, fresh, n_homotopy, tol, max_steps, give_up=False):
         ok_h = jnp.where(i == n_homotopy - 1, ok, ok_h)
         sol = sol._replace(converged=ok & ((i < n_homotopy) | ok_h))
         fails = jnp.where(i >= n_homotopy, jnp.where(ok, 0, fails + 1), 0)
-        return (jnp.where(ok, sol.x, x_prev), x_prev, ok_h, fails), sol
+        x_new = jnp.where(ok, sol.x, x_prev)
+        x_home = jnp.where(i == n_homotopy - 1, x_new, x_home)
+        return (x_new, x_prev, x_home, ok_h, fails), sol
 
     idx = jnp.arange(fresh.shape[0])
-    _, sols = jax.lax.scan(step, (z0, z0, jnp.asarray(True), jnp.asarray(0)),
-                           (thetas, fresh, idx))
+    _, sols = jax.lax.scan(step, (z0, z0, z0, jnp.asarray(True), jnp.asarray(0)),
+                           (thetas, fresh, restart, idx))
     return sols
 
 
@@ -373,42 +378,36 @@ def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, ma
         x0 = jnp.concatenate([path.uv1[i0], path.uv2[i0], path.phi2[i0][None]])
         psi0 = [None if p is None else p[i0] for p in (path.psi1, path.psi2)]
         z0 = jax.lax.stop_gradient(cs.join(x0, *psi0))
-        # each direction away from the start: the homotopy s = 1 -> 0 at the start
-        # angle, then the continuation along the grid (padded at the grid's end with
-        # the last angle) -- one scan, one Newton in the program
-        fwd = i0 + 1 + steps
-        bwd = i0 - 1 - steps
+        # the homotopy s = 1 -> 0 at the start angle, then the continuation along the
+        # grid away from the start, first forwards to the grid's end, then again from
+        # the start backwards to its beginning -- one scan, one Newton in the program
+        n_fwd = n - 1 - i0
+        back = steps >= n_fwd
+        cols_run = jnp.where(back, i0 - 1 - (steps - n_fwd), i0 + 1 + steps)
         ph0 = jnp.full((k,), path.phi1[i0])
-        phis = jnp.stack([jnp.concatenate([ph0, path.phi1[jnp.clip(fwd, 0, n - 1)]]),
-                          jnp.concatenate([ph0, path.phi1[jnp.clip(bwd, 0, n - 1)]])])
-        # a constant predictor at the first angle step and on the padding, the linear
+        phis = jnp.concatenate([ph0, path.phi1[jnp.clip(cols_run, 0, n - 1)]])
+        # a constant predictor at the first angle step of each direction, the linear
         # predictor of the two previous solutions elsewhere
-        pad = jnp.stack([fwd > n - 1, bwd < 0])
-        fresh = jnp.concatenate([jnp.zeros((2, k), bool),
-                                 pad | (steps == 0)[None, :]], axis=1)
+        turn = steps == n_fwd
+        fresh = jnp.concatenate([jnp.zeros((k,), bool), (steps == 0) | turn])
+        restart = jnp.concatenate([jnp.zeros((k,), bool), turn & (steps > 0)])
         const = [v + 0.0 * levels for v in (g0, pinion, e, tip, g0b, corner)]
-
-        def run(ph, fr):
-                return _continue(F, z0, (ph, levels, *const), fr, k, tol, max_steps,
-                             give_up=tip > 0.5)
-
-        sols = jax.vmap(run)(phis, fresh)
-        ok_ref = sols.converged[0, k - 1] & sols.converged[1, k - 1]
-        pos = jnp.where(cols < i0, k + i0 - cols - 1,
+        sols = _continue(F, z0, (phis, levels, *const), fresh, restart, k, tol, max_steps,
+                         give_up=tip > 0.5)
+        ok_ref = sols.converged[k - 1]
+        pos = jnp.where(cols < i0, k + n_fwd + i0 - cols - 1,
                         jnp.where(cols > i0, k + cols - i0 - 1, k - 1))
-        way = jnp.where(cols < i0, 1, 0)
 
         def whole(field):
-            return field[way, pos]
+            return field[pos]
 
         conv_e, res_e = relative_to_start(
-            whole(sols.converged), whole(sols.residual), ok_ref,
-            jnp.maximum(sols.residual[0, k - 1], sols.residual[1, k - 1]))
+            whole(sols.converged), whole(sols.residual), ok_ref, sols.residual[k - 1])
         return whole(sols.x), conv_e, res_e, sols.steps
 
     pin_np, tip_np, corner_np = _PINION[:nc], _TIP[:nc], _CORNER[:nc]
     Z, conv, res, steps = jax.vmap(one_edge)(*(jnp.asarray(a) for a in
-                                        (pin_np, _END[:nc], tip_np, corner_np)))
+                                             (pin_np, _END[:nc], tip_np, corner_np)))
 
     def post(z, ph1):
         x, psi1, psi2 = cs.split(z)
