@@ -88,6 +88,8 @@ WALL = {
     "example-list": ["example", "list"],
     "example-show-vh": ["example", "show", "vh_catt_17x23"],
     "tca-vh-11": ["tca", "example:vh_catt_17x23", "--positions", "11"],
+    "tca-hypoid": ["tca", HYPOID_TCA, "--pitches", "2"],
+    "efficiency": JOBS["efficiency"][2],
 }
 
 EVENTS = {"/jax/core/compile/jaxpr_trace_duration": "trace",

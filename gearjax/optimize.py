@@ -57,6 +57,7 @@ from typing import Any, Callable, NamedTuple
 
 import jax
 import jax.numpy as jnp
+import numpy as np
 import optax
 
 __all__ = ["CONVERGED", "MAX_ITERATIONS", "FAILED", "STATUS_MESSAGES", "status_message",
@@ -96,7 +97,7 @@ class OptResult(NamedTuple):
     x_history: jnp.ndarray
     grad_norm: jnp.ndarray
     steps: int
-    status: jnp.ndarray = jnp.asarray(MAX_ITERATIONS)
+    status: jnp.ndarray = np.asarray(MAX_ITERATIONS)
 
     @property
     def message(self) -> str:

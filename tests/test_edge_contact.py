@@ -900,3 +900,56 @@ def test_corner_leads_only_where_the_te_falls_both_ways(drive):
                             [0.5 * CORNER_SLOPE_TOL, -1.0]])   # level within tol: leads
     got = np.asarray(corner_leads(slopes, jnp.asarray(drive)))
     np.testing.assert_array_equal(got, [True, True, False, False, False, True])
+
+
+# --------------------------------------------------------------------------------------
+# the one-lane continuation (both directions in one scan) against two separate scans
+
+
+def _lane_system(z, th):
+    phi, s = th
+    return jnp.stack([z[0] + 0.3 * z[0] ** 3 + 0.1 * z[1] - phi - s,
+                      z[1] + 0.2 * jnp.sin(z[0]) - 0.5 * phi])
+
+
+@pytest.mark.parametrize("i0", [0, 3, 8])
+def test_one_lane_continuation_equals_two_directions(i0):
+    """An edge candidate runs the homotopy at grid point ``i0``, the steps to the grid's
+    end, then from the homotopy's end back to the grid's start, in one scan
+    (``_continue`` with ``restart``).  Each half must be exactly the continuation of
+    that direction alone (the homotopy, then a constant predictor at its first angle
+    step, then the linear predictor of its own two previous solutions): solutions,
+    Newton step counts, flags and residuals bit-identical, for a start inside the grid
+    and at either end."""
+    from gearjax.tca.edge_contact import _continue
+    n, k = 9, 4
+    phis = np.linspace(-1.0, 1.0, n)
+    levels = np.linspace(1.0, 0.0, k + 1)[1:]
+    z0 = jnp.asarray([0.0, 0.0])          # F(z0, (phi, 1)) != 0: the homotopy works
+
+    def run(cols, turn=None):
+        # as face_end_contact lays it out: a constant predictor at the first angle
+        # step and at the turn, the restart from the homotopy's end at the turn
+        m = len(cols)
+        th = (jnp.asarray(np.concatenate([np.full(k, phis[i0]), phis[cols]])),
+              jnp.asarray(np.concatenate([levels, np.zeros(m)])))
+        steps = np.arange(m)
+        fresh = steps == 0
+        restart = np.zeros(m, bool)
+        if turn is not None:
+            fresh = fresh | (steps == turn)
+            restart = (steps == turn) & (steps > 0)
+        pad = np.zeros(k, bool)
+        return _continue(_lane_system, z0, th, jnp.asarray(np.concatenate([pad, fresh])),
+                         jnp.asarray(np.concatenate([pad, restart])), k, 1e-11, 30)
+
+    fwd = list(range(i0 + 1, n))
+    bwd = list(range(i0 - 1, -1, -1))
+    both = run(fwd + bwd, turn=len(fwd))
+    alone_f, alone_b = run(fwd), run(bwd)
+    nf = k + len(fwd)
+    for field in ("x", "steps", "converged", "residual"):
+        a = np.asarray(getattr(both, field))
+        np.testing.assert_array_equal(a[:nf], np.asarray(getattr(alone_f, field)))
+        np.testing.assert_array_equal(a[nf:], np.asarray(getattr(alone_b, field))[k:])
+    assert bool(np.all(np.asarray(both.converged)))

@@ -13,6 +13,7 @@ import math
 
 import jax
 import jax.numpy as jnp
+import numpy as np
 
 from gearjax.gears.hypoid.blank import BlankInput
 from gearjax.studies.cutter_radius import StudySettings, study_statistics
@@ -24,7 +25,7 @@ _DEG = math.pi / 180.0
 #: box of the optimisation variables (mm, deg, mm) and their scales
 OPT_BOUNDS = {"cutter_radius": (60.0, 130.0), "blade_angle_delta_deg": (-3.0, 3.0),
               "cutter_shift": (-5.0, 5.0)}
-_OPT_SCALE = jnp.array([10.0, 1.0, 1.0])     # x = (r0/10 mm, d_alpha/deg, shift/mm)
+_OPT_SCALE = np.array([10.0, 1.0, 1.0])     # x = (r0/10 mm, d_alpha/deg, shift/mm)
 
 
 def _x_to_settings(x):

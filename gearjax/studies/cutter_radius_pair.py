@@ -33,6 +33,7 @@ from typing import NamedTuple
 
 import jax
 import jax.numpy as jnp
+import numpy as np
 
 from gearjax.gears.hypoid.cutter import FaceMillCutter
 from gearjax.gears.hypoid.formate import formate_from_placement, generating_gear_pinion
@@ -68,7 +69,7 @@ class StudyPair(NamedTuple):
 
 
 #: reflection y -> -y (homogeneous): the mirror image of the cone model's set (left hand)
-_MIRROR = jnp.diag(jnp.array([1.0, -1.0, 1.0, 1.0]))
+_MIRROR = np.diag([1.0, -1.0, 1.0, 1.0])
 
 
 def _member_blank(bd, k: int, teeth: int, hand: str) -> MemberBlank:

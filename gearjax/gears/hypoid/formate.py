@@ -96,8 +96,8 @@ def _primal(tree):
     return jax.tree_util.tree_map(lambda x: np.asarray(x, dtype=float), v)
 
 
-_RXPI = jnp.diag(jnp.array([1.0, -1.0, -1.0, 1.0]))
-_EZ = jnp.array([0.0, 0.0, 1.0])
+_RXPI = np.diag([1.0, -1.0, -1.0, 1.0])
+_EZ = np.array([0.0, 0.0, 1.0])
 
 
 def _hom(R, t):

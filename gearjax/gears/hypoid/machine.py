@@ -204,7 +204,7 @@ def _rot_k(phi_t, eps):
     return frames.rot_axis(jnp.stack([jnp.sin(eps), 0.0 * eps, jnp.cos(eps)]), phi_t)
 
 
-_MIRROR_Y = jnp.diag(jnp.array([1.0, -1.0, 1.0, 1.0]))
+_MIRROR_Y = np.diag([1.0, -1.0, 1.0, 1.0])
 
 
 def dial_cutter_to_cradle(d: No116Dials, eps=WEDGE_ANGLE, length=MACHINE_LENGTH):
