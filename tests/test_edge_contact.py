@@ -676,9 +676,17 @@ def vh_tip_run():
     pinion of a given pair (e.g. another blade angle: a base-pitch mismatch): one
     compiled program, ``run(pair, pinion_pair, misalignment)``, for every pinion and
     misalignment."""
-    from gearjax.gears.vh_catt.tca import vh_tca_traced
+    from gearjax.gears.vh_catt.tca import MISMATCHED_PINION
+    from gearjax.tca.family import tca_parts
+    from gearjax.tca.path import DEFAULT_APPROACH
     pair = gj.load_design("example:vh_catt_17x23").pair
-    return pair, jax.jit(lambda p, q, m: vh_tca_traced(p, m, -1.0, pinion=q))
+
+    def run(p, q, m):                   # the drive side, edges, tips and corners solved
+        return tca_parts(MISMATCHED_PINION, (p, q), m, None, None, jnp.asarray(True),
+                         DEFAULT_APPROACH, steps_per_pitch=24, half_pitches=1.25, n_pairs=3,
+                         kinematics=False, face_ends=True)[:3]
+
+    return pair, jax.jit(run)
 
 
 def test_vh_catt_tip_contact_matches_closed_forms(vh_tip_run):

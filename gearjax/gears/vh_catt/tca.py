@@ -36,16 +36,16 @@ from __future__ import annotations
 import jax
 import jax.numpy as jnp
 
-from gearjax.tca.family import DriverAdapter, GearFamily, tca_parts
+from gearjax.tca.family import DriverAdapter, GearFamily
 from gearjax.gears.vh_catt.geometry import VHCattPair, generated_flank, pair_geometry
 from gearjax.loading.loaded_contact import TeethOf
-from gearjax.tca.path import DEFAULT_APPROACH, ContactPath
-from gearjax.tca.assembly import Assembly, Misalignment
+from gearjax.tca.path import ContactPath
+from gearjax.tca.assembly import Assembly
 from gearjax.tca.result import register_family
 
-__all__ = ["vh_assembly", "vh_flanks", "reference_guess", "vh_margin", "vh_tca_traced", "margin_parts",
+__all__ = ["vh_assembly", "vh_flanks", "reference_guess", "vh_margin", "margin_parts",
            "SUMMARY_KEYS", "tca_summary", "pair_of",
-           "VHCattFamily", "ADAPTER"]
+           "VHCattFamily", "ADAPTER", "MISMATCHED_PINION"]
 
 
 def pair_of(design) -> VHCattPair:
@@ -63,7 +63,7 @@ def vh_assembly(pair: VHCattPair) -> Assembly:
 def vh_flanks(pair: VHCattPair, code, pinion: VHCattPair | None = None):
     """Pinion and gear flanks of side ``code`` (-1 drive, +1 coast; may be traced); the
     pinion cut as the pinion of ``pinion`` where given (a deliberately mismatched pinion,
-    e.g. another blade angle: :func:`vh_tca_traced`)."""
+    e.g. another blade angle: :data:`MISMATCHED_PINION`)."""
     return (generated_flank(pair if pinion is None else pinion, "pinion", code),
             generated_flank(pair, "gear", code))
 
@@ -240,32 +240,17 @@ class VHCattFamily(GearFamily):
 
 class _MismatchedPinion(VHCattFamily):
     """A VH-CATT pair whose pinion is cut as the pinion of another pair (a deliberate
-    mismatch, :func:`vh_tca_traced`): ``pair = (VHCattPair, pinion VHCattPair)``."""
+    mismatch, whose tip contacts the tests check): ``pair = (VHCattPair, pinion
+    VHCattPair)``, same tooth numbers and module (e.g. another blade angle); the
+    pinion's own tip and form circles bound its flank.  A family like the others: the
+    one driver runs it, ``tca_parts(MISMATCHED_PINION, (pair, pinion), mis, ...)``."""
 
     def _members(self, pair):
         return pair
 
 
 FAMILY = VHCattFamily()
+#: the VH-CATT family with a mismatched pinion (:class:`_MismatchedPinion`)
 MISMATCHED_PINION = _MismatchedPinion()
 ADAPTER = DriverAdapter(FAMILY)
 register_family(VHCattPair, ADAPTER)
-
-
-def vh_tca_traced(pair: VHCattPair, mis: Misalignment, code, *, steps_per_pitch: int = 24,
-                  half_pitches: float = 1.25, n_pairs: int = 3, approach=DEFAULT_APPROACH,
-                  face_ends: bool = True, pinion: VHCattPair | None = None):
-    """Traceable point-contact TCA ``(path, margin, multi)`` of side ``code`` (-1 drive,
-    +1 coast; may be traced) by the one driver (:func:`gearjax.tca.family.tca_parts`), on
-    the uniform grid of pinion angles ``phi1_ref + k 2 pi/(z1 steps_per_pitch)``,
-    ``|k| <= round(half_pitches steps_per_pitch)``; with ``face_ends`` the edge
-    contacts (face ends, tip edges, corners) are solved too.
-    ``pinion`` : cut the pinion as the pinion of this pair instead (same tooth numbers
-    and module; e.g. another blade angle: a deliberate base-pitch mismatch, whose tip
-    contacts the tests check); its own tip and form circles bound its flank."""
-    fam, p = (FAMILY, pair) if pinion is None else (MISMATCHED_PINION, (pair, pinion))
-    path, margin, multi, _, _ = tca_parts(fam, p, mis, None, None, jnp.asarray(code) < 0,
-                                          approach, steps_per_pitch=steps_per_pitch,
-                                          half_pitches=half_pitches, n_pairs=n_pairs,
-                                          kinematics=False, face_ends=face_ends)
-    return path, margin, multi
