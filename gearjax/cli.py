@@ -162,22 +162,33 @@ def _fast_compile_flags() -> None:
     ``import gearjax`` does not start it) for a CPU run: not with
     ``GEARJAX_FAST_COMPILE=0``, nor where ``JAX_PLATFORMS`` names another platform or a
     GPU plugin of JAX is installed (optimised GPU kernels matter more there)."""
-    import importlib.util
-
     if os.environ.get("GEARJAX_FAST_COMPILE", "1").strip().lower() in ("0", "off", "false", "no"):
         return
     platforms = os.environ.get("JAX_PLATFORMS", "").strip().lower()
     if platforms and platforms != "cpu":
         return
-    if not platforms and any(importlib.util.find_spec(m) is not None for m in
-                             ("jax_cuda12_plugin", "jax_cuda13_plugin", "jax_rocm60_plugin",
-                              "jax_rocm7_plugin")):
+    if not platforms and _accelerator_plugin_installed():
         return
     flags = os.environ.get("XLA_FLAGS", "")
     for name, value in FAST_COMPILE_FLAGS:
         if name not in flags:
             flags = f"{flags} --{name}={value}".strip()
     os.environ["XLA_FLAGS"] = flags
+
+
+def _accelerator_plugin_installed() -> bool:
+    """A PJRT plugin (CUDA, ROCm, ...) that JAX would load: JAX finds them as entry
+    points of the group ``jax_plugins`` or as modules of the ``jax_plugins`` namespace
+    package (the same two places JAX looks; a few milliseconds)."""
+    import importlib.util
+    import pkgutil
+    from importlib import metadata
+
+    if metadata.entry_points(group="jax_plugins"):
+        return True
+    spec = importlib.util.find_spec("jax_plugins")
+    return spec is not None and any(
+        True for _ in pkgutil.iter_modules(spec.submodule_search_locations or []))
 
 
 def main(argv=None) -> int:

@@ -26,7 +26,7 @@ def _flags():
 
 
 def test_flags_added_for_a_cpu_run(env):
-    env.setattr(cli.importlib.util, "find_spec", lambda name: None)
+    env.setattr(cli, "_accelerator_plugin_installed", lambda: False)
     cli._fast_compile_flags()
     assert _flags().split() == ["--xla_backend_optimization_level=0",
                                 "--xla_cpu_use_fusion_emitters=false"]
@@ -35,7 +35,7 @@ def test_flags_added_for_a_cpu_run(env):
 
 
 def test_a_users_choice_is_kept(env):
-    env.setattr(cli.importlib.util, "find_spec", lambda name: None)
+    env.setattr(cli, "_accelerator_plugin_installed", lambda: False)
     env.setenv("XLA_FLAGS", "--xla_backend_optimization_level=3 --xla_dump_to=/x")
     cli._fast_compile_flags()
     assert _flags().split() == ["--xla_backend_optimization_level=3", "--xla_dump_to=/x",
@@ -46,20 +46,29 @@ def test_a_users_choice_is_kept(env):
                                      ("GEARJAX_FAST_COMPILE", "off"),
                                      ("JAX_PLATFORMS", "cuda")])
 def test_switched_off_or_not_a_cpu_run(env, setting):
-    env.setattr(cli.importlib.util, "find_spec", lambda name: None)
+    env.setattr(cli, "_accelerator_plugin_installed", lambda: False)
     env.setenv(*setting)
     cli._fast_compile_flags()
     assert _flags() == ""
 
 
 def test_not_with_a_gpu_plugin_installed(env):
-    env.setattr(cli.importlib.util, "find_spec",
-                lambda name: object() if name == "jax_cuda12_plugin" else None)
+    env.setattr(cli, "_accelerator_plugin_installed", lambda: True)
     cli._fast_compile_flags()
     assert _flags() == ""
     env.setenv("JAX_PLATFORMS", "cpu")             # the user asks for the CPU: flags apply
     cli._fast_compile_flags()
     assert "--xla_backend_optimization_level=0" in _flags()
+
+
+def test_plugin_discovery_finds_jax_plugins(tmp_path, monkeypatch):
+    """Where JAX looks for PJRT plugins: a module of the ``jax_plugins`` namespace
+    package counts; this environment (CPU only) has none."""
+    assert cli._accelerator_plugin_installed() is False
+    (tmp_path / "jax_plugins" / "xla_fake").mkdir(parents=True)
+    (tmp_path / "jax_plugins" / "xla_fake" / "__init__.py").write_text("")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    assert cli._accelerator_plugin_installed() is True
 
 
 def test_importing_gearjax_does_not_start_the_backend(tmp_path):
