@@ -74,8 +74,8 @@ JOBS = {
     "efficiency": ("gearjax efficiency (spur 20/40, 200 N m, 1500 rpm)", "cli",
                    ["efficiency", "involute:z1=20,z2=40,m=4,alpha=20,b=30", "--torque-Nm", "200",
                     "--rpm", "1500", "--oil", "mineral_vg100", "--sigma-um", "0.4"]),
-    "tca": ("hypoid_tca (8/43 drive, prepare + TCA)", "py", "tca"),
-    "tca-coast": ("hypoid_tca drive, then coast (2nd side)", "py", "tca_coast"),
+    "tca": ("run_tca hypoid (8/43 drive, prepare + TCA)", "py", "tca"),
+    "tca-coast": ("run_tca hypoid drive, then coast (2nd side)", "py", "tca_coast"),
     "tca-grad": ("grad of TE p-t-p wrt pinion radial distance", "py", "tca_grad"),
     "synthesis": ("local synthesis (spiral bevel 10/30)", "py", "synthesis"),
 }
@@ -101,42 +101,37 @@ EVENTS = {"/jax/core/compile/jaxpr_trace_duration": "trace",
 
 def _py_job(name):
     import jax
-    import jax.numpy as jnp
     from dataclasses import replace
 
+    import gearjax as gj
     from gearjax.gears.hypoid import tca as th
     from gearjax.gears.hypoid.design_file import load_design
-    from gearjax.tca.assembly import Misalignment
 
     if name == "tca":
         def run():
             design = load_design(HYPOID_TCA)
-            res = th.hypoid_tca(th.prepare(th.pair_flanks(design, "drive")))
+            res = gj.run_tca(th.prepare(th.pair_flanks(design, "drive")), kinematics=False)
             return float(res.multi.ptp)
         return run
     if name == "tca_coast":
         def run():
             design = load_design(HYPOID_TCA)
-            out = [float(th.hypoid_tca(th.prepare(th.pair_flanks(design, s))).multi.ptp)
+            out = [float(gj.run_tca(th.prepare(th.pair_flanks(design, s)),
+                                    kinematics=False).multi.ptp)
                    for s in ("drive", "coast")]
             return out
         return run
     if name == "tca_grad":
-        def ptp(sr, pair, x_ref, phi1_ref, drive):
-            ms = replace(pair.pinion.machine, radial_distance=sr)
-            p = replace(pair, pinion=replace(pair.pinion, machine=ms))
-            res = th.hypoid_tca_traced(p, Misalignment.zero(), x_ref, phi1_ref, drive=drive)
-            return res.multi.ptp
-
-        grad = jax.jit(jax.grad(ptp), static_argnames=("drive",))
-
         def run():
             design = load_design(HYPOID_TCA)
             prep = th.prepare(th.pair_flanks(design, "drive"))
-            pair = prep.pair
-            return float(grad(pair.pinion.machine.radial_distance, pair,
-                              jnp.asarray(prep.x_ref), jnp.asarray(prep.phi1_ref),
-                              drive=prep.drive))
+            f = gj.tca_function(prep, kinematics=False)
+
+            def ptp(sr):
+                pair = f.pair
+                ms = replace(pair.pinion.machine, radial_distance=sr)
+                return f(replace(pair, pinion=replace(pair.pinion, machine=ms))).multi.ptp
+            return float(jax.jit(jax.grad(ptp))(f.pair.pinion.machine.radial_distance))
         return run
     if name == "synthesis":
         from gearjax.gears.hypoid import synthesis as sy

@@ -40,6 +40,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+import gearjax as gj
 from gearjax.gears.hypoid import tca as th
 from gearjax.gears.hypoid.contact_kinematics import path_kinematics
 from gearjax.studies import cutter_radius as hk
@@ -76,8 +77,8 @@ def conjugate_sweep(sp):
         x_ref = np.array(prep.x_ref, float)
         x_ref[1] = frac * s_tip
         p = prep._replace(x_ref=x_ref)
-        out = th.hypoid_tca(p, line_contact=True, steps_per_pitch=8, half_pitches=1.5,
-                            n_pairs=3, throw=False)
+        out = gj.run_tca(p, line_contact=True, steps_per_pitch=8, half_pitches=1.5,
+                         n_pairs=3, throw=False, kinematics=False)
         ok = np.asarray(out.path.converged) & (np.asarray(out.margin) >= 0.0)
         te_max = max(te_max, float(np.max(np.abs(np.asarray(out.path.te)[ok]))) / ARCSEC)
         k = path_kinematics(prep.pair, out.path, line_contact=True)
@@ -113,7 +114,8 @@ def localised(sp, d_radius=2.0, c2=0.02):
     p2 = th.with_point_radius(sp.pair.pinion, d_radius, float(prep0.x_ref[0]))
     pin = replace(p2, machine=replace(p2.machine, modified_roll_2c=jnp.asarray(c2)))
     prep = th.prepare(replace(sp.pair, pinion=pin))
-    out = th.hypoid_tca(prep, steps_per_pitch=16, half_pitches=1.0, n_pairs=3, throw=False)
+    out = gj.run_tca(prep, steps_per_pitch=16, half_pitches=1.0, n_pairs=3, throw=False,
+                     kinematics=False)
     k = path_kinematics(prep.pair, out.path, line_contact=False)
     _, f = _seed_fields(sp, out.path.p2_body)
     ok = (np.asarray(out.path.converged) & (np.asarray(out.margin) >= 0.0)

@@ -17,7 +17,7 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
-import gearjax  # noqa: F401  (float64)
+import gearjax as gj
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -47,8 +47,8 @@ def main():
     p_fl, g_fl = th.complementary_pinion(pair.gear, pair.pinion.blank)
     prep = th.prepare(replace(pair, pinion=p_fl, gear=g_fl))
     t = time.perf_counter()
-    conj = th.hypoid_tca(prep, line_contact=True, steps_per_pitch=8, half_pitches=1.5,
-                         n_pairs=3, throw=False)
+    conj = gj.run_tca(prep, line_contact=True, steps_per_pitch=8, half_pitches=1.5,
+                      n_pairs=3, throw=False, kinematics=False)
     ok = np.asarray(conj.path.converged)
     on = ok & (np.asarray(conj.margin) >= 0.0)
     out["conjugate"] = {"max_abs_te_arcsec_converged": float(np.abs(np.asarray(conj.path.te)[ok]).max() / ARCSEC),
@@ -57,7 +57,7 @@ def main():
                         "seconds_incl_compile": time.perf_counter() - t}
     loc = localised(prep)
     t = time.perf_counter()
-    res = th.hypoid_tca(loc, n_pairs=5)
+    res = gj.run_tca(loc, n_pairs=5, kinematics=False)
     sec = time.perf_counter() - t
     p = res.path
     x = np.asarray(p.phi1) - float(p.phi1[p.phi1.shape[0] // 2])
@@ -78,7 +78,7 @@ def main():
         "seconds_incl_compile": sec,
     }
     t = time.perf_counter()
-    vals, table = th.misalignment_sensitivity(loc, n_pairs=5)
+    vals, table = gj.tca_sensitivity(loc, n_pairs=5)
     out["misalignment_table"] = {"values": vals, "per_unit": table,
                                  "seconds_incl_compile": time.perf_counter() - t}
     save_tca_plot(OUT / "tca_spiral_bevel.png", [("localised 10/30, drive", p, res.margin, res.multi)],
@@ -105,7 +105,7 @@ def main():
             x1 = jnp.concatenate([uv1, s.x[1:]])
             return s.converged, F(x1, s.x[0])[4], s.x
         ok, n_eq, y = step1(jnp.concatenate([jnp.array([pr.phi1_ref]), jnp.asarray(pr.x_ref[2:])]))
-        full = th.hypoid_tca(pr, n_pairs=3, throw=False)
+        full = gj.run_tca(pr, n_pairs=3, throw=False, kinematics=False)
         rep[side] = {"hand": pair.hand, "mean_point_gap_mm": pr.mismatch[0],
                      "mean_point_normal_angle_deg": pr.mismatch[1],
                      "step1_converged": bool(ok),

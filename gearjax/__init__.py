@@ -86,6 +86,13 @@ def tca_function(design, *, side=None, **options):
     spiral-bevel/hypoid pairs (``f.pair`` is the prepared pair of the design, the
     natural point to differentiate at).  Options as for :func:`run_tca` (no
     ``throw``: check ``result.path.converged`` and ``result.on_flank``).
+
+    ``f(pair, misalignment, reference=(x_ref, phi1_ref))`` starts the contact path from
+    another reference guess (unknowns ``(u1, v1, u2, v2, phi2)`` at pinion angle
+    ``phi1_ref``; may be traced): by default the one found for ``design`` (for
+    involute pairs: inside the program, where it moves with the design).  Every call
+    of every ``f`` with the same family and options runs one compiled program (the
+    side is an argument of it, not part of its key).
     """
     check_design(design)
     kw = dict(options)

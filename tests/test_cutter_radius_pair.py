@@ -4,12 +4,14 @@ it generates, TCA contact points, and the kinematics there against the paper's e
 model."""
 
 import dataclasses
+import functools
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
 
+import gearjax as gj
 from gearjax.gears.hypoid import tca as th
 from gearjax.gears.hypoid.contact_kinematics import path_kinematics
 from gearjax.studies import cutter_radius as hk
@@ -23,8 +25,8 @@ def conj():
     inp = hk.study_blank_input(95.25)
     sp = study_pair(inp, hk.StudySettings.make(95.25), "convex")
     prep = th.prepare(sp.pair)
-    out = th.hypoid_tca(prep, line_contact=True, steps_per_pitch=8, half_pitches=1.0, n_pairs=3,
-                        throw=False)
+    out = gj.run_tca(prep, line_contact=True, steps_per_pitch=8, half_pitches=1.0, n_pairs=3,
+                     kinematics=False, throw=False)
     return sp, prep, out
 
 
@@ -76,8 +78,8 @@ def test_contact_kinematics_equal_the_seed_model(conj):
     for frac in (0.3, 0.7):
         x_ref = np.array(prep.x_ref, float)
         x_ref[1] = 2.0 * frac * x_ref[1]          # x_ref[1] is half the blade to the tip
-        outs.append(th.hypoid_tca(prep._replace(x_ref=x_ref), line_contact=True, steps_per_pitch=8,
-                                  half_pitches=1.0, n_pairs=3, throw=False))
+        outs.append(gj.run_tca(prep._replace(x_ref=x_ref), line_contact=True, steps_per_pitch=8,
+                               half_pitches=1.0, n_pairs=3, kinematics=False, throw=False))
     uv_all = []
     for out in outs:
         assert np.asarray(out.path.converged).all()
@@ -116,17 +118,17 @@ GRAD_NAMES = (SETTING_NAMES + ("point_radius", "pinion_crossing", "phi2m")
               + CONTACT_NAMES + ("te",))
 
 
-@jax.jit
-def _contact_scalars(pair, x_ref, phi1_ref):
+@functools.partial(jax.jit, static_argnums=1)
+def _contact_scalars(pair, tca, x_ref, phi1_ref):
     """Line-contact TCA on a 5-point grid round ``phi1_ref`` (pinion blade position
-    ``x_ref[1]`` fixed) and the pair's kinematics at the middle point.
+    ``x_ref[1]`` fixed) and the pair's kinematics at the middle point (``tca`` the
+    pair's :func:`gearjax.tca_function`, started from ``(x_ref, phi1_ref)``).
 
     Surface contact only (``face_ends=False``): the middle point is a contact inside
     both flanks (its margin is returned and asserted positive), where the face-end /
     tip-edge solves of the full TCA are not taken and change neither the value nor the
     derivative; leaving them out of this jvp program saves ~9 s CPU of compilation."""
-    out = th.hypoid_tca_traced(pair, Misalignment.zero(), x_ref, phi1_ref, steps_per_pitch=4,
-                               half_pitches=0.5, line_contact=True, n_pairs=3, face_ends=False)
+    out = tca(pair, Misalignment.zero(), reference=(x_ref, phi1_ref))
     k = path_kinematics(pair, out.path, line_contact=True)
     m = 2
     vals = [out.path.phi2[m], out.path.axial2[m], out.path.radial2[m], k.u_e[m], k.u_s[m],
@@ -134,7 +136,7 @@ def _contact_scalars(pair, x_ref, phi1_ref):
     return jnp.stack(vals), out.path.converged & (out.margin[m] > 0.0)
 
 
-def machine_pair_scalars(r0, x_ref, phi1_ref, hand):
+def machine_pair_scalars(r0, tca, x_ref, phi1_ref, hand):
     """Scalars of the machine-cut pair of the study with cutter radius ``r0`` (mm): the
     pinion's machine settings (mm, rad), its point radius and crossing point (mm), the
     mean-contact gear angle (rad), and at a fixed pinion angle and blade position the
@@ -147,7 +149,7 @@ def machine_pair_scalars(r0, x_ref, phi1_ref, hand):
     pin = sp.pair.pinion
     head = [getattr(pin.machine, n) for n in SETTING_NAMES]
     head += [pin.cutter.point_radius, sp.pair.pinion_crossing, sp.info["phi2m"]]
-    contact, conv = _contact_scalars(sp.pair, x_ref, phi1_ref)
+    contact, conv = _contact_scalars(sp.pair, tca, x_ref, phi1_ref)
     return jnp.concatenate([jnp.stack(head), contact]), conv
 
 
@@ -155,7 +157,9 @@ def gradient_table(prep, h=0.1):
     """(autodiff d/dr0, Richardson-extrapolated central difference with steps h and
     h/2: ``(4 D(h/2) - D(h)) / 3``, error O(h^4)) for :data:`GRAD_NAMES`."""
     x_ref, phi1_ref = jnp.asarray(prep.x_ref), jnp.asarray(prep.phi1_ref)
-    f = lambda r: machine_pair_scalars(r, x_ref, phi1_ref, prep.pair.hand)
+    tca = gj.tca_function(prep, steps_per_pitch=4, half_pitches=0.5, line_contact=True,
+                          n_pairs=3, face_ends=False, kinematics=False)
+    f = lambda r: machine_pair_scalars(r, tca, x_ref, phi1_ref, prep.pair.hand)
     (v0, conv), (dv, _) = jax.jvp(f, (jnp.asarray(R0),), (jnp.asarray(1.0),))
     assert np.asarray(conv).all()
 

@@ -14,6 +14,7 @@ Tip edges: a spur pair with a base-pitch mismatch touches at a tooth tip off the
 of action; reference: the closed form of the plane involutes (below, before the tests).
 """
 
+import functools
 import json
 
 import jax
@@ -40,14 +41,18 @@ LEAD = 0.5 * B * DG * np.cos(np.radians(20.0)) / RB2      # rad, edge ahead of m
 
 @pytest.fixture(scope="module")
 def traced():
-    """The involute TCA (line contact) with and without face ends: one compiled program
-    each, ``traced[fe](design, misalignment, side=-1.0)``; the side (-1 drive, +1 coast)
-    is a traced argument, so both sides share the program."""
-    progs = {fe: jax.jit(lambda d, m, s, fe=fe: itca.involute_tca_traced(d, m, side=s,
-                                                                       face_ends=fe))
-             for fe in (True, False)}
-    return {fe: (lambda d, m, side=-1.0, p=p: p(d, m, jnp.asarray(side, float)))
-            for fe, p in progs.items()}
+    """The involute TCA (line contact, 24 steps per pitch, +-1.25 pitches, 3 pairs, no
+    kinematics) with and without face ends by the one entry point,
+    ``traced[fe](design, misalignment, side=-1.0)`` (-1 drive, +1 coast) ->
+    ``(path, margin, multi)``: one compiled program each (the side is an argument of
+    the program, so both sides share it)."""
+    def run(d, m, side=-1.0, fe=True):
+        f = gj.tca_function(d, side="drive" if side < 0 else "coast", line_contact=True,
+                            face_ends=fe, kinematics=False, steps_per_pitch=24,
+                            half_pitches=1.25, n_pairs=3)
+        res = f(d, m)
+        return res.path, res.margin, res.multi
+    return {fe: functools.partial(run, fe=fe) for fe in (True, False)}
 
 
 def _mis(dg):

@@ -19,8 +19,7 @@ import gearjax as gj
 from gearjax.cli import main
 from gearjax.gears.preset_bevel import analysis as A
 from gearjax.gears.preset_bevel import geometry as G
-from gearjax.gears.preset_bevel.pair import preset_assembly, reference_contact, side_flanks
-from gearjax.gears.preset_bevel.tca import preset_result_traced
+from gearjax.gears.preset_bevel.pair import preset_assembly, side_flanks
 from gearjax.tca.assembly import gear_mount
 from gearjax.tca.result import strong_float64
 
@@ -189,14 +188,13 @@ def surface_only(des):
     jitted program, the forward-mode derivative of (TE p-t-p, TE at one grid point)
     along a direction ``dtheta`` of (kappa, rho1): the implicit derivatives of every
     contact solve (one program for every design, misalignment and direction)."""
-    x_ref, phi1_ref = reference_contact(des, "drive")
+    f = gj.tca_function(des, side="drive", face_ends=False, **OPTS)
 
     @jax.jit
     def run(d, mis, dtheta):
         def g(th):
             dd = dataclasses.replace(d, kappa=th[0], rho1=th[1])
-            res = preset_result_traced(dd, mis, x_ref, phi1_ref, side="drive",
-                                       face_ends=False, **OPTS)
+            res = f(dd, mis)
             return jnp.stack([res.multi.ptp, res.path.te[GRAD_POINT]]), res
         _, dval, res = jax.jvp(g, (jnp.stack([d.kappa, d.rho1]),), (dtheta,), has_aux=True)
         return res, dval

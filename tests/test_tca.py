@@ -20,8 +20,9 @@ from gearjax.tca.edge_contact import EDGE_NAMES
 from gearjax.tca.path import (ARCSEC, NoContactError, contact_path, ellipse_from_weingarten,
                               multi_pair)
 from gearjax.tca.assembly import Misalignment
-from gearjax.gears.involute.tca import (InvoluteTCA, crowned_pinion_flank,
-                                  misalignment_sensitivity, tca_summary, SUMMARY_KEYS)
+from gearjax.gears.involute.tca import (InvoluteTCA, crowned_pinion_flank, tca_summary,
+                                        SUMMARY_KEYS)
+from gearjax.tca.family import sensitivity_table
 
 
 def involute_tca(des, mis=None, *, side=-1, throw=True):
@@ -380,8 +381,20 @@ MIS0 = Misalignment(jnp.asarray(0.0), jnp.asarray(0.0), jnp.asarray(0.0), jnp.as
 
 @pytest.fixture(scope="module")
 def sensitivity(crowned):
+    """``(values, table, design Jacobian)`` of the TCA summary at ``MIS0``: ``jax.jacfwd``
+    by the misalignment and every design field through the one traceable entry point
+    (:func:`gearjax.tca_function`), one program."""
     des, _ = crowned
-    return misalignment_sensitivity(des, MIS0)
+    f = gj.tca_function(des, kinematics=False)
+
+    def summary(d, m):
+        res = f(d, m)
+        return tca_summary(res.path, res.multi)
+
+    vals, (jdes, jmis) = jax.jit(
+        lambda d, m: (summary(d, m), jax.jacfwd(summary, argnums=(0, 1))(d, m)))(des, MIS0)
+    values, table = sensitivity_table(SUMMARY_KEYS, vals, jmis)
+    return values, table, jdes
 
 
 def test_misalignment_directions_of_crowned_spur_pair(sensitivity):

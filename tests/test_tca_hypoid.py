@@ -12,6 +12,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
+import gearjax as gj
 from gearjax.gears.hypoid.design_file import load_design
 from gearjax.gears.hypoid import tca as th
 from gearjax.tca.path import ARCSEC, NoContactError
@@ -48,15 +49,14 @@ def _modified(prep, d_radius, c2):
 
 @pytest.fixture(scope="module")
 def point_tca(conjugate):
-    f = jax.jit(partial(th.hypoid_tca_traced, line_contact=False, steps_per_pitch=STEPS,
-                        half_pitches=HALF, n_pairs=3, drive=conjugate.drive))
-    return lambda pair, mis=Misalignment.zero(): f(pair, mis, jnp.asarray(conjugate.x_ref),
-                                                   conjugate.phi1_ref)
+    f = gj.tca_function(conjugate, line_contact=False, steps_per_pitch=STEPS, half_pitches=HALF,
+                        n_pairs=3, kinematics=False)
+    return lambda pair, mis=Misalignment.zero(): f(pair, mis)
 
 
 def test_crown_gear_complementary_pair_is_conjugate(conjugate):
-    res = th.hypoid_tca(conjugate, line_contact=True, steps_per_pitch=STEPS, half_pitches=HALF,
-                        n_pairs=3, throw=False)
+    res = gj.run_tca(conjugate, line_contact=True, steps_per_pitch=STEPS, half_pitches=HALF,
+                     n_pairs=3, kinematics=False, throw=False)
     p = res.path
     assert bool(np.all(np.asarray(p.converged)))
     te = np.abs(np.asarray(p.te)) / ARCSEC
@@ -156,13 +156,12 @@ def test_a_prepared_pair_is_labelled_by_its_flanks(conjugate, coast):
     prepared pair's own flanks decide its side -- the result is labelled by them, and a
     side that contradicts them is a one-line ValueError before any work -- while a
     design file's ``side`` picks the flanks (drive by default)."""
-    import gearjax as gj
     for prep, side, other in ((conjugate, "drive", "coast"), (coast, "coast", "drive")):
         with pytest.raises(ValueError, match=f"pinion flank of this pair is .*the {side} side"):
             gj.run_tca(prep, side=other)
         with pytest.raises(ValueError, match=f"the {side} side"):
             gj.run_tca(prep.pair, side=other)
-        # the program of th.hypoid_tca (no kinematics), compiled by the tests above
+        # the program of the line-contact TCA without kinematics, compiled by the tests above
         res = gj.run_tca(prep, line_contact=True, steps_per_pitch=STEPS, half_pitches=HALF,
                          n_pairs=3, kinematics=False, throw=False)
         assert res.side == side and res.family == "hypoid"
@@ -177,10 +176,9 @@ def test_a_prepared_pair_is_labelled_by_its_flanks(conjugate, coast):
 
 @pytest.fixture(scope="module")
 def coast_point_tca(coast):
-    f = jax.jit(partial(th.hypoid_tca_traced, line_contact=False, steps_per_pitch=STEPS,
-                        half_pitches=HALF, n_pairs=3, drive=coast.drive))
-    return lambda pair, mis=Misalignment.zero(): f(pair, mis, jnp.asarray(coast.x_ref),
-                                                   coast.phi1_ref)
+    f = gj.tca_function(coast, line_contact=False, steps_per_pitch=STEPS, half_pitches=HALF,
+                        n_pairs=3, kinematics=False)
+    return lambda pair, mis=Misalignment.zero(): f(pair, mis)
 
 
 def test_coast_complementary_pair_is_conjugate(conjugate, coast):
@@ -193,8 +191,8 @@ def test_coast_complementary_pair_is_conjugate(conjugate, coast):
     envelope is the other extremum) and its cutter blade is the other side."""
     assert coast.drive != conjugate.drive
     assert coast.pair.pinion.cutter.sign == -conjugate.pair.pinion.cutter.sign
-    res = th.hypoid_tca(coast, line_contact=True, steps_per_pitch=STEPS, half_pitches=HALF,
-                        n_pairs=3, throw=False)
+    res = gj.run_tca(coast, line_contact=True, steps_per_pitch=STEPS, half_pitches=HALF,
+                     n_pairs=3, kinematics=False, throw=False)
     p = res.path
     on = np.asarray(res.margin) >= 0.0
     assert on.sum() >= 6 and bool(np.all(np.asarray(p.converged)))
@@ -346,9 +344,9 @@ def test_gradients_match_central_differences(conjugate, point_tca):
 
 def test_bad_input_and_no_contact(conjugate):
     with pytest.raises(ValueError, match="steps_per_pitch"):
-        th.hypoid_tca(conjugate, steps_per_pitch=1)
+        gj.run_tca(conjugate, kinematics=False, steps_per_pitch=1)
     with pytest.raises(ValueError, match="n_pairs"):
-        th.hypoid_tca(conjugate, n_pairs=4)
+        gj.run_tca(conjugate, kinematics=False, n_pairs=4)
     with pytest.raises(ValueError, match="side"):
         th.pair_flanks(load_design("example:spiral_bevel_10x30"), "reverse")
     # pinion turned inside out (the other blade side): its flank cannot meet the gear's

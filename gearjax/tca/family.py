@@ -46,8 +46,7 @@ from gearjax.tca.path import (DEFAULT_APPROACH, check_on_flank_converged, check_
 from gearjax.tca.assembly import Misalignment
 from gearjax.tca.result import TCAResult, check_side, contact_kinematics, strong_float64
 
-__all__ = ["GearFamily", "DriverAdapter", "tca_parts", "result_traced", "sensitivity_table",
-           "OPTION_NAMES"]
+__all__ = ["GearFamily", "DriverAdapter", "tca_parts", "sensitivity_table", "OPTION_NAMES"]
 
 #: the TCA options every family accepts (``line_contact`` only where supported)
 OPTION_NAMES = ("steps_per_pitch", "half_pitches", "n_pairs", "approach", "kinematics",
@@ -240,15 +239,6 @@ def tca_parts(fam: GearFamily, pair, mis, x_ref, phi1_ref, drive, approach, *,
     return path, margin, multi, coords, kin
 
 
-def result_traced(fam: GearFamily, pair, mis, x_ref, phi1_ref, side: str,
-                  approach=DEFAULT_APPROACH, **static) -> TCAResult:
-    """:func:`tca_parts` of the named ``side`` as a :class:`TCAResult` (traceable; the
-    families' own ``*_result_traced`` entry points)."""
-    parts = tca_parts(fam, pair, mis, x_ref, phi1_ref, jnp.asarray(side == "drive"), approach,
-                      **static)
-    return TCAResult(*parts, side, fam.name)
-
-
 _STATIC = ("fam", "steps_per_pitch", "half_pitches", "n_pairs", "kinematics", "face_ends",
            "line_contact")
 
@@ -350,18 +340,20 @@ class DriverAdapter:
         return res
 
     def traced(self, design, *, side=None, **options):
-        """A pure ``f(pair, mis=None) -> TCAResult`` (the concrete set-up and reference
-        contact of ``design`` fixed once here); ``f.pair`` the design's differentiable
-        pair."""
+        """A pure ``f(pair, mis=None, *, reference=None) -> TCAResult`` (the concrete
+        set-up and reference contact of ``design`` fixed once here; ``reference =
+        (x_ref, phi1_ref)`` replaces that reference guess, e.g. a traced one);
+        ``f.pair`` the design's differentiable pair."""
         setup, side = self._setup(design, side)
         approach, static = self.options(options, setup)
         x_ref, phi1_ref = self._reference(setup, side)
         fam = self.fam
 
-        def f(pair, mis=None):
+        def f(pair, mis=None, *, reference=None):
             mis = Misalignment.zero() if mis is None else mis
-            return _result(fam, fam.program_pair(pair, setup), mis, x_ref, phi1_ref,
-                           approach, side, static)
+            xr, pr = (x_ref, phi1_ref) if reference is None else reference
+            return _result(fam, fam.program_pair(pair, setup), mis, xr, pr, approach, side,
+                           static)
         f.pair = fam.user_pair(setup)
         return f
 

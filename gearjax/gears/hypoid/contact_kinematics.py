@@ -94,7 +94,7 @@ def path_kinematics(pair: th.HypoidPair, path: ContactPath, mis: Misalignment | 
                     *, line_contact: bool = False) -> PathKinematics:
     """Model and pair kinematics at every point of ``path`` (module docstring; jitted).
 
-    ``path`` is the :attr:`~gearjax.gears.hypoid.tca.HypoidTCA.path` of a TCA of ``pair``
+    ``path`` is the :attr:`~gearjax.TCAResult.path` of a TCA of ``pair``
     with misalignment ``mis`` (default none) in the same contact mode
     (``line_contact``).  Points where the path did not converge give meaningless
     values: mask them with ``path.converged``.

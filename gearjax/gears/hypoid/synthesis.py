@@ -90,7 +90,7 @@ Residuals are divided by the scales :data:`SCALES` (0.1 mm, 1 arcsec, 1 arcsec,
 i.e. 0.1 um, 0.001 arcsec, 0.001 deg).
 
 **Verification** (:func:`verify`): an independent full TCA
-(:func:`~gearjax.gears.hypoid.tca.hypoid_tca`, its own reference, default grid of 16
+(:func:`gearjax.run_tca` without kinematics, its own reference, default grid of 16
 steps per pitch, 5 pairs) of the synthesised pair; the bearing position is read off
 where its path crosses the ``zeta = 0`` line (linear interpolation), the TE level
 as the TE of the envelope's apex (3-point parabola) minus the TE of pair 0 at the
@@ -496,8 +496,8 @@ def verify(pair: th.HypoidPair, tgt, *, steps_per_pitch: int = 16, half_pitches:
     """
     t0 = time.perf_counter()
     prep = th.prepare(pair)
-    out = th.hypoid_tca(prep, steps_per_pitch=steps_per_pitch, half_pitches=half_pitches,
-                        n_pairs=n_pairs)
+    out = th.ADAPTER.run(prep, steps_per_pitch=steps_per_pitch, half_pitches=half_pitches,
+                         n_pairs=n_pairs, kinematics=False)
     jax.block_until_ready(out.path.te)
     secs = time.perf_counter() - t0
     tgt = np.asarray(tgt, float)

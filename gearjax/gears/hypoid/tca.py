@@ -28,7 +28,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax.tca.family import DriverAdapter, GearFamily, tca_parts
+from gearjax.tca.family import DriverAdapter, GearFamily
 from gearjax.gears.hypoid.design_file import HypoidDesign
 from gearjax.gears.hypoid.flank import face_apex_offset, root_apex_offset
 from gearjax.gears.hypoid.pair import (SIDES, HypoidPair, complementary_pinion, flank_coordinates,
@@ -38,16 +38,14 @@ from gearjax.gears.hypoid.pair import (SIDES, HypoidPair, complementary_pinion, 
 from gearjax.loading.loaded_contact import TeethOf
 from gearjax.newton import newton_solve
 from gearjax.surfaces import GeneratedSurface
-from gearjax.tca.path import (DEFAULT_APPROACH, ContactPath, MultiPair, NoContactError,
-                              contact_system)
+from gearjax.tca.path import NoContactError, contact_system
 from gearjax.tca.assembly import Misalignment
 from gearjax.tca.result import register_family
 
 __all__ = ["mean_dedendum", "HypoidPair", "pair_flanks", "complementary_pinion",
            "hypoid_assembly", "flank_function", "reference_guess", "hypoid_margin",
-           "flank_coordinates", "hypoid_tca_traced", "hypoid_tca", "SIDES", "HypoidTCA",
-           "Prepared", "prepare", "with_point_radius", "pinion_outline",
-           "misalignment_sensitivity", "reference_contact", "tca_summary", "SUMMARY_KEYS",
+           "flank_coordinates", "SIDES", "Prepared", "prepare", "with_point_radius",
+           "pinion_outline", "reference_contact", "tca_summary", "SUMMARY_KEYS",
            "HypoidFamily", "SensedPair", "FAMILY", "ADAPTER"]
 
 
@@ -143,23 +141,6 @@ def reference_contact(pair: HypoidPair, mis: Misalignment, x_guess, phi1_guess):
     return jax.lax.stop_gradient(x_ref), s1.x[0], s1.converged
 
 
-class HypoidTCA(NamedTuple):
-    """Result of a hypoid/spiral-bevel TCA.
-
-    path : :class:`~gearjax.tca.path.ContactPath` of tooth pair 0 (TE in rad).
-    margin : (N,) boundary margin (mm, >= 0 on both working flanks).
-    multi : :class:`~gearjax.tca.path.MultiPair` (consecutive pairs, envelope, ptp,
-        transfer points, contact ratio).
-    coords : ``{xi1, h1, xi2, h2}`` face-width position (-1 toe .. +1 heel) and
-        height above the root cone (mm) of the contact on pinion (1) and gear (2).
-    """
-
-    path: ContactPath
-    margin: jax.Array
-    multi: MultiPair
-    coords: dict
-
-
 class Prepared(NamedTuple):
     """Concrete set-up of a pair for TCA (:func:`prepare`)."""
 
@@ -202,7 +183,7 @@ SUMMARY_KEYS = ("ptp_rad", "phi2_ref_rad", "xi1", "h1_mm", "xi2", "h2_mm", "semi
                 "path_angle_rad")
 
 
-def tca_summary(pair: HypoidPair, res: HypoidTCA):
+def tca_summary(pair: HypoidPair, res):
     """Scalar summary (traceable), in :data:`SUMMARY_KEYS` order.
 
     ptp_rad : peak-to-peak of the unloaded TE envelope over one pitch;
@@ -212,7 +193,8 @@ def tca_summary(pair: HypoidPair, res: HypoidTCA):
     semi_major_mm : contact-ellipse semi-major axis at the reference;
     path_angle_rad : direction of the path of contact on the pinion flank at the
     reference, ``atan2(dh1, (F1/2) dxi1)`` by central differences of the grid (0 =
-    lengthwise, pi/2 = along the profile).
+    lengthwise, pi/2 = along the profile).  ``res`` a :class:`~gearjax.TCAResult` of
+    ``pair`` (its path and face-width coordinates).
     """
     p, c = res.path, res.coords
     mid = p.phi1.shape[0] // 2
@@ -379,39 +361,3 @@ FAMILY = HypoidFamily()
 ADAPTER = DriverAdapter(FAMILY)
 for _t in (HypoidDesign, HypoidPair, Prepared):
     register_family(_t, ADAPTER)
-
-
-def hypoid_tca_traced(pair: HypoidPair, mis: Misalignment, x_ref, phi1_ref, *,
-                      steps_per_pitch: int = 16, half_pitches: float = 2.0,
-                      line_contact: bool = False, n_pairs: int = 5, drive=True,
-                      approach=DEFAULT_APPROACH, face_ends: bool = True) -> HypoidTCA:
-    """Traceable TCA of a flank pair by the one driver (:func:`gearjax.tca.family.tca_parts`;
-    see :class:`HypoidFamily`): ``x_ref, phi1_ref`` from :func:`prepare`, ``drive`` its
-    sense of rotation.  With ``face_ends`` (default) the contacts at the toe and heel,
-    the tip edges and their corners are solved too, and the contact made at each
-    pinion angle is the surface or an edge contact (``path.edge_kind``)."""
-    path, margin, multi, coords, _ = tca_parts(
-        FAMILY, SensedPair(pair, jnp.asarray(drive)), mis, x_ref, phi1_ref, jnp.asarray(True),
-        approach, steps_per_pitch=steps_per_pitch, half_pitches=half_pitches,
-        n_pairs=n_pairs, kinematics=False, face_ends=face_ends, line_contact=line_contact)
-    return HypoidTCA(path, margin, multi, coords)
-
-
-def hypoid_tca(pair: HypoidPair | Prepared, mis: Misalignment | None = None, *,
-               throw: bool = True, **options) -> HypoidTCA:
-    """Jitted TCA of a flank pair (``pair`` a :class:`HypoidPair`, prepared here, or a
-    :class:`Prepared`) without the kinematics, as a :class:`HypoidTCA`: the program of
-    :func:`gearjax.run_tca` (options and ``throw`` as there)."""
-    res = ADAPTER.run(pair, mis, throw=throw, **{**options, "kinematics": False})
-    return HypoidTCA(res.path, res.margin, res.multi, res.coords)
-
-
-def misalignment_sensitivity(prep: Prepared, mis: Misalignment | None = None, **options):
-    """The V-H check by ``jax.jacfwd``: derivatives of the :func:`tca_summary` values
-    (TE peak-to-peak, gear angle at the reference = TE shift, bearing position on
-    both flanks, ellipse length, path angle) with respect to dE, dP, dG (per mm) and
-    dSigma (per rad), exact through every contact solve (point contact):
-    :func:`gearjax.tca_sensitivity` of the prepared pair.  Returns ``(values, table)``:
-    dicts keyed by :data:`SUMMARY_KEYS`; ``table[key]`` is ``{"dE": .., "dP": ..,
-    "dG": .., "dSigma": ..}``."""
-    return ADAPTER.sensitivity(prep, mis, **options)

@@ -42,14 +42,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from functools import partial
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 
 from gearjax.errors import check_range, is_traced
-from gearjax.tca.family import DriverAdapter, GearFamily, sensitivity_table, tca_parts
+from gearjax.tca.family import DriverAdapter, GearFamily
 from gearjax.fields import float64_array
 from gearjax.gears.involute.geometry import (InvolutePair, generated_flank, pair_geometry,
                                              rack_family, rack_family_data, rack_psi0)
@@ -57,13 +56,13 @@ from gearjax.gears.involute.limits import involute_face_ends, involute_limits, i
 from gearjax.gears.involute.mesh import check_mesh_supported, involute_mesh_teeth
 from gearjax.loading.loaded_contact import TeethOf
 from gearjax.surfaces import GeneratedSurface
-from gearjax.tca.path import DEFAULT_APPROACH, ContactPath, MultiPair
-from gearjax.tca.assembly import Assembly, Misalignment
-from gearjax.tca.result import check_side, register_family, strong_float64
+from gearjax.tca.path import ContactPath, MultiPair
+from gearjax.tca.assembly import Assembly
+from gearjax.tca.result import register_family, strong_float64
 
 __all__ = ["InvoluteTCA", "InvoluteFamily", "FAMILY", "ADAPTER", "crowned_pinion_flank",
-           "involute_assembly", "involute_tca_traced", "tca_summary", "SUMMARY_KEYS",
-           "reference_guess", "misalignment_sensitivity", "overlap_ratio", "default_grid",
+           "involute_assembly", "tca_summary", "SUMMARY_KEYS", "reference_guess",
+           "overlap_ratio", "default_grid",
            "default_line_contact", "split_teeth", "join_teeth"]
 
 
@@ -377,58 +376,3 @@ class InvoluteFamily(GearFamily):
 FAMILY = InvoluteFamily()
 ADAPTER = DriverAdapter(FAMILY)
 register_family(InvoluteTCA, ADAPTER)
-
-
-def involute_tca_traced(des: InvoluteTCA, mis: Misalignment, *, side=-1.0,
-                        steps_per_pitch: int = 24, half_pitches: float = 1.25,
-                        line_contact: bool = True, n_pairs: int = 3,
-                        approach=DEFAULT_APPROACH, face_ends: bool = True):
-    """Traceable TCA ``(path, margin, multi)`` of side code ``side`` (-1 drive, +1 coast;
-    may be traced) by the one driver (:func:`gearjax.tca.family.tca_parts`): the grid of
-    pinion angles ``phi1_ref + k 2 pi/(z1 steps_per_pitch)``, ``|k| <= round(half_pitches
-    steps_per_pitch)``, centred on the nominal pitch-point contact; with ``face_ends``
-    the contacts of the face ends, tip edges and their corners are solved too, and the
-    contact made at each pinion angle is the surface or an edge contact
-    (:func:`gearjax.tca.edge_contact.face_end_contact`; ``path.edge_kind``)."""
-    path, margin, multi, _, _ = tca_parts(
-        FAMILY, des, mis, None, None, jnp.asarray(side) < 0, approach,
-        steps_per_pitch=steps_per_pitch, half_pitches=half_pitches, n_pairs=n_pairs,
-        kinematics=False, face_ends=face_ends, line_contact=line_contact)
-    return path, margin, multi
-
-
-@partial(jax.jit, static_argnames=("steps_per_pitch", "half_pitches", "line_contact", "n_pairs",
-                                   "face_ends"))
-def _sensitivity_program(blank, teeth, mis, drive, *, steps_per_pitch, half_pitches,
-                         line_contact, n_pairs, face_ends):
-    def f(d, m):
-        path, _, multi, _, _ = tca_parts(
-            FAMILY, join_teeth(d, teeth), m, None, None, drive, DEFAULT_APPROACH,
-            steps_per_pitch=steps_per_pitch, half_pitches=half_pitches, n_pairs=n_pairs,
-            kinematics=False, face_ends=face_ends, line_contact=line_contact)
-        return tca_summary(path, multi)
-    return f(blank, mis), jax.jacfwd(f, argnums=(0, 1))(blank, mis)
-
-
-def misalignment_sensitivity(des: InvoluteTCA, mis: Misalignment | None = None, *,
-                             side: str = "drive", **options):
-    """Sensitivity of the TCA summary to dE, dP, dG, dSigma *and the design* by
-    ``jax.jacfwd`` (exact, implicit-function-theorem derivatives through every solve).
-
-    Returns ``(values, table, design_jac)``: ``values`` a dict of :data:`SUMMARY_KEYS`
-    at ``mis``; ``table`` ``{key: {"dE": .., "dP": .., "dG": .., "dSigma": ..}}`` of
-    derivatives per mm (dE, dP, dG) and per rad (dSigma), in the key's unit (the
-    table of :func:`gearjax.tca_sensitivity`); ``design_jac`` an :class:`InvoluteTCA`
-    pytree whose leaves are the (7,) derivatives of the summary by that design field.
-    Options (grid, ``line_contact``) and their defaults as for :func:`gearjax.run_tca`.
-    """
-    side = check_side(side)
-    pair = strong_float64(des)
-    static = ADAPTER.resolve(pair, {**options, "kinematics": False})
-    static.pop("kinematics")
-    mis = Misalignment.zero() if mis is None else mis
-    vals, (jac_des, jac) = _sensitivity_program(*split_teeth(pair), strong_float64(mis),
-                                                jnp.asarray(side == "drive"), **static)
-    values, table = sensitivity_table(SUMMARY_KEYS, vals, jac)
-    jac_des = replace(jac_des, pair=replace(jac_des.pair, z1=des.pair.z1, z2=des.pair.z2))
-    return values, table, jac_des

@@ -30,16 +30,14 @@ from __future__ import annotations
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax.tca.family import DriverAdapter, GearFamily, result_traced
+from gearjax.tca.family import DriverAdapter, GearFamily
 from gearjax.gears.preset_bevel.geometry import PresetBevelDesign, cone_distances, pitch_angles
 from gearjax.gears.preset_bevel.pair import (drives_forward, preset_assembly, preset_face_ends,
                                              preset_margin, reference_contact, side_flanks)
 from gearjax.loading.loaded_contact import TeethOf
-from gearjax.tca.path import DEFAULT_APPROACH
-from gearjax.tca.assembly import Misalignment
 from gearjax.tca.result import TCAResult, register_family
 
-__all__ = ["PresetBevelFamily", "preset_result_traced", "preset_outline",
+__all__ = ["PresetBevelFamily", "preset_outline",
            "SUMMARY_KEYS", "preset_summary", "DEFAULTS", "ADAPTER"]
 
 #: default TCA grid of the family
@@ -133,16 +131,3 @@ ADAPTER = DriverAdapter(FAMILY)
 register_family(PresetBevelDesign, ADAPTER)
 
 
-def preset_result_traced(des: PresetBevelDesign, mis: Misalignment, x_ref, phi1_ref, *,
-                         side: str = "drive", steps_per_pitch: int = 24,
-                         half_pitches: float = 1.0, n_pairs: int = 3,
-                         approach=DEFAULT_APPROACH, kinematics: bool = True,
-                         face_ends: bool = True) -> TCAResult:
-    """Traceable TCA of ``side`` (the driver's :func:`~gearjax.tca.family.tca_parts` for this
-    family).  ``x_ref, phi1_ref`` from :func:`~gearjax.gears.preset_bevel.pair.
-    reference_contact` (concrete, fixed: the grid does not move with the design).
-    ``face_ends``: solve the edge contacts (default; ``False``: surface contact only,
-    ``path.edge_kind`` None)."""
-    return result_traced(FAMILY, des, mis, x_ref, phi1_ref, side, approach,
-                         steps_per_pitch=steps_per_pitch, half_pitches=half_pitches,
-                         n_pairs=n_pairs, kinematics=kinematics, face_ends=face_ends)
