@@ -150,11 +150,15 @@ def _enable_compilation_cache() -> None:
 #: waits for.  LLVM optimisation level 0 and XLA's older loop emitters halve it (cold
 #: ``gearjax tca`` of the 8/43 hypoid 30.0 -> 15.8 s, ``gearjax efficiency`` of a spur
 #: pair 26.3 -> 13.1 s on 2 cores) and about double the run time of the compiled
-#: programs (the bench TCA 32 -> 62 ms); results agree to round-off (the test suite
-#: runs with the same options).  ``GEARJAX_FAST_COMPILE=0`` keeps XLA's defaults (long
-#: runs); an option already in ``XLA_FLAGS`` is kept.
+#: programs (the bench TCA 32 -> 62 ms); one LLVM module instead of XLA's default split
+#: into parts (which at level 0 are compiled one after the other: the split only adds
+#: work) takes about 10 % more off (the spur pair's TCA program 9.1 -> 6.8 s of
+#: compilation).  Results agree to round-off (the test suite runs with the same
+#: options).  ``GEARJAX_FAST_COMPILE=0`` keeps XLA's defaults (long runs); an option
+#: already in ``XLA_FLAGS`` is kept.
 FAST_COMPILE_FLAGS = (("xla_backend_optimization_level", "0"),
-                      ("xla_cpu_use_fusion_emitters", "false"))
+                      ("xla_cpu_use_fusion_emitters", "false"),
+                      ("xla_cpu_parallel_codegen_split_count", "1"))
 
 
 def _fast_compile_flags() -> None:

@@ -29,9 +29,10 @@ def test_flags_added_for_a_cpu_run(env):
     env.setattr(cli, "_accelerator_plugin_installed", lambda: False)
     cli._fast_compile_flags()
     assert _flags().split() == ["--xla_backend_optimization_level=0",
-                                "--xla_cpu_use_fusion_emitters=false"]
+                                "--xla_cpu_use_fusion_emitters=false",
+                                "--xla_cpu_parallel_codegen_split_count=1"]
     cli._fast_compile_flags()                      # idempotent
-    assert len(_flags().split()) == 2
+    assert len(_flags().split()) == 3
 
 
 def test_a_users_choice_is_kept(env):
@@ -39,7 +40,8 @@ def test_a_users_choice_is_kept(env):
     env.setenv("XLA_FLAGS", "--xla_backend_optimization_level=3 --xla_dump_to=/x")
     cli._fast_compile_flags()
     assert _flags().split() == ["--xla_backend_optimization_level=3", "--xla_dump_to=/x",
-                                "--xla_cpu_use_fusion_emitters=false"]
+                                "--xla_cpu_use_fusion_emitters=false",
+                                "--xla_cpu_parallel_codegen_split_count=1"]
 
 
 @pytest.mark.parametrize("setting", [("GEARJAX_FAST_COMPILE", "0"),
