@@ -66,20 +66,25 @@ def test_tca_function_starts_the_path_at_the_reference_given(conj):
     """``gearjax.tca_function``'s ``f(pair, reference=(x_ref, phi1_ref))`` starts the
     contact path from that guess instead of the design's: in line contact the pinion
     blade position ``x_ref[1]`` is the contact line followed (it stays fixed), so a
-    reference at 60 % of the prepared one gives the TCA of the prepared pair whose
-    guess is there, bit-identical (the same compiled program), and not the default's."""
+    reference at 60 % of the prepared one, its grid centred a third of a grid step
+    later, gives the TCA of the prepared pair whose guess is there, bit-identical (the
+    same compiled program), and not the default's."""
     _, prep, out0 = conj
     x_ref = np.array(prep.x_ref, float)
     x_ref[1] *= 0.6
+    phi1_ref = prep.phi1_ref + (2.0 * np.pi / (prep.pair.z1 * 8)) / 3.0
     opts = dict(line_contact=True, steps_per_pitch=8, half_pitches=1.0, n_pairs=3,
                 kinematics=False)
-    ref = gj.run_tca(prep._replace(x_ref=x_ref), throw=False, **opts)
+    ref = gj.run_tca(prep._replace(x_ref=x_ref, phi1_ref=phi1_ref), throw=False, **opts)
     f = gj.tca_function(prep, **opts)
-    got = f(f.pair, reference=(jnp.asarray(x_ref), jnp.asarray(prep.phi1_ref)))
-    for name in ("uv1", "uv2", "phi2", "te", "converged"):
+    got = f(f.pair, reference=(jnp.asarray(x_ref), jnp.asarray(phi1_ref)))
+    for name in ("phi1", "uv1", "uv2", "phi2", "te", "converged"):
         np.testing.assert_array_equal(np.asarray(getattr(got.path, name)),
                                       np.asarray(getattr(ref.path, name)), err_msg=name)
+    assert np.asarray(got.path.converged).all()
     np.testing.assert_array_equal(np.asarray(got.path.uv1)[:, 1], x_ref[1])
+    mid = got.path.phi1.shape[0] // 2
+    assert float(got.path.phi1[mid]) == pytest.approx(phi1_ref, abs=1e-15)
     np.testing.assert_array_equal(np.asarray(out0.path.uv1)[:, 1], prep.x_ref[1])
     default = f(f.pair)
     np.testing.assert_array_equal(np.asarray(default.path.uv1), np.asarray(out0.path.uv1))
