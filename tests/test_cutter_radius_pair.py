@@ -72,7 +72,7 @@ def test_tca_function_starts_the_path_at_the_reference_given(conj):
     _, prep, out0 = conj
     x_ref = np.array(prep.x_ref, float)
     x_ref[1] *= 0.6
-    phi1_ref = prep.phi1_ref + (2.0 * np.pi / (prep.pair.z1 * 8)) / 3.0
+    phi1_ref = float(prep.phi1_ref + (2.0 * np.pi / (prep.pair.z1 * 8)) / 3.0)
     opts = dict(line_contact=True, steps_per_pitch=8, half_pitches=1.0, n_pairs=3,
                 kinematics=False)
     ref = gj.run_tca(prep._replace(x_ref=x_ref, phi1_ref=phi1_ref), throw=False, **opts)
