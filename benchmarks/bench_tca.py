@@ -164,7 +164,7 @@ def main():
     t0 = time.perf_counter()
     path, margin, multi = involute_tca(des, mis)
     t_first = time.perf_counter() - t0
-    t_fwd = _best(lambda: involute_tca(des, mis, throw=False))
+    t_fwd = _best(lambda: involute_tca(des, mis, throw=False), repeat=20)
 
     # SciPy: same equations, jitted residual and Jacobian, one fsolve per position,
     # previous solution as the start, from the reference outwards
@@ -193,13 +193,13 @@ def main():
                 out[i] = xp
         return out
 
-    t_scipy = _best(scipy_run, repeat=2)
+    t_scipy = _best(scipy_run, repeat=5)
     X = scipy_run()
     dphi2 = np.max(np.abs(X[:, 4] - np.asarray(path.phi2)))
 
     # the surface contact alone in gearjax (the work of the SciPy surface loop)
     t_surf = _best(lambda: gj.run_tca(des, mis, kinematics=False, face_ends=False,
-                                      throw=False).path.te)
+                                      throw=False).path.te, repeat=20)
     # the edge candidates by SciPy, checked against gearjax's on the same surface path
     F_e, cs_e, fns, asm, surf, edges = edge_setup(des, mis, 24)
     scipy_edge_loop(F_e, cs_e, fns, surf)                 # compiles F and J
@@ -228,7 +228,7 @@ def main():
     t0 = time.perf_counter()
     jax.block_until_ready(grad(des, mis))
     t_grad_first = time.perf_counter() - t0
-    t_grad = _best(lambda: grad(des, mis), repeat=3)
+    t_grad = _best(lambda: grad(des, mis), repeat=10)
 
     print(f"{'task':58s} {'time':>10s}")
     lab0 = 'gearjax TCA, 61 positions x 3 pairs'

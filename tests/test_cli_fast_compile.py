@@ -90,3 +90,17 @@ def test_importing_gearjax_does_not_start_the_backend(tmp_path):
     env = {k: v for k, v in os.environ.items() if k != "XLA_FLAGS"}
     subprocess.run([sys.executable, "-c", code], check=True, env=env, timeout=120)
     assert dump.is_dir() and any(dump.iterdir())
+
+
+def test_only_a_real_command_line_run_sets_the_flags(env, monkeypatch, capsys):
+    """``main(argv)`` called in-process (a notebook, a test, another program) leaves
+    the caller's ``XLA_FLAGS`` alone; ``main()`` -- the console command, arguments from
+    ``sys.argv`` -- adds the options."""
+    env.setattr(cli, "_accelerator_plugin_installed", lambda: False)
+    env.setenv("GEARJAX_CACHE_DIR", "off")
+    assert cli.main(["example", "list"]) == 0
+    assert _flags() == ""
+    monkeypatch.setattr(sys, "argv", ["gearjax", "example", "list"])
+    assert cli.main() == 0
+    assert "--xla_cpu_parallel_codegen_split_count=1" in _flags()
+    capsys.readouterr()

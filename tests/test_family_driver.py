@@ -183,6 +183,22 @@ def test_toy_family_options_sensitivity_and_gradient():
     assert abs(float(g)) > 1e-4
 
 
+def test_an_option_given_as_none_takes_the_family_default(toy_runs):
+    """Every TCA option given as None means the family's default (what a command line
+    or a study file passes for an option it leaves out): the same static options and the
+    same result, bit-identical, as the run without them (its compiled program)."""
+    des = _toy(18, 31)
+    names = ("steps_per_pitch", "half_pitches", "n_pairs", "line_contact", "approach",
+             "face_ends", "kinematics")
+    assert TOY.resolve(des, dict.fromkeys(names)) == TOY.resolve(des, {})
+    res = gj.run_tca(des, side="drive", **dict.fromkeys(names))
+    ref = toy_runs[(18, 31, "drive")]
+    for name in ("phi1", "phi2", "te", "converged"):
+        np.testing.assert_array_equal(np.asarray(getattr(res.path, name)),
+                                      np.asarray(getattr(ref.path, name)), err_msg=name)
+    assert res.kinematics is not None
+
+
 def test_driver_strict_default_and_masks():
     """``throw`` defaults to True in the driver's ``run``: a pair with no grid point on
     both flanks (here a negative face width: every face margin < 0) is a
