@@ -5,7 +5,9 @@ Solves ``F(x, theta) = 0`` for ``x`` (a scalar or a 1-D array) given parameters
 Each iteration takes the full Newton step ``dx = -J^{-1} F`` and backtracks
 (halving, Armijo condition on ``max|F|``) when the step does not reduce the residual;
 with ``natural_monotonicity=True`` a step is also accepted when it passes Deuflhard's
-natural monotonicity test (the simplified Newton correction shrinks).
+natural monotonicity test (the simplified Newton correction shrinks); with
+``noise_floor=True`` the confirming step of a converged iterate is taken without a
+line search.
 
 Derivatives of the solution with respect to ``theta`` are **not** obtained by
 differentiating through the iterations.  The solution map carries a
@@ -83,8 +85,11 @@ def _lin_solve(J, b):
     return jnp.linalg.solve(J, b)
 
 
-def _loop(F, tol, xtol, max_steps, max_halvings, natural, x0, theta):
-    """Damped Newton iterations on the flattened unknown."""
+def _loop(F, tol, xtol, max_steps, max_halvings, ls, x0, theta):
+    """Damped Newton iterations on the flattened unknown; ``ls = (natural, floor)`` the
+    line-search options of :func:`newton_solve` (``natural_monotonicity``,
+    ``noise_floor``)."""
+    natural, floor = ls
     shape = jnp.shape(x0)
 
     def f(x):
@@ -112,13 +117,17 @@ def _loop(F, tol, xtol, max_steps, max_halvings, natural, x0, theta):
         # appears once in the line search, not twice (half the program to trace and
         # compile for an ``F`` that itself contains solves)
         dx_norm = jnp.linalg.norm(dx)
+        # at the noise floor (converged, and the full step below xtol) the step is taken
+        # as it is: halving a step of round-off size finds no decrease to test for
+        at_floor = floor & (res <= tol) & (
+            jnp.max(jnp.abs(dx)) <= xtol * (1.0 + jnp.max(jnp.abs(x))))
 
         def ls_cond(s):
             alpha, xn, fn, rn, theta_n, i = s
             good = rn <= (1.0 - 1e-4 * alpha) * res
             if natural:
                 good = good | (theta_n <= (1.0 - 0.25 * alpha) * dx_norm)
-            return (i < 0) | ((i < max_halvings) & jnp.logical_not(good))
+            return (i < 0) | ((i < max_halvings) & jnp.logical_not(good | at_floor))
 
         def ls_body(s):
             alpha, _, _, _, _, i = s
@@ -155,15 +164,14 @@ def _loop(F, tol, xtol, max_steps, max_halvings, natural, x0, theta):
 
 
 @partial(jax.custom_jvp, nondiff_argnums=(0, 1, 2, 3, 4, 5))
-def _solve(F, tol, xtol, max_steps, max_halvings, natural, x0, theta):
-    return _loop(F, tol, xtol, max_steps, max_halvings, natural, jax.lax.stop_gradient(x0),
-                 theta)
+def _solve(F, tol, xtol, max_steps, max_halvings, ls, x0, theta):
+    return _loop(F, tol, xtol, max_steps, max_halvings, ls, jax.lax.stop_gradient(x0), theta)
 
 
-def _solve_jvp(F, tol, xtol, max_steps, max_halvings, natural, primals, tangents):
+def _solve_jvp(F, tol, xtol, max_steps, max_halvings, ls, primals, tangents):
     x0, theta = primals
     _, theta_dot = tangents
-    out = _solve(F, tol, xtol, max_steps, max_halvings, natural, x0, theta)
+    out = _solve(F, tol, xtol, max_steps, max_halvings, ls, x0, theta)
     xs = out[0]
     shape = jnp.shape(xs)
 
@@ -199,7 +207,7 @@ _solve.defjvp(_solve_jvp, symbolic_zeros=True)
 
 def newton_solve(F: Callable, x0, theta=(), *, tol: float = 1e-10, xtol: float = 1e-12,
                  max_steps: int = 50, max_halvings: int = 12,
-                 natural_monotonicity: bool = False) -> NewtonResult:
+                 natural_monotonicity: bool = False, noise_floor: bool = False) -> NewtonResult:
     """Solve the square system ``F(x, theta) = 0`` by damped Newton iterations.
 
     Parameters
@@ -220,6 +228,13 @@ def newton_solve(F: Callable, x0, theta=(), *, tol: float = 1e-10, xtol: float =
         contact), where the full Newton step is right but raises the residual of one
         equation and the residual test would damp the iteration to a crawl.
         Reference: [Deuflhard2004] §3.3.
+    noise_floor : take the full step without a line search where the iterate has
+        converged (``max|F| <= tol``) and the step is below ``xtol`` -- the last,
+        confirming iteration.  Its step is of round-off size, so no decrease can be
+        tested: the line search would halve it ``max_halvings`` times and, under
+        ``vmap``, hold every lane of the batch that long.  The root moves by round-off
+        only (the TCA's continuations use it: contacts equal to 4e-13 mm and TE to
+        3e-10 arcsec with and without, docs/tca.md "Cost").
 
     Returns
     -------
@@ -235,7 +250,7 @@ def newton_solve(F: Callable, x0, theta=(), *, tol: float = 1e-10, xtol: float =
         # the options: a module-level ``F`` is traced and compiled once per process
         # instead of at every call (an eager ``while_loop`` compiles its loop anew)
         return _newton_jit(F, float(tol), float(xtol), int(max_steps), int(max_halvings),
-                           bool(natural_monotonicity), x0, theta)
+                           (bool(natural_monotonicity), bool(noise_floor)), x0, theta)
     converted, consts = jax.closure_convert(lambda x, th: F(x, th), x0, theta)
 
     def F_all(x, th_all):
@@ -243,7 +258,8 @@ def newton_solve(F: Callable, x0, theta=(), *, tol: float = 1e-10, xtol: float =
         return converted(x, th, *cs)
 
     x, res, steps, conv = _solve(F_all, float(tol), float(xtol), int(max_steps),
-                                 int(max_halvings), bool(natural_monotonicity), x0,
+                                 int(max_halvings), (bool(natural_monotonicity),
+                                                     bool(noise_floor)), x0,
                                  (theta, tuple(consts)))
     return NewtonResult(x, res, steps, conv)
 
@@ -284,9 +300,10 @@ def _eager(F, x0, theta) -> bool:
 
 
 @partial(jax.jit, static_argnums=(0, 1, 2, 3, 4, 5))
-def _newton_jit(F, tol, xtol, max_steps, max_halvings, natural, x0, theta):
+def _newton_jit(F, tol, xtol, max_steps, max_halvings, ls, x0, theta):
     return newton_solve(F, x0, theta, tol=tol, xtol=xtol, max_steps=max_steps,
-                        max_halvings=max_halvings, natural_monotonicity=natural)
+                        max_halvings=max_halvings, natural_monotonicity=ls[0],
+                        noise_floor=ls[1])
 
 
 # ----------------------------------------------------------------------------

@@ -291,7 +291,8 @@ def _continue(F, z0, thetas, fresh, restart, n_homotopy, tol, max_steps, give_up
         dead = give_up & ((fails >= CORNER_GIVE_UP) | ((i >= n_homotopy) & ~ok_h))
 
         sol = newton_solve(_give_up_system(F), pred, (theta, jax.lax.stop_gradient(pred), dead),
-                           tol=tol, max_steps=max_steps, natural_monotonicity=True)
+                           tol=tol, max_steps=max_steps, natural_monotonicity=True,
+                           noise_floor=True)
         ok = sol.converged & ~dead
         ok_h = jnp.where(i == n_homotopy - 1, ok, ok_h)
         sol = sol._replace(converged=ok & ((i < n_homotopy) | ok_h))

@@ -234,7 +234,7 @@ def solve_grid(F, x_prev, x_prev2, phis, tol, max_steps):
         x_prev, x_prev2 = carry
         pred = jax.lax.stop_gradient(2.0 * x_prev - x_prev2)
         sol = newton_solve(F, pred, phi, tol=tol, max_steps=max_steps,
-                           natural_monotonicity=True)
+                           natural_monotonicity=True, noise_floor=True)
         ok = sol.converged
         return (jnp.where(ok, sol.x, x_prev), x_prev), sol
 
