@@ -153,3 +153,36 @@ def test_natural_monotonicity_accepts_the_full_step_the_residual_test_damps():
     # the implicit derivative does not depend on the globalisation: dx/dK = 0 here
     g = jax.grad(lambda k: newton_solve(_badly_scaled, x0, k, natural_monotonicity=True).x[0])(K)
     assert abs(float(g)) < 1e-12
+
+
+def test_noise_floor_takes_the_confirming_step_as_it_is():
+    """``noise_floor``: the confirming iteration of a converged solve (max|F| <= tol,
+    full step below xtol) takes its round-off step without the line search, which would
+    halve it up to ``max_halvings`` times (no decrease can show at the noise floor) and,
+    under ``vmap``, hold the whole batch that long.  A system with a term that is zero in
+    exact arithmetic and round-off noise in floating point, 8 lanes: the same Newton
+    steps per lane and the same roots (to the noise), fewer evaluations of F by the
+    batch (counted as the program runs; 131 -> 115 measured)."""
+    calls = []
+
+    def F(x, th):
+        jax.debug.callback(lambda: calls.append(1))
+        noise = 1e3 * ((x[0] + 1e-3) ** 2 - x[0] ** 2 - 2e-3 * x[0] - 1e-6)
+        return jnp.stack([x[0] ** 2 + x[1] ** 2 - 10.0 * th[0] + noise,
+                          jnp.cos(x[0]) - x[1] * th[1]])
+
+    ths = jnp.stack([jnp.linspace(1.0, 1.6, 8), jnp.linspace(0.5, 0.9, 8)], axis=1)
+    out = {}
+    for floor in (False, True):
+        calls.clear()
+        r = jax.jit(jax.vmap(lambda t, floor=floor: newton_solve(
+            F, jnp.array([1.0, 1.0]), t, tol=1e-10, natural_monotonicity=True,
+            noise_floor=floor)))(ths)
+        jax.block_until_ready(r.x)
+        jax.effects_barrier()
+        out[floor] = (r, len(calls))
+    (r0, n0), (r1, n1) = out[False], out[True]
+    assert bool(jnp.all(r0.converged)) and bool(jnp.all(r1.converged))
+    np.testing.assert_array_equal(np.asarray(r1.steps), np.asarray(r0.steps))
+    np.testing.assert_allclose(np.asarray(r1.x), np.asarray(r0.x), rtol=1e-10)
+    assert n1 < n0, (n1, n0)
