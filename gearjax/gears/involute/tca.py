@@ -62,8 +62,8 @@ from gearjax.tca.result import register_family, strong_float64
 
 __all__ = ["InvoluteTCA", "InvoluteFamily", "FAMILY", "ADAPTER", "crowned_pinion_flank",
            "involute_assembly", "tca_summary", "SUMMARY_KEYS", "reference_guess",
-           "overlap_ratio", "default_grid",
-           "default_line_contact", "split_teeth", "join_teeth"]
+           "overlap_ratio", "default_grid", "default_line_contact", "split_teeth",
+           "join_teeth"]
 
 
 @jax.tree_util.register_dataclass

@@ -37,8 +37,8 @@ from gearjax.gears.preset_bevel.pair import (drives_forward, preset_assembly, pr
 from gearjax.loading.loaded_contact import TeethOf
 from gearjax.tca.result import TCAResult, register_family
 
-__all__ = ["PresetBevelFamily", "preset_outline",
-           "SUMMARY_KEYS", "preset_summary", "DEFAULTS", "ADAPTER"]
+__all__ = ["PresetBevelFamily", "preset_outline", "SUMMARY_KEYS", "preset_summary", "DEFAULTS",
+           "ADAPTER"]
 
 #: default TCA grid of the family
 DEFAULTS = dict(steps_per_pitch=24, half_pitches=1.0, n_pairs=3)
@@ -129,5 +129,3 @@ class PresetBevelFamily(GearFamily):
 FAMILY = PresetBevelFamily()
 ADAPTER = DriverAdapter(FAMILY)
 register_family(PresetBevelDesign, ADAPTER)
-
-
