@@ -146,8 +146,9 @@ def efficiency_warnings(eff, res: TCAResult, *, film_method: str = "auto",
                         viscosity_model: str = "roelands") -> list[str]:
     """One line per problem of a concrete result (``eff`` a
     :class:`~gearjax.loading.mesh_efficiency.MeshEfficiency`, ``res`` its TCA): TCA
-    quality flags, load balance or friction solves not converged, grid too short, loaded edge contact, implausible
-    results (:func:`plausibility`: one line per failed check with the worst value), a
+    quality flags, load balance or friction solves not converged, grid too short,
+    loaded edge contact, implausible results (:func:`plausibility`: one line per
+    failed check with the worst value), a
     film below :data:`FILM_MIN_MM`, the film formula outside its fitted ellipticity
     range and the viscosity law above 3 GPa (``film_method``, ``viscosity_model`` as
     given to the friction model)."""

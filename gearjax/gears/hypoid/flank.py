@@ -66,7 +66,8 @@ from gearjax.io import FlankGrid  # noqa: F401  (the shared export grid; exporte
 from gearjax.newton import newton_solve
 
 __all__ = ["MemberBlank", "FlankSpec", "FlankGrid", "program_pair", "make_member_blank",
-           "mean_cone_distance", "face_apex_offset", "root_apex_offset", "axial_coords", "pitch_distance", "xi_of",
+           "mean_cone_distance", "face_apex_offset", "root_apex_offset", "axial_coords",
+           "pitch_distance", "xi_of",
            "face_cone_gap", "root_cone_gap", "work_point", "meshing_function", "mid_estimate",
            "solve_tip", "solve_point", "flank_points", "flank_surface", "spiral_angle_at",
            "MachineChain", "machine_chain", "chain_point", "chain_normal", "body_family",
