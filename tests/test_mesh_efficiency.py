@@ -82,6 +82,24 @@ def test_one_loaded_program_for_every_tooth_pair(spur, oil_surface, weber_run):
                                rtol=1e-9)
 
 
+def test_the_loads_program_compiles_beside_the_tca(spur, oil_surface, weber_run, monkeypatch):
+    """``mesh_efficiency`` offers its loads' program to the compilation of the TCA's two
+    programs (gearjax/compile_ahead.py), after them, on the abstract TCA result: the
+    first call compiles all three side by side.  Planted bug caught: ``also`` dropped (the
+    loads' program compiled alone after the TCA's, ~2 s more on a first call)."""
+    import gearjax.compile_ahead as ca
+    submitted = []
+    orig = ca.CompileAhead.submit
+
+    def spy(self, fun, *args, **static):
+        submitted.append(getattr(fun, "__name__", repr(fun)))
+        return orig(self, fun, *args, **static)
+    monkeypatch.setattr(ca.CompileAhead, "submit", spy)
+    eff, _ = mesh_efficiency(spur[1], TORQUE, RPM, *oil_surface, compliance="weber")
+    assert submitted == ["_surface_program", "_finish_program", "_post_jit"], submitted
+    assert float(eff.mean_efficiency) == float(weber_run[0].mean_efficiency)
+
+
 def test_textbook_load_sharing_and_balance(spur, iso_run):
     eff, res = iso_run
     geo = pair_geometry(spur[0])

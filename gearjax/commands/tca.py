@@ -266,10 +266,11 @@ def run(args) -> int:
         print(f"# TE p-t-p {out['ptp_arcsec']:.4f} arcsec, contact ratio {out['contact_ratio']:.4f}")
         print(f"{'phi1[deg]':>10s} {'TE[arcsec]':>11s} {'axial1':>9s} {'radius1':>9s} "
               f"{'2a[mm]':>8s} {'2b[mm]':>8s} flag")
-        for i in range(len(path.phi1)):
+        phi1 = np.asarray(path.phi1)
+        for i in range(len(phi1)):
             flag = ("ok" if on[i] else "edge" if edge[i] else "off" if conv[i]
                     else "no-conv")
-            print(f"{math.degrees(float(path.phi1[i])):10.4f} {_cell(te[i], 11, 5)} "
+            print(f"{math.degrees(float(phi1[i])):10.4f} {_cell(te[i], 11, 5)} "
                   f"{_cell(ax[i], 9, 4)} {_cell(rad[i], 9, 4)} "
                   f"{_cell(2 * sm[i], 8, 4)} {_cell(2 * sn[i], 8, 4)} {flag}")
     for sd, msg in failed.items():

@@ -440,17 +440,20 @@ def mesh_efficiency(design, torque_Nm, pinion_rpm, oil: Oil, surface: Surface, *
     opts = _grid_options(ad, design, tca_options)
     kw = {} if side is None else {"side": side}
     teeth_of, pair, run_design = ad.mesh(design, **kw, **opts)
-    res = ad.run(run_design, misalignment, **kw, **opts, kinematics=True, throw=throw)
     oil = dataclasses.replace(oil, name="")
     # a family whose pair has static fields that only enter arithmetic (the tooth
     # numbers of an involute pair) passes them traced: one program for every pair
     blank, extra = ad.split_pair(pair)
-    join = ad.join_pair
-    eff = _post_jit(res, blank, extra, jnp.asarray(T, float), jnp.asarray(n, float), oil,
-                    surface, jnp.asarray(Ep, float), jnp.asarray(nu, float), teeth_of=teeth_of,
-                    join=join, steps_per_pitch=int(opts["steps_per_pitch"]),
-                    n_pairs=int(opts["n_pairs"]), compliance=compliance,
-                    viscosity_model=viscosity_model, film_method=film_method)
+    args = (blank, extra, jnp.asarray(T, float), jnp.asarray(n, float), oil, surface,
+            jnp.asarray(Ep, float), jnp.asarray(nu, float))
+    static = dict(teeth_of=teeth_of, join=ad.join_pair,
+                  steps_per_pitch=int(opts["steps_per_pitch"]), n_pairs=int(opts["n_pairs"]),
+                  compliance=compliance, viscosity_model=viscosity_model,
+                  film_method=film_method)
+    # the loads' program compiles beside the TCA's (gearjax/compile_ahead.py)
+    res = ad.run(run_design, misalignment, **kw, **opts, kinematics=True, throw=throw,
+                 also=lambda ahead, r: ahead.submit(_post_jit, r, *args, **static))
+    eff = _post_jit(res, *args, **static)
     return eff, res
 
 

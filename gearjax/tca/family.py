@@ -6,9 +6,12 @@ says *how* a TCA is run, once for every family: the grid of pinion angles, the
 continued contact solve (:func:`gearjax.tca.path.contact_path`), the edge contacts
 (:func:`gearjax.tca.edge_contact.face_end_contact`), the consecutive tooth pairs and the
 TE envelope (:func:`gearjax.tca.multi_pair.multi_pair`), the rolling/sliding kinematics
-(:func:`gearjax.tca.result.contact_kinematics`) and the :class:`TCAResult`.  One
-compiled program per family class and static option set serves both sides and every
-design of the family (the family object is a static argument; the pair a pytree).
+(:func:`gearjax.tca.result.contact_kinematics`) and the :class:`TCAResult`.  A
+concrete TCA runs as two compiled programs -- :func:`tca_surface` (reference, grid,
+surface contact, margins) and :func:`tca_finish` (edge contacts, tooth pairs,
+kinematics) -- compiled side by side (:mod:`gearjax.compile_ahead`); the pair of them
+per family class and static option set serves both sides and every design of the
+family (the family object is a static argument; the pair a pytree).
 
 **Side convention** (the same in every ported family): the user names a side
 ``"drive"`` or ``"coast"``; inside a program it is the traced boolean ``drive`` (True
@@ -39,6 +42,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from gearjax.compile_ahead import CompileAhead
 from gearjax.tca.edge_contact import face_end_contact
 from gearjax.tca.multi_pair import multi_pair
 from gearjax.tca.path import (DEFAULT_APPROACH, check_on_flank_converged, check_tca_options,
@@ -46,7 +50,8 @@ from gearjax.tca.path import (DEFAULT_APPROACH, check_on_flank_converged, check_
 from gearjax.tca.assembly import Misalignment
 from gearjax.tca.result import TCAResult, check_side, contact_kinematics, strong_float64
 
-__all__ = ["GearFamily", "DriverAdapter", "tca_parts", "sensitivity_table", "OPTION_NAMES"]
+__all__ = ["GearFamily", "DriverAdapter", "tca_parts", "tca_surface", "tca_finish",
+           "sensitivity_table", "OPTION_NAMES"]
 
 #: the TCA options every family accepts (``line_contact`` only where supported)
 OPTION_NAMES = ("steps_per_pitch", "half_pitches", "n_pairs", "approach", "kinematics",
@@ -208,20 +213,44 @@ def tca_parts(fam: GearFamily, pair, mis, x_ref, phi1_ref, drive, approach, *,
     contact; pair 0 shifted by whole pitches gives the neighbouring pairs and the TE
     envelope (max where :meth:`GearFamily.forward`, else min).  ``x_ref = None``: the
     family's :meth:`GearFamily.reference_traced` inside the program; the reference is
-    then refined by :meth:`GearFamily.refine_reference` before the grid is laid."""
+    then refined by :meth:`GearFamily.refine_reference` before the grid is laid.
+    The two stages :func:`tca_surface` and :func:`tca_finish`."""
+    surface = tca_surface(fam, pair, mis, x_ref, phi1_ref, drive, approach,
+                          steps_per_pitch=steps_per_pitch, half_pitches=half_pitches,
+                          line_contact=line_contact)
+    return tca_finish(fam, pair, mis, drive, surface, steps_per_pitch=steps_per_pitch,
+                      n_pairs=n_pairs, kinematics=kinematics, face_ends=face_ends,
+                      line_contact=line_contact)
+
+
+def tca_surface(fam: GearFamily, pair, mis, x_ref, phi1_ref, drive, approach, *,
+                steps_per_pitch: int, half_pitches: float, line_contact: bool = False):
+    """First stage of :func:`tca_parts`: the reference contact, the grid and the
+    surface contact continued over it, its flank margins; ``(path, margin, coords)``."""
     ok = None
     if x_ref is None:
         x_ref, phi1_ref, ok = fam.reference_traced(pair, drive, line_contact)
     r1, r2 = fam.flanks(pair, drive, line_contact)
     x_ref, phi1_ref = fam.refine_reference(pair, mis, r1, r2, x_ref, phi1_ref, line_contact)
     grid = pinion_angle_grid(phi1_ref, fam.pinion_teeth(pair), steps_per_pitch, half_pitches)
-    asm = fam.assembly(pair)
-    fwd = fam.forward(pair, drive)
-    path = contact_path(r1, r2, asm, mis, grid, x_ref, line_contact=line_contact,
-                        approach=approach)
+    path = contact_path(r1, r2, fam.assembly(pair), mis, grid, x_ref,
+                        line_contact=line_contact, approach=approach)
     if ok is not None:
         path = path._replace(converged=path.converged & ok)
     margin, coords = fam.boundaries(pair, path)
+    return path, margin, coords
+
+
+def tca_finish(fam: GearFamily, pair, mis, drive, surface, *, steps_per_pitch: int,
+               n_pairs: int, kinematics: bool, face_ends: bool = True,
+               line_contact: bool = False):
+    """Second stage of :func:`tca_parts` from the first's ``surface = (path, margin,
+    coords)``: the edge contacts, the tooth pairs and the kinematics; ``(path, margin,
+    multi, coords, kinematics)``."""
+    path, margin, coords = surface
+    r1, r2 = fam.flanks(pair, drive, line_contact)
+    asm = fam.assembly(pair)
+    fwd = fam.forward(pair, drive)
     edges = fam.edges(pair) if face_ends else None
     if edges is not None:
         parts, g1, g2, tips = edges
@@ -241,17 +270,42 @@ def tca_parts(fam: GearFamily, pair, mis, x_ref, phi1_ref, drive, approach, *,
 
 _STATIC = ("fam", "steps_per_pitch", "half_pitches", "n_pairs", "kinematics", "face_ends",
            "line_contact")
+_SURFACE_STATIC = ("fam", "steps_per_pitch", "half_pitches", "line_contact")
+_FINISH_STATIC = ("fam", "steps_per_pitch", "n_pairs", "kinematics", "face_ends",
+                  "line_contact")
 
 
-@functools.partial(jax.jit, static_argnames=_STATIC)
-def _program(blank, extra, mis, x_ref, phi1_ref, approach, drive, *, fam, **static):
-    return tca_parts(fam, fam.join(blank, extra), mis, x_ref, phi1_ref, drive, approach,
-                     **static)
+# A concrete TCA runs as two programs, so that the second compiles while the first
+# is traced and both compile at once (gearjax/compile_ahead.py).
+@functools.partial(jax.jit, static_argnames=_SURFACE_STATIC)
+def _surface_program(blank, extra, mis, x_ref, phi1_ref, approach, drive, *, fam, **static):
+    return tca_surface(fam, fam.join(blank, extra), mis, x_ref, phi1_ref, drive, approach,
+                       **static)
 
 
-def _result(fam, pair, mis, x_ref, phi1_ref, approach, side, static) -> TCAResult:
-    parts = _program(*fam.split(strong_float64(pair)), strong_float64(mis), x_ref, phi1_ref,
-                     approach, jnp.asarray(side == "drive"), fam=fam, **static)
+@functools.partial(jax.jit, static_argnames=_FINISH_STATIC)
+def _finish_program(blank, extra, mis, drive, surface, *, fam, **static):
+    return tca_finish(fam, fam.join(blank, extra), mis, drive, surface, **static)
+
+
+def _result(fam, pair, mis, x_ref, phi1_ref, approach, side, static, also=None) -> TCAResult:
+    """The TCA by the two programs.  Concrete inputs: both compiled ahead side by side
+    (with whatever ``also(ahead, abstract_result)`` submits to the same
+    :class:`~gearjax.compile_ahead.CompileAhead`, e.g. the efficiency program)."""
+    blank, extra = fam.split(strong_float64(pair))
+    mis, drive = strong_float64(mis), jnp.asarray(side == "drive")
+    s1 = {k: static[k] for k in _SURFACE_STATIC[1:]}
+    s2 = {k: static[k] for k in _FINISH_STATIC[1:]}
+    a1 = (blank, extra, mis, x_ref, phi1_ref, approach, drive)
+    with CompileAhead() as ahead:
+        surface = ahead.submit(_surface_program, *a1, fam=fam, **s1)
+        if surface is not None:
+            parts = ahead.submit(_finish_program, blank, extra, mis, drive, surface, fam=fam,
+                                 **s2)
+            if also is not None:
+                also(ahead, TCAResult(*parts, side, fam.name))
+    surface = _surface_program(*a1, fam=fam, **s1)
+    parts = _finish_program(blank, extra, mis, drive, surface, fam=fam, **s2)
     return TCAResult(*parts, side, fam.name)
 
 
@@ -324,17 +378,19 @@ class DriverAdapter:
         """``(setup, side)`` of :meth:`GearFamily.setup` (``side`` checked first)."""
         return self.fam.setup(design, None if side is None else check_side(side))
 
-    def run(self, design, mis=None, *, side=None, **options) -> TCAResult:
+    def run(self, design, mis=None, *, side=None, also=None, **options) -> TCAResult:
         """Validated, jitted TCA; ``throw`` (default True) raises
         :class:`~gearjax.errors.ConvergenceError` (``NoContactError``) when a solve
-        failed on the working flank or no grid point is on both flanks."""
+        failed on the working flank or no grid point is on both flanks.  ``also(ahead,
+        abstract_result)``: submits the programs that will run on the result to the
+        :class:`~gearjax.compile_ahead.CompileAhead` that compiles the TCA's."""
         throw = options.get("throw", True)
         setup, side = self._setup(design, side)
         approach, static = self.options(options, setup, run=True)
         mis = Misalignment.zero() if mis is None else mis
         x_ref, phi1_ref = self._reference(setup, side)
         pair = self.fam.program_pair(self.fam.user_pair(setup), setup)
-        res = _result(self.fam, pair, mis, x_ref, phi1_ref, approach, side, static)
+        res = _result(self.fam, pair, mis, x_ref, phi1_ref, approach, side, static, also)
         if throw:
             check_on_flank_converged(res.path, res.margin)
         return res

@@ -507,20 +507,19 @@ def require_path(path: ContactPath, what: str = "tooth contact analysis") -> Non
 def check_on_flank_converged(path: ContactPath, margin) -> None:
     """Raise ConvergenceError if a solve failed between on-flank points, and
     :class:`~gearjax.tca.path.NoContactError` if no grid point is on both flanks (concrete)."""
-    conv = np.asarray(path.converged)
+    conv, res = np.asarray(path.converged), np.asarray(path.residual)   # host arrays
     inside = np.asarray(margin) >= 0.0
     mid = conv.shape[0] // 2
     if not conv[mid]:
-        require_converged(path.converged[mid:mid + 1], "tooth contact at the reference point",
-                          path.residual[mid:mid + 1])
+        require_converged(conv[mid:mid + 1], "tooth contact at the reference point",
+                          res[mid:mid + 1])
     idx = np.nonzero(inside & conv)[0]
     if idx.size == 0:
         raise NoContactError("no contact inside the flank boundaries at any grid position "
                              "(the flanks do not touch); pass throw=False to get the masks")
     if idx.size:
         sl = slice(idx[0], idx[-1] + 1)
-        require_converged(path.converged[sl], "tooth contact analysis on the flank",
-                          path.residual[sl])
+        require_converged(conv[sl], "tooth contact analysis on the flank", res[sl])
 
 
 def check_tca_options(steps_per_pitch, half_pitches, n_pairs, approach) -> None:

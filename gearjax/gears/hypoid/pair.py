@@ -61,6 +61,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from gearjax.compile_ahead import CompileAhead
 from gearjax.fields import float64_array, floats_for_ints
 from gearjax.frames import matrix_x
 from gearjax.gears.hypoid.cutter import FaceMillCutter
@@ -73,7 +74,7 @@ from gearjax.tca.path import ContactPath
 
 __all__ = ["SIDES", "HypoidPair", "program_pair", "pair_flanks", "mean_dedendum", "complementary_pinion",
            "with_point_radius", "flank_function", "hypoid_assembly", "mean_point",
-           "flank_coordinates", "hypoid_margin"]
+           "mean_points", "flank_coordinates", "hypoid_margin"]
 
 
 # drive side: pinion concave drives gear convex (Gleason convention); coast: the others
@@ -266,16 +267,34 @@ def mean_point(fl: FlankSpec, crossing):
     """Mean point of a flank (concrete): ``uv = (theta, s)`` at mid face, half-way along
     the blade to the tip, its body-frame point (origin at the crossing point) and the
     outward normal (out of the tooth material; one envelope solve for both)."""
-    tip = solve_tip(fl, 0.0, mid_estimate(fl))
-    uv = jnp.array([float(tip.x[1]), 0.5 * float(tip.x[0])])
-    psi = 0.0
-    if fl.machine.generated:
-        # the cached envelope solve of the flank function (a constant shift of the
-        # family does not change the meshing equation): no recompilation per call
-        psi = flank_function(fl, crossing).solve(uv).x
-    r, n = work_point(fl, uv[1], uv[0], psi)
+    uv, r, n = _mean_point(fl, jnp.asarray(crossing, float))
     q = np.asarray(r) - np.array([0.0, 0.0, float(crossing)])
     return np.asarray(uv), q, np.asarray(n)
+
+
+def mean_points(pair: "HypoidPair"):
+    """:func:`mean_point` of the pinion and of the gear (their programs compiled side by
+    side, gearjax/compile_ahead.py: a generated and a formate member are two)."""
+    members = ((pair.pinion, pair.pinion_crossing), (pair.gear, pair.gear_crossing))
+    with CompileAhead() as ahead:
+        for fl, crossing in members:
+            ahead.submit(_mean_point, fl, jnp.asarray(crossing, float))
+    return tuple(mean_point(fl, crossing) for fl, crossing in members)
+
+
+@jax.jit
+def _mean_point(fl: FlankSpec, crossing):
+    # one program (the set-up's small solves and their arithmetic compiled together,
+    # not one small program per operation)
+    tip = solve_tip(fl, 0.0, mid_estimate(fl))
+    uv = jnp.stack([tip.x[1], 0.5 * tip.x[0]])
+    psi = 0.0
+    if fl.machine.generated:
+        # the envelope solve of the flank function (a constant shift of the family
+        # does not change the meshing equation)
+        psi = flank_function(fl, crossing).solve(uv).x
+    r, n = work_point(fl, uv[1], uv[0], psi)
+    return uv, r, n
 
 
 def flank_coordinates(fl: FlankSpec, crossing, p_body):

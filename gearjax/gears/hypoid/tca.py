@@ -33,7 +33,7 @@ from gearjax.gears.hypoid.design_file import HypoidDesign
 from gearjax.gears.hypoid.flank import face_apex_offset, root_apex_offset
 from gearjax.gears.hypoid.pair import (SIDES, HypoidPair, complementary_pinion, flank_coordinates,
                                        flank_function, hypoid_assembly, hypoid_face_ends,
-                                       hypoid_margin, mean_dedendum, mean_point, pair_flanks,
+                                       hypoid_margin, mean_dedendum, mean_points, pair_flanks,
                                        program_pair, with_point_radius)
 from gearjax.loading.loaded_contact import TeethOf
 from gearjax.newton import newton_solve
@@ -62,8 +62,7 @@ def reference_guess(pair: HypoidPair, n_search: int = 181):
 
 def _search(pair: HypoidPair, n_search: int):
     """:func:`reference_guess`, plus the pinion's mean point and outward normal (body frame)."""
-    (uv1, q1, n1), (uv2, q2, n2) = (mean_point(pair.pinion, pair.pinion_crossing),
-                                    mean_point(pair.gear, pair.gear_crossing))
+    (uv1, q1, n1), (uv2, q2, n2) = mean_points(pair)
     a = np.linspace(-np.pi, np.pi, n_search, endpoint=False)
     A1, A2 = np.meshgrid(a, a, indexing="ij")
     best = None

@@ -1,0 +1,97 @@
+"""Compile the programs of one concrete run side by side, on the machine's other cores.
+
+A concrete run (:func:`gearjax.run_tca`, :func:`gearjax.mesh_efficiency`, the command
+line) calls two or three jitted programs one after the other, each needing the one
+before's outputs.  The first call of each is dominated by its compilation: tracing
+(Python, holds the interpreter lock), then XLA's passes and LLVM (C++, release it; on
+2 cores the hypoid TCA spends about 3 s tracing and 9 s compiling).  Called one after
+the other, the compilations queue behind each other on one core.
+
+:class:`CompileAhead` traces and lowers each program in the calling thread -- the
+next program from the abstract outputs of the one before (``jax.jit(...).trace``) --
+and hands its XLA compilation to a worker thread, so that a program compiles while the
+next is traced, and two compile at once.  Leaving the ``with`` block waits for every
+compilation; the run then calls the jitted functions as usual and finds each in JAX's
+own caches (tracing, lowering and executables are cached per abstract signature, so a
+concrete call with the same shapes, dtypes and weak types hits what was compiled
+ahead; JAX's persistent compilation cache serves a warm process as before).  A
+program compiled ahead once in a process is not submitted again.  Nothing changes in
+what is computed: the same jitted functions run on the same arguments.
+
+Inside a trace (``jax.jit``, ``jax.grad`` of a :func:`gearjax.tca_function`) there is
+nothing to compile ahead: :meth:`CompileAhead.submit` returns None and the caller
+runs its programs directly.  A compilation that fails ahead is not reported here: the
+concrete call that follows compiles again and raises the error where it belongs.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import os
+import threading
+
+import jax
+
+__all__ = ["CompileAhead"]
+
+_POOL: concurrent.futures.ThreadPoolExecutor | None = None
+_POOL_LOCK = threading.Lock()
+#: (function, static arguments, abstract signature) -> abstract outputs, of every
+#: program compiled ahead in this process
+_DONE: dict = {}
+
+
+def _pool() -> concurrent.futures.ThreadPoolExecutor:
+    global _POOL
+    with _POOL_LOCK:
+        if _POOL is None:
+            _POOL = concurrent.futures.ThreadPoolExecutor(
+                max_workers=max(1, min(4, os.cpu_count() or 1)),
+                thread_name_prefix="gearjax-compile")
+        return _POOL
+
+
+def _signature(args, static) -> tuple | None:
+    """The key of a call: tree structure, abstract value of each leaf, static
+    arguments; None where a leaf is a tracer (inside a trace: nothing to compile)."""
+    leaves, tree = jax.tree.flatten(args)
+    if any(isinstance(x, jax.core.Tracer) for x in leaves):
+        return None
+    return tree, tuple(jax.typeof(x) for x in leaves), tuple(sorted(static.items()))
+
+
+class CompileAhead:
+    """``with CompileAhead() as ahead: out = ahead.submit(f, *args, **static)`` (module
+    docstring): ``f`` a ``jax.jit`` function, ``static`` its static arguments."""
+
+    def __init__(self):
+        self._pending = []
+
+    def submit(self, fun, *args, **static):
+        """Trace and lower ``fun(*args, **static)`` here, compile it on a worker thread;
+        returns its abstract outputs (``jax.ShapeDtypeStruct`` leaves, the arguments of
+        a next program), or None inside a trace (an argument is a tracer)."""
+        sig = _signature(args, static)
+        if sig is None:
+            return None
+        key = (fun, sig)
+        if key in _DONE:
+            return _DONE[key]
+        traced = fun.trace(*args, **static)
+        out = traced.out_info
+        future = _pool().submit(traced.lower().compile)
+        self._pending.append((key, out, future))
+        return out
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        for key, out, future in self._pending:
+            try:
+                future.result()
+            except Exception:   # the concrete call compiles again and raises it
+                continue
+            _DONE[key] = out
+        self._pending = []
+        return False

@@ -1,0 +1,127 @@
+"""Programs compiled ahead side by side (gearjax/compile_ahead.py) are the programs the
+run then calls: each traced once, compiled on a worker thread, found in JAX's caches by
+the concrete call.
+
+Planted bugs caught: abstract arguments of a next program that differ from the concrete
+ones (a weak type or dtype lost: the concrete call traces and compiles a second time),
+a submission that ignores its static arguments, ahead compilation inside a trace
+(``submit`` must decline tracers), the memo that skips a program compiled once, a TCA
+driver that no longer runs its two stages through :class:`CompileAhead` or hands a
+next program an abstract result unlike the concrete one.  (That the efficiency program
+is offered to the TCA's compilation: tests/test_mesh_efficiency.py.)
+"""
+
+import logging
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+import gearjax as gj
+from gearjax.compile_ahead import CompileAhead
+from test_family_driver import TOY, _toy
+
+
+class _Log(logging.Handler):
+    """JAX's compile log (``jax_log_compiles``): (message, thread name) records."""
+
+    def __init__(self):
+        super().__init__(logging.WARNING)
+        self.records = []
+
+    def emit(self, record):
+        self.records.append((record.getMessage(), record.threadName))
+
+    def traces(self, name):
+        return sum(m.startswith(f"Finished tracing {name} ") for m, _ in self.records)
+
+    def compile_threads(self, name):
+        return [t for m, t in self.records if m.startswith("Finished XLA compilation")
+                and f"jit({name})" in m]
+
+
+@pytest.fixture
+def compile_log():
+    log = _Log()
+    logger = logging.getLogger("jax")
+    logger.addHandler(log)
+    was = jax.config.jax_log_compiles
+    # globally: a config context is thread-local, the compilations run on other threads
+    jax.config.update("jax_log_compiles", True)
+    try:
+        yield log
+    finally:
+        jax.config.update("jax_log_compiles", was)
+        logger.removeHandler(log)
+
+
+def test_next_program_from_abstract_outputs_is_traced_once(compile_log):
+    """A chain of two programs (the second on the first's abstract outputs, a weak-typed
+    scalar among them) and a static argument: each traced once, compiled on a worker
+    thread, the concrete calls hit; a second submission is served by the memo."""
+    @jax.jit
+    def first(x, a):
+        return {"y": jnp.sin(x) * a, "s": jnp.sum(x), "w": a * 2.0}
+
+    def second_(d, *, k):
+        return d["y"] * k + d["s"] + d["w"]
+    second = jax.jit(second_, static_argnames="k")
+
+    x = jnp.linspace(0.0, 1.0, 5)
+    with CompileAhead() as ahead:
+        out = ahead.submit(first, x, 3.0)
+        assert jax.typeof(out["w"]).weak_type          # the weak type travels
+        ahead.submit(second, out, k=4)
+    got = second(first(x, 3.0), k=4)
+    np.testing.assert_allclose(np.asarray(got), np.sin(np.linspace(0, 1, 5)) * 12.0 + 2.5 + 6.0,
+                               rtol=1e-14)
+    assert compile_log.traces("first") == 1 and compile_log.traces("second_") == 1
+    threads = compile_log.compile_threads("first") + compile_log.compile_threads("second_")
+    assert threads and all(t.startswith("gearjax-compile") for t in threads), threads
+    # compiled ahead once: a second submission traces nothing
+    with CompileAhead() as ahead:
+        assert jax.typeof(ahead.submit(first, x, 3.0)["s"]) == jax.typeof(jnp.float64(0.0))
+    assert compile_log.traces("first") == 1
+    # another static argument is another program
+    with CompileAhead() as ahead:
+        ahead.submit(second, out, k=5)
+    assert compile_log.traces("second_") == 2
+
+
+def test_inside_a_trace_nothing_is_compiled_ahead():
+    f = jax.jit(lambda x: 2.0 * x)
+    seen = []
+
+    def g(x):
+        with CompileAhead() as ahead:
+            seen.append(ahead.submit(f, x))
+        return f(x)
+    assert float(jax.jit(g)(1.5)) == 3.0 and float(jax.grad(g)(1.5)) == 2.0
+    assert seen == [None, None]
+
+
+def test_the_tca_runs_its_two_programs_compiled_ahead(compile_log):
+    """The concrete TCA (toy family, a grid no other test uses): both stages traced
+    once and compiled on worker threads; ``also`` is offered the abstract result, whose
+    every leaf has the concrete result's abstract value (else a program compiled on it
+    would compile again when called)."""
+    des = _toy(18, 31)
+    seen = []
+    res = TOY.run(des, side="drive", steps_per_pitch=11, also=lambda a, r: seen.append(r))
+    assert compile_log.traces("_surface_program") == 1
+    assert compile_log.traces("_finish_program") == 1
+    for name in ("_surface_program", "_finish_program"):
+        threads = compile_log.compile_threads(name)
+        assert threads and all(t.startswith("gearjax-compile") for t in threads), (name, threads)
+    assert len(seen) == 1
+    abstract = jax.tree.map(jax.typeof, seen[0])
+    concrete = jax.tree.map(jax.typeof, res)
+    assert jax.tree.structure(abstract) == jax.tree.structure(concrete)
+    assert jax.tree.leaves(abstract) == jax.tree.leaves(concrete)
+    assert (seen[0].side, seen[0].family) == ("drive", "toy_spur")
+    # and the two-program run is the one-program traced TCA
+    f = gj.tca_function(des, side="drive", steps_per_pitch=11)
+    one = jax.jit(lambda p: f(p).path.te)(f.pair)
+    np.testing.assert_allclose(np.asarray(res.path.te), np.asarray(one), rtol=0, atol=1e-15)
+
