@@ -32,13 +32,15 @@ import threading
 
 import jax
 
-__all__ = ["CompileAhead"]
+__all__ = ["CompileAhead", "prefetch"]
 
 _POOL: concurrent.futures.ThreadPoolExecutor | None = None
 _POOL_LOCK = threading.Lock()
 #: (function, static arguments, abstract signature) -> abstract outputs, of every
 #: program compiled ahead in this process
 _DONE: dict = {}
+#: the same key -> (abstract outputs, future) of a compilation not yet waited for
+_RUNNING: dict = {}
 
 
 def _pool() -> concurrent.futures.ThreadPoolExecutor:
@@ -77,9 +79,10 @@ class CompileAhead:
         key = (fun, sig)
         if key in _DONE:
             return _DONE[key]
-        traced = fun.trace(*args, **static)
-        out = traced.out_info
-        future = _pool().submit(traced.lower().compile)
+        if key not in _RUNNING:             # (else: submitted by :func:`prefetch`)
+            traced = fun.trace(*args, **static)
+            _RUNNING[key] = traced.out_info, _pool().submit(traced.lower().compile)
+        out, future = _RUNNING[key]
         self._pending.append((key, out, future))
         return out
 
@@ -88,6 +91,7 @@ class CompileAhead:
 
     def __exit__(self, *exc):
         for key, out, future in self._pending:
+            _RUNNING.pop(key, None)
             try:
                 future.result()
             except Exception:   # the concrete call compiles again and raises it
@@ -95,3 +99,13 @@ class CompileAhead:
             _DONE[key] = out
         self._pending = []
         return False
+
+
+def prefetch(fun, *args, **static) -> None:
+    """Start compiling ``fun(*args, **static)`` (abstract arguments allowed:
+    ``jax.ShapeDtypeStruct``) and go on without waiting: a later
+    :meth:`CompileAhead.submit` of the same program (same abstract arguments) waits for
+    this compilation instead of starting another.  For a program a run will need once
+    work that does not feed its shapes is done (a set-up's solve compiles while the
+    blank is computed)."""
+    CompileAhead().submit(fun, *args, **static)

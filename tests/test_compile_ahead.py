@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 
 import gearjax as gj
+import gearjax.compile_ahead as ca
 from gearjax.compile_ahead import CompileAhead
 from test_family_driver import TOY, _toy
 
@@ -125,3 +126,42 @@ def test_the_tca_runs_its_two_programs_compiled_ahead(compile_log):
     one = jax.jit(lambda p: f(p).path.te)(f.pair)
     np.testing.assert_allclose(np.asarray(res.path.te), np.asarray(one), rtol=0, atol=1e-15)
 
+
+
+def test_prefetch_then_submit_waits_for_the_same_compilation(compile_log):
+    """:func:`prefetch` on abstract arguments starts the compilation; a submission of the
+    same program on concrete arguments later waits for it (one trace, no second
+    compilation) and the concrete call hits."""
+    @jax.jit
+    def third(x, n):
+        return jnp.cumsum(x) * n
+
+    ca.prefetch(third, jax.ShapeDtypeStruct((4,), jnp.float64),
+                jax.ShapeDtypeStruct((), jnp.float64))
+    x = jnp.arange(4.0)
+    with CompileAhead() as ahead:
+        ahead.submit(third, x, jnp.float64(2.0))
+    np.testing.assert_array_equal(np.asarray(third(x, jnp.float64(2.0))), [0.0, 2.0, 6.0, 12.0])
+    assert compile_log.traces("third") == 1
+    assert len(compile_log.compile_threads("third")) == 1
+    assert not ca._RUNNING
+
+
+def test_hypoid_mean_points_prefetched_as_they_run(monkeypatch):
+    """The hypoid set-up starts compiling its mean-point programs before the blank is
+    computed (``mean_points_ahead``); they must be the programs ``mean_points`` then
+    runs: the same abstract signatures (a crossing point of another dtype or weak
+    type, or another flank, would compile a second program)."""
+    from gearjax.gears.hypoid.pair import mean_points, mean_points_ahead, pair_flanks
+    keys = []
+    orig = CompileAhead.submit
+
+    def spy(self, fun, *args, **static):
+        keys.append((fun.__name__, ca._signature(args, static)))
+        return orig(self, fun, *args, **static)
+    monkeypatch.setattr(CompileAhead, "submit", spy)
+    d = gj.load_design(gj.example_path("hft_8x43_synthesised"))
+    mean_points_ahead(d, "coast")
+    mean_points(pair_flanks(d, "coast"))
+    assert len(keys) == 4 and keys[:2] == keys[2:], keys
+    assert keys[0][1] != keys[1][1]            # pinion and gear: two programs

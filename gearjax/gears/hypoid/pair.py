@@ -61,7 +61,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax.compile_ahead import CompileAhead
+from gearjax.compile_ahead import CompileAhead, prefetch
 from gearjax.fields import float64_array, floats_for_ints
 from gearjax.frames import matrix_x
 from gearjax.gears.hypoid.cutter import FaceMillCutter
@@ -74,7 +74,7 @@ from gearjax.tca.path import ContactPath
 
 __all__ = ["SIDES", "HypoidPair", "program_pair", "pair_flanks", "mean_dedendum", "complementary_pinion",
            "with_point_radius", "flank_function", "hypoid_assembly", "mean_point",
-           "mean_points", "flank_coordinates", "hypoid_margin"]
+           "mean_points", "mean_points_ahead", "flank_coordinates", "hypoid_margin"]
 
 
 # drive side: pinion concave drives gear convex (Gleason convention); coast: the others
@@ -270,6 +270,17 @@ def mean_point(fl: FlankSpec, crossing):
     uv, r, n = _mean_point(fl, jnp.asarray(crossing, float))
     q = np.asarray(r) - np.array([0.0, 0.0, float(crossing)])
     return np.asarray(uv), q, np.asarray(n)
+
+
+def mean_points_ahead(design, side: str) -> None:
+    """Start compiling the :func:`mean_point` programs of the flanks of ``side`` of a
+    design file and go on (gearjax/compile_ahead.py): they compile while the caller
+    computes the blank and the crossing points; :func:`mean_points` then waits for them."""
+    if side not in SIDES:
+        return
+    crossing = jax.ShapeDtypeStruct((), jnp.float64)
+    for member, flank in zip(("pinion", "gear"), SIDES[side]):
+        prefetch(_mean_point, design.flank(member, flank), crossing)
 
 
 def mean_points(pair: "HypoidPair"):

@@ -33,8 +33,9 @@ from gearjax.gears.hypoid.design_file import HypoidDesign
 from gearjax.gears.hypoid.flank import face_apex_offset, root_apex_offset
 from gearjax.gears.hypoid.pair import (SIDES, HypoidPair, complementary_pinion, flank_coordinates,
                                        flank_function, hypoid_assembly, hypoid_face_ends,
-                                       hypoid_margin, mean_dedendum, mean_points, pair_flanks,
-                                       program_pair, with_point_radius)
+                                       hypoid_margin, mean_dedendum, mean_points,
+                                       mean_points_ahead, pair_flanks, program_pair,
+                                       with_point_radius)
 from gearjax.loading.loaded_contact import TeethOf
 from gearjax.newton import newton_solve
 from gearjax.surfaces import GeneratedSurface
@@ -256,6 +257,7 @@ def _prepared(design, side):
         prep = design if isinstance(design, Prepared) else prepare(design)
         return prep, found
     side = side or "drive"
+    mean_points_ahead(design, side)       # compiles while pair_flanks computes the blank
     return prepare(pair_flanks(design, side)), side
 
 
