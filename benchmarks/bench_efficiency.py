@@ -9,6 +9,10 @@ pass).  Prints a table: compile and run time of each, and the ratio gradient /
 forward measured in the same process.
 
     python benchmarks/bench_efficiency.py [--design hypoid_iso_10x41_synthesised] [--repeats 5]
+                                          [--fast-compile]
+
+``--fast-compile`` adds both routes jitted with ``compiler_options =
+gearjax.FAST_COMPILE_OPTIONS`` (the command line's XLA options for one program).
 """
 
 from __future__ import annotations
@@ -29,6 +33,8 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--design", default="hypoid_iso_10x41_synthesised")
     ap.add_argument("--repeats", type=int, default=5)
+    ap.add_argument("--fast-compile", action="store_true",
+                    help="also compile both with gearjax.FAST_COMPILE_OPTIONS")
     args = ap.parse_args()
     design = gj.load_design(f"example:{args.design}")
     f = efficiency_function(design)
@@ -47,9 +53,14 @@ def main():
     a = (x0, gj.Misalignment.zero(), jnp.asarray(200.0), jnp.asarray(1000.0),
          jnp.asarray(oil.eta0), jnp.asarray(surf.sigma))
     rows = []
-    for label, fn in (("forward eta_bar", jax.jit(eta)),
-                      ("gradient (reverse, %d inputs)" % (len(names) + 8),
-                       jax.jit(jax.grad(eta, argnums=(0, 1, 2, 3, 4, 5))))):
+    grad = jax.grad(eta, argnums=(0, 1, 2, 3, 4, 5))
+    fast = dict(compiler_options=gj.FAST_COMPILE_OPTIONS)
+    routes = [("forward eta_bar", jax.jit(eta)),
+              ("gradient (reverse, %d inputs)" % (len(names) + 8), jax.jit(grad))]
+    if args.fast_compile:
+        routes += [("forward, FAST_COMPILE_OPTIONS", jax.jit(eta, **fast)),
+                   ("gradient, FAST_COMPILE_OPTIONS", jax.jit(grad, **fast))]
+    for label, fn in routes:
         t = time.perf_counter()
         jax.block_until_ready(fn(*a))
         tc = time.perf_counter() - t
@@ -69,6 +80,9 @@ def main():
     for label, tc, t in rows:
         print(f"{label:40s} {tc:12.1f} {t:10.4f}")
     print(f"gradient / forward cost: {rows[1][2] / rows[0][2]:.2f}")
+    if args.fast_compile:
+        print(f"with FAST_COMPILE_OPTIONS: gradient compile {rows[1][1] / rows[3][1]:.2f}x "
+              f"faster, its call {rows[3][2] / rows[1][2]:.2f}x slower")
 
 
 if __name__ == "__main__":

@@ -30,6 +30,7 @@ _jax.config.update("jax_enable_x64", True)
 __version__ = "0.1.0"
 
 # -- the verbs and types of the chain -------------------------------------------------
+from gearjax.compile_ahead import FAST_COMPILE_OPTIONS  # noqa: E402
 from gearjax.errors import ConvergenceError  # noqa: E402
 from gearjax.fields import field_names, get_fields, with_fields  # noqa: E402
 from gearjax.newton import NewtonResult, newton_solve  # noqa: E402
@@ -133,6 +134,8 @@ __all__ = [
     # optimisers and solvers, their results and status
     "minimize_optax", "minimize_lbfgsb", "least_squares_lm", "OptResult", "LMResult",
     "status_message", "newton_solve", "NewtonResult", "ConvergenceError", "NoContactError",
+    # compile time: XLA options for jax.jit(..., compiler_options=...) on the CPU
+    "FAST_COMPILE_OPTIONS",
     # design fields by name
     "field_names", "get_fields", "with_fields",
     # namespaces

@@ -14,6 +14,8 @@ import os
 import sys
 import warnings
 
+from gearjax.compile_ahead import FAST_COMPILE_OPTIONS
+
 # sub-command modules, in the order they appear in ``gearjax --help``
 COMMANDS = [
     "gearjax.commands.involute",
@@ -156,9 +158,8 @@ def _enable_compilation_cache() -> None:
 #: compilation).  Results agree to round-off (the test suite runs with the same
 #: options).  ``GEARJAX_FAST_COMPILE=0`` keeps XLA's defaults (long runs); an option
 #: already in ``XLA_FLAGS`` is kept.
-FAST_COMPILE_FLAGS = (("xla_backend_optimization_level", "0"),
-                      ("xla_cpu_use_fusion_emitters", "false"),
-                      ("xla_cpu_parallel_codegen_split_count", "1"))
+FAST_COMPILE_FLAGS = tuple((name, str(value).lower())
+                           for name, value in FAST_COMPILE_OPTIONS.items())
 
 
 def _fast_compile_flags() -> None:

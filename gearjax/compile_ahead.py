@@ -15,7 +15,8 @@ compilation; the run then calls the jitted functions as usual and finds each in 
 own caches (tracing, lowering and executables are cached per abstract signature, so a
 concrete call with the same shapes, dtypes and weak types hits what was compiled
 ahead; JAX's persistent compilation cache serves a warm process as before).  A
-program compiled ahead once in a process is not submitted again.  Nothing changes in
+program compiled ahead once in a process is not submitted again (after
+``jax.clear_caches()`` it compiles on its call, as it would without this module).  Nothing changes in
 what is computed: the same jitted functions run on the same arguments.
 
 Inside a trace (``jax.jit``, ``jax.grad`` of a :func:`gearjax.tca_function`) there is
@@ -32,7 +33,18 @@ import threading
 
 import jax
 
-__all__ = ["CompileAhead", "prefetch"]
+__all__ = ["CompileAhead", "prefetch", "FAST_COMPILE_OPTIONS"]
+
+#: XLA options that trade run time for compile time on the CPU, for a program compiled
+#: once and run a few times (``jax.jit(f, compiler_options=FAST_COMPILE_OPTIONS)``; the
+#: command line sets the same ones for its whole process, gearjax/cli.py): LLVM
+#: optimisation level 0, XLA's older loop emitters, one LLVM module per program.  They
+#: halve to third the compilation of gearjax's programs and about double their run time;
+#: results agree to round-off (the test suite runs with them).  CPU only: on a GPU they
+#: would slow the kernels down.
+FAST_COMPILE_OPTIONS = {"xla_backend_optimization_level": 0,
+                        "xla_cpu_use_fusion_emitters": False,
+                        "xla_cpu_parallel_codegen_split_count": 1}
 
 _POOL: concurrent.futures.ThreadPoolExecutor | None = None
 _POOL_LOCK = threading.Lock()

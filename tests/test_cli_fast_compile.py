@@ -104,3 +104,28 @@ def test_only_a_real_command_line_run_sets_the_flags(env, monkeypatch, capsys):
     assert cli.main() == 0
     assert "--xla_cpu_parallel_codegen_split_count=1" in _flags()
     capsys.readouterr()
+
+
+def test_fast_compile_options_for_one_program():
+    """``gearjax.FAST_COMPILE_OPTIONS`` (the command line's options, for
+    ``jax.jit(..., compiler_options=...)``) are accepted by this XLA -- a misspelt or
+    retired option is an error at compile time -- and change a Newton solve and its
+    implicit derivative only at the rounding level; the command line's flags are the
+    same options."""
+    import jax
+    import jax.numpy as jnp
+    import gearjax as gj
+
+    def root(a):
+        res = gj.newton_solve(lambda x, p: jnp.stack([x[0] ** 3 + x[1] - p, x[1] - 0.5 * x[0]]),
+                              jnp.array([1.0, 0.5]), a)
+        return res.x[0]
+
+    f = jax.value_and_grad(root)
+    v0, g0 = jax.jit(f)(2.0)
+    v1, g1 = jax.jit(f, compiler_options=gj.FAST_COMPILE_OPTIONS)(2.0)
+    assert abs(float(v1) - float(v0)) < 1e-14 and abs(float(g1) - float(g0)) < 1e-13
+    # x^3 + x/2 = 2: x = 1.1173..., dx/da = 1 / (3 x^2 + 1/2)
+    assert float(g0) == pytest.approx(1.0 / (3.0 * float(v0) ** 2 + 0.5), rel=1e-12)
+    assert dict(cli.FAST_COMPILE_FLAGS) == {k: str(v).lower()
+                                            for k, v in gj.FAST_COMPILE_OPTIONS.items()}

@@ -42,6 +42,17 @@ class _Log(logging.Handler):
                 and f"jit({name})" in m]
 
 
+class _CountingTrace:
+    """A jitted function that counts its ``trace`` calls."""
+
+    def __init__(self, fun):
+        self.fun, self.n = fun, 0
+
+    def trace(self, *args, **static):
+        self.n += 1
+        return self.fun.trace(*args, **static)
+
+
 @pytest.fixture
 def compile_log():
     log = _Log()
@@ -80,10 +91,14 @@ def test_next_program_from_abstract_outputs_is_traced_once(compile_log):
     assert compile_log.traces("first") == 1 and compile_log.traces("second_") == 1
     threads = compile_log.compile_threads("first") + compile_log.compile_threads("second_")
     assert threads and all(t.startswith("gearjax-compile") for t in threads), threads
-    # compiled ahead once: a second submission traces nothing
+    # compiled ahead once: a second submission traces nothing (not even a hit in JAX's
+    # trace cache: the memo answers)
+    counted = _CountingTrace(first)
     with CompileAhead() as ahead:
-        assert jax.typeof(ahead.submit(first, x, 3.0)["s"]) == jax.typeof(jnp.float64(0.0))
-    assert compile_log.traces("first") == 1
+        ahead.submit(counted, x, 3.0)
+    with CompileAhead() as ahead:
+        assert jax.typeof(ahead.submit(counted, x, 3.0)["s"]) == jax.typeof(jnp.float64(0.0))
+    assert counted.n == 1 and compile_log.traces("first") == 1
     # another static argument is another program
     with CompileAhead() as ahead:
         ahead.submit(second, out, k=5)
@@ -147,11 +162,12 @@ def test_prefetch_then_submit_waits_for_the_same_compilation(compile_log):
     assert not ca._RUNNING
 
 
-def test_hypoid_mean_points_prefetched_as_they_run(monkeypatch):
+def test_hypoid_mean_points_prefetched_as_they_run(monkeypatch, compile_log):
     """The hypoid set-up starts compiling its mean-point programs before the blank is
     computed (``mean_points_ahead``); they must be the programs ``mean_points`` then
-    runs: the same abstract signatures (a crossing point of another dtype or weak
-    type, or another flank, would compile a second program)."""
+    submits and calls: the same abstract signatures (a crossing point of another dtype
+    or weak type, or another flank, would compile a second program): two traces, one
+    per member (JAX's caches are cleared between test modules)."""
     from gearjax.gears.hypoid.pair import mean_points, mean_points_ahead, pair_flanks
     keys = []
     orig = CompileAhead.submit
@@ -164,4 +180,5 @@ def test_hypoid_mean_points_prefetched_as_they_run(monkeypatch):
     mean_points_ahead(d, "coast")
     mean_points(pair_flanks(d, "coast"))
     assert len(keys) == 4 and keys[:2] == keys[2:], keys
+    assert compile_log.traces("_mean_point") == 2
     assert keys[0][1] != keys[1][1]            # pinion and gear: two programs

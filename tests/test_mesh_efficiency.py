@@ -86,8 +86,10 @@ def test_the_loads_program_compiles_beside_the_tca(spur, oil_surface, weber_run,
     """``mesh_efficiency`` offers its loads' program to the compilation of the TCA's two
     programs (gearjax/compile_ahead.py), after them, on the abstract TCA result: the
     first call compiles all three side by side.  Planted bug caught: ``also`` dropped (the
-    loads' program compiled alone after the TCA's, ~2 s more on a first call)."""
+    loads' program compiled alone after the TCA's, ~2 s more on a first call); the oil's
+    name a key of the program (each named oil compiling its own)."""
     import gearjax.compile_ahead as ca
+    from gearjax.loading.mesh_efficiency import _post_jit
     submitted = []
     orig = ca.CompileAhead.submit
 
@@ -98,6 +100,11 @@ def test_the_loads_program_compiles_beside_the_tca(spur, oil_surface, weber_run,
     eff, _ = mesh_efficiency(spur[1], TORQUE, RPM, *oil_surface, compliance="weber")
     assert submitted == ["_surface_program", "_finish_program", "_post_jit"], submitted
     assert float(eff.mean_efficiency) == float(weber_run[0].mean_efficiency)
+    n0 = _post_jit._cache_size()
+    renamed = dataclasses.replace(oil_surface[0], name="the same oil, renamed")
+    eff2, _ = mesh_efficiency(spur[1], TORQUE, RPM, renamed, oil_surface[1], compliance="weber")
+    assert _post_jit._cache_size() == n0
+    assert float(eff2.mean_efficiency) == float(eff.mean_efficiency)
 
 
 def test_textbook_load_sharing_and_balance(spur, iso_run):
