@@ -63,28 +63,34 @@ def progress_enabled(stream=None, force: bool | None = None) -> bool:
 
 
 class _CompileWatch:
-    """Counts JAX trace/lower/compile events open right now (via jax.monitoring)."""
+    """Counts JAX trace/lower/compile events open right now (via jax.monitoring; the
+    events of programs compiled side by side arrive from worker threads)."""
 
     def __init__(self, on_change):
         self.open = 0
         self.count = 0          # compile-pipeline steps finished
-        self.seconds = 0.0      # their total duration (s); nested steps are not summed twice
+        self.seconds = 0.0      # their total duration (s); nested or overlapping steps once
         self._on_change = on_change
         self._mon = None
+        self._lock = threading.Lock()
 
     def _start(self, event, value, **kw):
         if event.startswith(_COMPILE_EVENTS):
-            self.open += 1
-            if self.open == 1:
+            with self._lock:
+                self.open += 1
+                first = self.open == 1
+            if first:
                 self._on_change()
 
     def _end(self, event, duration, **kw):
         if event.startswith(_COMPILE_EVENTS):
-            self.count += 1
-            if self.open <= 1:
-                self.seconds += float(duration)
-            self.open = max(self.open - 1, 0)
-            if self.open == 0:
+            with self._lock:
+                self.count += 1
+                if self.open <= 1:
+                    self.seconds += float(duration)
+                self.open = max(self.open - 1, 0)
+                last = self.open == 0
+            if last:
                 self._on_change()
 
     def __enter__(self):
