@@ -211,6 +211,33 @@ def test_driver_strict_default_and_masks():
     assert not np.any(np.asarray(res.on_flank))
 
 
+def test_on_flank_check_spans_the_converged_points_inside():
+    """``check_on_flank_converged`` (the strict default's check, on host arrays): it
+    raises for a failed solve *between* converged on-flank points, not for a failed
+    solve outside that span whose junk margin happens to be >= 0, and says "no contact"
+    when no converged point is inside.  Planted bugs caught: the span taken over
+    unconverged points too; the residual of the whole path reported."""
+    from types import SimpleNamespace
+    from gearjax.tca.path import NoContactError, check_on_flank_converged
+
+    def path(conv):
+        conv = np.asarray(conv, bool)
+        return SimpleNamespace(converged=conv, residual=np.where(conv, 1e-13, 3e-2))
+    margin = np.array([-1.0, -1.0, 0.5, 1.0, 0.5, -1.0, -1.0, 0.7, -1.0])
+    # failed solve at 7 (margin junk, >= 0) outside the converged span 2..4
+    check_on_flank_converged(path([1, 1, 1, 1, 1, 1, 1, 0, 1]), margin)
+    # failed solve at 3, inside the span 2..5 (4 is the reference point, converged):
+    # reported with its own residual
+    with pytest.raises(gj.ConvergenceError, match=r"on the flank: 1 of 4 solves .*worst "
+                                                  r"residual among them 0\.03"):
+        check_on_flank_converged(path([1, 1, 1, 0, 1, 1, 1, 1, 1]),
+                                 np.array([-1.0, -1.0, 0.5, 1.0, 0.5, 0.6, -1.0, -1.0, -1.0]))
+    # only an unconverged point inside: no contact
+    with pytest.raises(NoContactError, match="no contact inside the flank boundaries"):
+        check_on_flank_converged(path([1, 1, 1, 1, 1, 1, 1, 0, 1]),
+                                 np.where(np.arange(9) == 7, 0.7, -1.0))
+
+
 def test_driver_solves_edges_only_when_asked():
     """``face_ends`` reaches the family: its ``edges`` are asked for exactly when the
     option is on (traced only, nothing compiled)."""

@@ -582,3 +582,15 @@ def test_efficiency_function_is_mesh_efficiency_as_a_pure_function(spur, oil_sur
     assert g.options["line_contact"] is True
     for k in ("steps_per_pitch", "half_pitches", "n_pairs", "line_contact"):
         assert g.options[k] == gj.tca.family_of(high).resolve(high, {})[k], k
+
+
+def test_coast_side_of_a_symmetric_pair(spur, oil_surface, weber_run):
+    """``side="coast"`` reaches the TCA the loads stand on (its result is the coast
+    side's) and, by the mirror symmetry of an unmodified spur pair, gives the drive
+    side's efficiency (equal to the last bit here: mirrored arithmetic).  Planted bug
+    caught: the side dropped from the TCA call (coast teeth on the drive TCA)."""
+    eff, res = mesh_efficiency(spur[1], TORQUE, RPM, *oil_surface, compliance="weber",
+                               side="coast")
+    assert res.side == "coast" and weber_run[1].side == "drive"
+    assert float(eff.mean_efficiency) == pytest.approx(float(weber_run[0].mean_efficiency),
+                                                      rel=1e-12)

@@ -355,3 +355,24 @@ def test_bad_input_and_no_contact(conjugate):
                                                                      sign=-pair.pinion.cutter.sign)))
     with pytest.raises(NoContactError):
         th.prepare(wrong)
+
+
+@pytest.mark.parametrize("example", ["hft_8x43_synthesised", "hypoid_iso_10x41"])
+def test_mean_points_at_mid_face_and_the_gear_at_mid_depth(example):
+    """The mean points that seed the reference search (``mean_points``): at mid face
+    (``|xi| < 0.1``, the blade point half-way to the tip of the one on the face cone at
+    xi = 0) and, for the gear -- whose blade runs from its root cone (the cutter's tips)
+    to its face cone -- half-way between the two cones (closed form: equal gaps).  Both
+    members of offset pairs, each in its own frame (the crossing points differ by 1.0
+    and 5.9 mm here).  Planted bug caught: a member's mean point computed with the other
+    member's crossing point (the gear's gaps 4.3/6.3 and 10.8/-0.5 mm)."""
+    from gearjax.gears.hypoid.pair import flank_coordinates, mean_points, pair_flanks
+    d = gj.load_design(gj.example_path(example))
+    for side in ("drive", "coast"):
+        p = pair_flanks(d, side)
+        (_, q1, _), (_, q2, _) = mean_points(p)
+        for fl, crossing, q in ((p.pinion, p.pinion_crossing, q1), (p.gear, p.gear_crossing, q2)):
+            xi, above_root, below_tip = (float(v) for v in flank_coordinates(fl, crossing, q))
+            assert abs(xi) < 0.1, (side, xi)
+        assert abs(above_root - below_tip) < 0.02 * (above_root + below_tip), (
+            side, above_root, below_tip)
