@@ -16,8 +16,14 @@ own caches (tracing, lowering and executables are cached per abstract signature,
 concrete call with the same shapes, dtypes and weak types hits what was compiled
 ahead; JAX's persistent compilation cache serves a warm process as before).  A
 program compiled ahead once in a process is not submitted again (after
-``jax.clear_caches()`` it compiles on its call, as it would without this module).  Nothing changes in
-what is computed: the same jitted functions run on the same arguments.
+``jax.clear_caches()`` it compiles on its call, as it would without this module).
+Nothing changes in what is computed: the same jitted functions run on the same
+arguments (the TCA as two programs: bit-identical on 54 TCAs of every family, their
+sensitivity tables and two efficiencies).
+
+:func:`prefetch` starts a compilation without waiting (abstract arguments allowed),
+for a program a run needs only after other work; :data:`FAST_COMPILE_OPTIONS` are the
+command line's XLA options, for one program.
 
 Inside a trace (``jax.jit``, ``jax.grad`` of a :func:`gearjax.tca_function`) there is
 nothing to compile ahead: :meth:`CompileAhead.submit` returns None and the caller
