@@ -14,7 +14,7 @@ import os
 import sys
 import warnings
 
-from gearjax.compile_ahead import FAST_COMPILE_OPTIONS
+from gearjax import FAST_COMPILE_OPTIONS
 
 # sub-command modules, in the order they appear in ``gearjax --help``
 COMMANDS = [
