@@ -66,7 +66,7 @@ def _pool() -> concurrent.futures.ThreadPoolExecutor:
     with _POOL_LOCK:
         if _POOL is None:
             _POOL = concurrent.futures.ThreadPoolExecutor(
-                max_workers=max(1, min(4, os.cpu_count() or 1)),
+                max_workers=max(4, min(8, os.cpu_count() or 1)),
                 thread_name_prefix="gearjax-compile")
         return _POOL
 
@@ -119,11 +119,11 @@ class CompileAhead:
         return False
 
 
-def prefetch(fun, *args, **static) -> None:
+def prefetch(fun, *args, **static):
     """Start compiling ``fun(*args, **static)`` (abstract arguments allowed:
     ``jax.ShapeDtypeStruct``) and go on without waiting: a later
     :meth:`CompileAhead.submit` of the same program (same abstract arguments) waits for
     this compilation instead of starting another.  For a program a run will need once
     work that does not feed its shapes is done (a set-up's solve compiles while the
-    blank is computed)."""
-    CompileAhead().submit(fun, *args, **static)
+    blank is computed).  Returns the abstract outputs, as :meth:`CompileAhead.submit`."""
+    return CompileAhead().submit(fun, *args, **static)

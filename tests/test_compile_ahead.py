@@ -182,3 +182,40 @@ def test_hypoid_mean_points_prefetched_as_they_run(monkeypatch, compile_log):
     assert len(keys) == 4 and keys[:2] == keys[2:], keys
     assert compile_log.traces("_mean_point") == 2
     assert keys[0][1] != keys[1][1]            # pinion and gear: two programs
+
+
+@pytest.mark.parametrize("side", ["drive", "coast"])
+def test_hypoid_tca_compiled_before_its_set_up_is_the_one_run(monkeypatch, side):
+    """A hypoid design file's TCA programs start compiling from the family's
+    ``early_setup`` (placeholder crossing points, reference and sense), before the blank
+    and the reference search; the run's own submissions must have the same abstract
+    arguments, or the early compilations are wasted and the run compiles again.
+    Traced only: the compilations are replaced by their abstract outputs, and the run
+    stops before it compiles."""
+    import gearjax.tca.family as family
+
+    early, real = [], []
+
+    class Stop(Exception):
+        pass
+
+    def fake_prefetch(fun, *args, **static):
+        early.append((fun.__name__, ca._signature(args, static)))
+        return fun.trace(*args, **static).out_info
+
+    orig = CompileAhead.submit
+
+    def fake_submit(self, fun, *args, **static):
+        if fun.__name__ not in ("_surface_program", "_finish_program"):
+            return orig(self, fun, *args, **static)          # the set-up's mean points
+        real.append((fun.__name__, ca._signature(args, static)))
+        if len(real) == 2:
+            raise Stop
+        return fun.trace(*args, **static).out_info
+    monkeypatch.setattr(family, "prefetch", fake_prefetch)
+    monkeypatch.setattr(CompileAhead, "submit", fake_submit)
+    d = gj.load_design(gj.example_path("hft_8x43_synthesised"))
+    with pytest.raises(Stop):
+        gj.run_tca(d, side=side, half_pitches=2.0)
+    assert [n for n, _ in early] == ["_surface_program", "_finish_program"]
+    assert early == real

@@ -42,7 +42,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax.compile_ahead import CompileAhead
+from gearjax.compile_ahead import CompileAhead, prefetch
 from gearjax.tca.edge_contact import face_end_contact
 from gearjax.tca.multi_pair import multi_pair
 from gearjax.tca.path import (DEFAULT_APPROACH, check_on_flank_converged, check_tca_options,
@@ -91,6 +91,14 @@ class GearFamily:
         the side) returns what it found, and the side its flanks decide.  Taking its
         own result back unchanged (``setup(setup, side)``)."""
         return self.pair(design), side or "drive"
+
+    def early_setup(self, design, side):
+        """Optional: a stand-in of :meth:`setup`'s set-up with the same structure and
+        leaf types but placeholder values, computed without the set-up's work, or None
+        (the default).  A family whose set-up is costly (a blank, a reference search)
+        returns one, and the driver starts compiling the TCA's programs from it before
+        the set-up runs (:mod:`gearjax.compile_ahead`)."""
+        return None
 
     def user_pair(self, setup):
         """The differentiable pair of a set-up: what ``tca_function``'s ``f`` takes and
@@ -288,15 +296,23 @@ def _finish_program(blank, extra, mis, drive, surface, *, fam, **static):
     return tca_finish(fam, fam.join(blank, extra), mis, drive, surface, **static)
 
 
-def _result(fam, pair, mis, x_ref, phi1_ref, approach, side, static, also=None) -> TCAResult:
-    """The TCA by the two programs.  Concrete inputs: both compiled ahead side by side
-    (with whatever ``also(ahead, abstract_result)`` submits to the same
-    :class:`~gearjax.compile_ahead.CompileAhead`, e.g. the efficiency program)."""
+def _program_args(fam, pair, mis, x_ref, phi1_ref, approach, side, static):
+    """The arguments of the two programs: ``(a1, s1, a2, s2)``, the first program
+    ``_surface_program(*a1, fam=fam, **s1)``, the second ``_finish_program(*a2,
+    surface, fam=fam, **s2)``."""
     blank, extra = fam.split(strong_float64(pair))
     mis, drive = strong_float64(mis), jnp.asarray(side == "drive")
     s1 = {k: static[k] for k in _SURFACE_STATIC[1:]}
     s2 = {k: static[k] for k in _FINISH_STATIC[1:]}
-    a1 = (blank, extra, mis, x_ref, phi1_ref, approach, drive)
+    return (blank, extra, mis, x_ref, phi1_ref, approach, drive), s1, (blank, extra, mis, drive), s2
+
+
+def _result(fam, pair, mis, x_ref, phi1_ref, approach, side, static, also=None) -> TCAResult:
+    """The TCA by the two programs.  Concrete inputs: both compiled ahead side by side
+    (with whatever ``also(ahead, abstract_result)`` submits to the same
+    :class:`~gearjax.compile_ahead.CompileAhead`, e.g. the efficiency program)."""
+    a1, s1, (blank, extra, mis, drive), s2 = _program_args(fam, pair, mis, x_ref, phi1_ref,
+                                                           approach, side, static)
     with CompileAhead() as ahead:
         surface = ahead.submit(_surface_program, *a1, fam=fam, **s1)
         if surface is not None:
@@ -385,6 +401,7 @@ class DriverAdapter:
         abstract_result)``: submits the programs that will run on the result to the
         :class:`~gearjax.compile_ahead.CompileAhead` that compiles the TCA's."""
         throw = options.get("throw", True)
+        self._compile_early(design, mis, side, options)
         setup, side = self._setup(design, side)
         approach, static = self.options(options, setup, run=True)
         mis = Misalignment.zero() if mis is None else mis
@@ -394,6 +411,33 @@ class DriverAdapter:
         if throw:
             check_on_flank_converged(res.path, res.margin)
         return res
+
+    def _compile_early(self, design, mis, side, options) -> None:
+        """Start compiling the TCA's two programs from the family's
+        :meth:`GearFamily.early_setup` (if it gives one) and go on: they compile while
+        the set-up runs; the run's own submission then waits for them
+        (:func:`gearjax.compile_ahead.prefetch`; the same abstract arguments, or else
+        nothing is shared and the run compiles as without this).  Only after the side and
+        the options have passed their checks, so that bad input is refused before any
+        work; nothing here may change what the run raises or returns."""
+        if side is not None:
+            check_side(side)
+        try:
+            early = self.fam.early_setup(design, side)
+            if early is None:
+                return
+            approach, static = self.options(options, early, run=True)
+            side = side or "drive"
+            x_ref, phi1_ref = self._reference(early, side)
+            pair = self.fam.program_pair(self.fam.user_pair(early), early)
+            mis = Misalignment.zero() if mis is None else mis
+            a1, s1, a2, s2 = _program_args(self.fam, pair, mis, x_ref, phi1_ref, approach,
+                                           side, static)
+            surface = prefetch(_surface_program, *a1, fam=self.fam, **s1)
+            if surface is not None:
+                prefetch(_finish_program, *a2, surface, fam=self.fam, **s2)
+        except Exception:   # bad input: the run itself refuses it, in its own words
+            return
 
     def traced(self, design, *, side=None, **options):
         """A pure ``f(pair, mis=None, *, reference=None) -> TCAResult`` (the concrete

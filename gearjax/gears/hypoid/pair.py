@@ -152,11 +152,13 @@ def check_pair_fields(pair: HypoidPair) -> None:
     check_range("offset", pair.offset, 0.0, None, unit="mm")
 
 
-def pair_flanks(design, side: str = "drive", *, hand: int = 1) -> HypoidPair:
+def pair_flanks(design, side: str = "drive", *, hand: int = 1,
+                crossings=None) -> HypoidPair:
     """The :class:`HypoidPair` of ``side`` ("drive"/"coast") of a loaded design
-    (:class:`gearjax.gears.hypoid.design_file.HypoidDesign`).  Mounting data from the design's blank: shaft
-    angle, offset and the crossing-point positions (ISO 23509 t_z1, t_z2 when the
-    blank design gives them, else 0 -- exact for a spiral-bevel pair)."""
+    (:class:`gearjax.gears.hypoid.design_file.HypoidDesign`).  Mounting data from the
+    design's blank: shaft angle, offset and the crossing-point positions (ISO 23509
+    t_z1, t_z2 when the blank design gives them, else 0 -- exact for a spiral-bevel
+    pair); ``crossings = (t_z1, t_z2)`` given: those instead (no blank computed)."""
     if side not in SIDES:
         raise ValueError(f"side = {side!r} must be 'drive' or 'coast'")
     f1, f2 = SIDES[side]
@@ -164,7 +166,7 @@ def pair_flanks(design, side: str = "drive", *, hand: int = 1) -> HypoidPair:
     blank = design.data.get("blank", {})
     sigma = math.radians(float(blank.get("shaft_angle_deg", 90.0)))
     E = float(blank.get("offset_mm", 0.0))
-    t1, t2 = _crossing_points(design)
+    t1, t2 = _crossing_points(design) if crossings is None else crossings
     return HypoidPair(p, g, _f(sigma), _f(E), _f(t1), _f(t2), p.blank.teeth, g.blank.teeth, hand)
 
 

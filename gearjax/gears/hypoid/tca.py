@@ -290,6 +290,14 @@ class HypoidFamily(GearFamily):
     def setup(self, design, side):
         return _prepared(design, side)
 
+    def early_setup(self, design, side):
+        # a design file: its pair with placeholder crossing points, reference, hand and
+        # sense (the program's structure; the blank and the search come later)
+        if isinstance(design, (Prepared, HypoidPair)) or (side or "drive") not in SIDES:
+            return None
+        pair = pair_flanks(design, side or "drive", crossings=(0.0, 0.0))
+        return Prepared(pair, np.zeros(5), 0.0, True, (0.0, 0.0))
+
     def user_pair(self, prep):
         return prep.pair
 
