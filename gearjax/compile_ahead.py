@@ -39,7 +39,7 @@ import threading
 
 import jax
 
-__all__ = ["CompileAhead", "prefetch", "FAST_COMPILE_OPTIONS"]
+__all__ = ["CompileAhead", "prefetch", "first_time", "FAST_COMPILE_OPTIONS"]
 
 #: XLA options that trade run time for compile time on the CPU, for a program compiled
 #: once and run a few times (``jax.jit(f, compiler_options=FAST_COMPILE_OPTIONS)``; the
@@ -59,6 +59,8 @@ _POOL_LOCK = threading.Lock()
 _DONE: dict = {}
 #: the same key -> (abstract outputs, future) of a compilation not yet waited for
 _RUNNING: dict = {}
+#: keys of the early starts made in this process (:func:`first_time`)
+_STARTED: set = set()
 
 
 def _pool() -> concurrent.futures.ThreadPoolExecutor:
@@ -127,3 +129,14 @@ def prefetch(fun, *args, **static):
     work that does not feed its shapes is done (a set-up's solve compiles while the
     blank is computed).  Returns the abstract outputs, as :meth:`CompileAhead.submit`."""
     return CompileAhead().submit(fun, *args, **static)
+
+
+def first_time(key) -> bool:
+    """True the first time ``key`` is asked in this process.  An early start whose
+    arguments cost something to build (a design file's flanks) is made once per key,
+    not on every run: a later run finds its programs compiled, and a run whose programs
+    differ compiles them side by side as usual."""
+    if key in _STARTED:
+        return False
+    _STARTED.add(key)
+    return True

@@ -169,6 +169,7 @@ def test_hypoid_mean_points_prefetched_as_they_run(monkeypatch, compile_log):
     or weak type, or another flank, would compile a second program): two traces, one
     per member (JAX's caches are cleared between test modules)."""
     from gearjax.gears.hypoid.pair import mean_points, mean_points_ahead, pair_flanks
+    monkeypatch.setattr(ca, "_STARTED", set())     # as in a fresh process
     keys = []
     orig = CompileAhead.submit
 
@@ -214,8 +215,15 @@ def test_hypoid_tca_compiled_before_its_set_up_is_the_one_run(monkeypatch, side)
         return fun.trace(*args, **static).out_info
     monkeypatch.setattr(family, "prefetch", fake_prefetch)
     monkeypatch.setattr(CompileAhead, "submit", fake_submit)
+    monkeypatch.setattr(ca, "_STARTED", set())     # as in a fresh process
     d = gj.load_design(gj.example_path("hft_8x43_synthesised"))
     with pytest.raises(Stop):
         gj.run_tca(d, side=side, half_pitches=2.0)
     assert [n for n, _ in early] == ["_surface_program", "_finish_program"]
     assert early == real
+    # once per option set: a second run builds no early arguments
+    early.clear()
+    real.clear()
+    with pytest.raises(Stop):
+        gj.run_tca(d, side=side, half_pitches=2.0)
+    assert early == [] and len(real) == 2

@@ -42,7 +42,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax.compile_ahead import CompileAhead, prefetch
+from gearjax.compile_ahead import CompileAhead, first_time, prefetch
 from gearjax.tca.edge_contact import face_end_contact
 from gearjax.tca.multi_pair import multi_pair
 from gearjax.tca.path import (DEFAULT_APPROACH, check_on_flank_converged, check_tca_options,
@@ -419,10 +419,16 @@ class DriverAdapter:
         (:func:`gearjax.compile_ahead.prefetch`; the same abstract arguments, or else
         nothing is shared and the run compiles as without this).  Only after the side and
         the options have passed their checks, so that bad input is refused before any
-        work; nothing here may change what the run raises or returns."""
+        work; nothing here may change what the run raises or returns.  Once per family,
+        design type, side and option set in a process (:func:`~gearjax.compile_ahead.
+        first_time`): building the early arguments costs ~10 ms, and a later run finds
+        its programs compiled."""
         if side is not None:
             check_side(side)
         try:
+            if not first_time((self.fam, type(design), side or "drive",
+                               tuple(sorted(options.items())))):
+                return                  # once per option set: the later runs find it
             early = self.fam.early_setup(design, side)
             if early is None:
                 return

@@ -61,7 +61,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax.compile_ahead import CompileAhead, prefetch
+from gearjax.compile_ahead import CompileAhead, first_time, prefetch
 from gearjax.fields import float64_array, floats_for_ints
 from gearjax.frames import matrix_x
 from gearjax.gears.hypoid.cutter import FaceMillCutter
@@ -278,8 +278,8 @@ def mean_points_ahead(design, side: str) -> None:
     """Start compiling the :func:`mean_point` programs of the flanks of ``side`` of a
     design file and go on (gearjax/compile_ahead.py): they compile while the caller
     computes the blank and the crossing points; :func:`mean_points` then waits for them."""
-    if side not in SIDES:
-        return
+    if side not in SIDES or not first_time(("hypoid mean points", side)):
+        return                          # (once per side: the later set-ups find them)
     crossing = jax.ShapeDtypeStruct((), jnp.float64)
     for member, flank in zip(("pinion", "gear"), SIDES[side]):
         prefetch(_mean_point, design.flank(member, flank), crossing)
