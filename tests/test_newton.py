@@ -5,7 +5,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from gearjax.newton import newton_solve
+from gearjax.newton import implicit_solution, newton_solve, split_derivative
 
 
 def cube_root_system(x, th):
@@ -186,3 +186,67 @@ def test_noise_floor_takes_the_confirming_step_as_it_is():
     np.testing.assert_array_equal(np.asarray(r1.steps), np.asarray(r0.steps))
     np.testing.assert_allclose(np.asarray(r1.x), np.asarray(r0.x), rtol=1e-10)
     assert n1 < n0, (n1, n0)
+
+
+def test_implicit_solution_attaches_the_derivative_of_a_root_found_elsewhere():
+    # a root found by closed form, the derivative attached: jacfwd, jacrev, second
+    # derivatives and a closure over a traced value as for newton_solve
+    def attached(th):
+        return implicit_solution(cube_root_system, jax.lax.stop_gradient(exact(th)), th)
+
+    np.testing.assert_allclose(attached(TH), exact(TH), rtol=0)
+    for jac in (jax.jacfwd, jax.jacrev):
+        np.testing.assert_allclose(jac(attached)(TH), jax.jacfwd(exact)(TH), rtol=1e-12)
+    np.testing.assert_allclose(jax.hessian(lambda th: attached(th)[1])(TH),
+                               jax.hessian(lambda th: exact(th)[1])(TH), rtol=1e-10)
+
+    def root(a):   # sin x = a th: the derivative flows through the closure over a
+        x = jax.lax.stop_gradient(jnp.arcsin(a * 0.5))
+        return implicit_solution(lambda z, th: jnp.sin(z) - a * th, x, 0.5)
+
+    np.testing.assert_allclose(jax.grad(root)(0.6), 0.5 / np.sqrt(1 - 0.3 ** 2), rtol=1e-12)
+    # the rule is evaluated at the x given: d sqrt(t)/dt = 1/(2 x) = 0.25 at x = 2
+    np.testing.assert_allclose(jax.grad(lambda th: implicit_solution(
+        lambda z, t: z ** 2 - t, jnp.asarray(2.0), th))(4.0), 0.25, rtol=1e-12)
+
+
+def test_split_derivative_continuation_matches_newton_through_a_scan():
+    # a continuation of x^3 + a x = t over t, solved frozen in a scan and attached
+    # after it: values, jacfwd and grad (with respect to the traced closure value a and
+    # the scanned t) equal those of newton_solve inside the scan
+    ts = jnp.linspace(0.5, 3.0, 6)
+
+    def F(x, t, a):
+        return x ** 3 + a * x - t
+
+    def by_newton(a, ts):
+        def step(x, t):
+            s = newton_solve(lambda z, tt: F(z, tt, a), x, t)
+            return s.x, s.x
+        return jax.lax.scan(step, jnp.asarray(0.5), ts)[1]
+
+    def by_split(a, ts):
+        frozen, attach = split_derivative(lambda z, tt: F(z, tt, a), jnp.asarray(0.5), ts[0])
+
+        def step(x, t):
+            s = newton_solve(frozen, x, t)
+            return s.x, s.x
+        xs = jax.lax.scan(step, jnp.asarray(0.5), jax.lax.stop_gradient(ts))[1]
+        return jax.vmap(attach)(xs, ts)
+
+    a = 1.3
+    np.testing.assert_allclose(by_split(a, ts), by_newton(a, ts), rtol=1e-14)
+    for argnums in (0, 1):
+        np.testing.assert_allclose(jax.jacfwd(by_split, argnums)(a, ts),
+                                   jax.jacfwd(by_newton, argnums)(a, ts), rtol=1e-12)
+    g = jax.grad(lambda a, ts: jnp.sum(by_split(a, ts) ** 2), (0, 1))(a, ts)
+    h = 1e-6
+    fd = (jnp.sum(by_split(a + h, ts) ** 2) - jnp.sum(by_split(a - h, ts) ** 2)) / (2 * h)
+    np.testing.assert_allclose(g[0], fd, rtol=1e-8)
+    # dx/dt = 1/(3x^2 + a) at each root, closed form
+    xs = by_split(a, ts)
+    np.testing.assert_allclose(jnp.diag(jax.jacfwd(by_split, 1)(a, ts)), 1 / (3 * xs ** 2 + a),
+                               rtol=1e-12)
+    # frozen cuts every derivative through the closure
+    assert float(jax.grad(lambda b: split_derivative(lambda z, tt: F(z, tt, b), jnp.asarray(0.5),
+                                                     1.0)[0](1.0, 1.0))(a)) == 0.0

@@ -127,7 +127,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from gearjax.frames import matrix_z
-from gearjax.newton import newton_solve
+from gearjax.newton import newton_solve, split_derivative
 from gearjax.tca.corners import (CORNER_GIVE_UP, CORNER_TOL, corner_end, corner_leads,
                                  corner_slope, pose)
 from gearjax.tca.path import (ContactPath, contact_system, flank_at, relative_to_start,
@@ -279,18 +279,24 @@ def _continue(F, z0, thetas, fresh, restart, n_homotopy, tol, max_steps, give_up
     failed in a row: its remaining steps are marked not converged and solve the trivial
     ``z - z_prev = 0`` instead (one Newton step), so that a lost candidate does not keep
     the candidates solved beside it in the same ``vmap`` iterating to ``max_steps``
-    (their Newton loops run as long as the slowest)."""
+    (their Newton loops run as long as the slowest).
+
+    The scan runs without derivatives; those of its roots are attached after it
+    (:func:`gearjax.newton.split_derivative`, as :func:`gearjax.tca.path.solve_grid`)."""
+    sg = jax.lax.stop_gradient
+    th0 = jax.tree.map(lambda a: a[0], thetas)
+    G_frozen, attach = split_derivative(_give_up_system(F), z0, (th0, z0, jnp.asarray(False)))
 
     def step(carry, inp):
         x_prev, x_prev2, x_home, ok_h, fails = carry
         theta, new, again, i = inp
         x_prev = jnp.where(again, x_home, x_prev)
         fails = jnp.where(again, 0, fails)
-        linear = jax.lax.stop_gradient(2.0 * x_prev - x_prev2)
+        linear = 2.0 * x_prev - x_prev2
         pred = jnp.where(new, x_prev, linear)
         dead = give_up & ((fails >= CORNER_GIVE_UP) | ((i >= n_homotopy) & ~ok_h))
 
-        sol = newton_solve(_give_up_system(F), pred, (theta, jax.lax.stop_gradient(pred), dead),
+        sol = newton_solve(G_frozen, pred, (theta, pred, dead),
                            tol=tol, max_steps=max_steps, natural_monotonicity=True,
                            noise_floor=True)
         ok = sol.converged & ~dead
@@ -299,12 +305,13 @@ def _continue(F, z0, thetas, fresh, restart, n_homotopy, tol, max_steps, give_up
         fails = jnp.where(i >= n_homotopy, jnp.where(ok, 0, fails + 1), 0)
         x_new = jnp.where(ok, sol.x, x_prev)
         x_home = jnp.where(i == n_homotopy - 1, x_new, x_home)
-        return (x_new, x_prev, x_home, ok_h, fails), sol
+        return (x_new, x_prev, x_home, ok_h, fails), (sol, pred, dead)
 
     idx = jnp.arange(fresh.shape[0])
-    _, sols = jax.lax.scan(step, (z0, z0, z0, jnp.asarray(True), jnp.asarray(0)),
-                           (thetas, fresh, restart, idx))
-    return sols
+    z0 = sg(z0)
+    _, (sols, preds, deads) = jax.lax.scan(
+        step, (z0, z0, z0, jnp.asarray(True), jnp.asarray(0)), (sg(thetas), fresh, restart, idx))
+    return sols._replace(x=jax.vmap(attach)(sols.x, (thetas, preds, deads)))
 
 
 def face_end_contact(r1: Callable, r2: Callable, asm, mis, path: ContactPath, margin,

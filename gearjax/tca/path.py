@@ -69,7 +69,7 @@ import numpy as np
 
 from gearjax.frames import matrix_z
 from gearjax.errors import ConvergenceError, check_int, check_range, require_converged
-from gearjax.newton import newton_solve
+from gearjax.newton import newton_solve, split_derivative
 from gearjax.tca.assembly import Assembly, Misalignment, gear_mount, rotation_about  # re-exported
 from gearjax.tca.multi_pair import MultiPair, multi_pair, pair_arrays  # re-exported
 from gearjax.surfaces import GeneratedSurface, local_geometry, unit_normal
@@ -228,18 +228,24 @@ def solve_grid(F, x_prev, x_prev2, phis, tol, max_steps):
     together, passed to ``F`` as its parameter): each solve starts from the linear
     predictor ``2 x_prev - x_prev2`` of the two previous points of the path.  A step
     that fails keeps ``x_prev`` and drops the predictor (``x_prev2 = x_prev``) for the
-    next step."""
+    next step.
+
+    The scan runs without derivatives; those of its roots are attached after it, one
+    implicit-function rule per root (:func:`gearjax.newton.split_derivative`): a
+    gradient then neither traces nor compiles the scan's linearisation."""
+    sg = jax.lax.stop_gradient
+    F_frozen, attach = split_derivative(F, x_prev, jax.tree.map(lambda a: a[0], phis))
 
     def step(carry, phi):
         x_prev, x_prev2 = carry
-        pred = jax.lax.stop_gradient(2.0 * x_prev - x_prev2)
-        sol = newton_solve(F, pred, phi, tol=tol, max_steps=max_steps,
+        pred = 2.0 * x_prev - x_prev2
+        sol = newton_solve(F_frozen, pred, phi, tol=tol, max_steps=max_steps,
                            natural_monotonicity=True, noise_floor=True)
         ok = sol.converged
         return (jnp.where(ok, sol.x, x_prev), x_prev), sol
 
-    _, sols = jax.lax.scan(step, (x_prev, x_prev2), phis)
-    return sols
+    _, sols = jax.lax.scan(step, (sg(x_prev), sg(x_prev2)), sg(phis))
+    return sols._replace(x=jax.vmap(attach)(sols.x, phis))
 
 
 _solve_grid = solve_grid
