@@ -28,6 +28,11 @@ zero tangents through ``F``.  An eager call (outside any trace, parameters concr
 arrays) runs as one ``jax.jit`` program cached on ``F`` (by identity) and the
 options: a module-level ``F`` is traced and compiled once per process.
 
+:func:`implicit_solution` attaches the same rule to a root found by another route, and
+:func:`split_derivative` splits it off a continuation: the ``lax.scan`` of solves runs
+without derivatives and each root gets its derivative after the scan (one ``vmap``),
+so that a gradient does not linearise the scan and its Newton loop.
+
 Every solve returns a :class:`NewtonResult` with the residual norm
 ``max|F(x)|``, the number of Newton steps and a ``converged`` flag
 (finite, residual <= ``tol``).  Nothing here raises on non-convergence — that is
