@@ -208,6 +208,8 @@ def test_implicit_solution_attaches_the_derivative_of_a_root_found_elsewhere():
     # the rule is evaluated at the x given: d sqrt(t)/dt = 1/(2 x) = 0.25 at x = 2
     np.testing.assert_allclose(jax.grad(lambda th: implicit_solution(
         lambda z, t: z ** 2 - t, jnp.asarray(2.0), th))(4.0), 0.25, rtol=1e-12)
+    # and no derivative flows into x itself
+    assert float(jax.grad(lambda x: implicit_solution(lambda z, t: z ** 2 - t, x, 4.0))(2.0)) == 0.0
 
 
 def test_split_derivative_continuation_matches_newton_through_a_scan():
