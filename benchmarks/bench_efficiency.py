@@ -13,6 +13,10 @@ forward measured in the same process.
 
 ``--fast-compile`` adds both routes jitted with ``compiler_options =
 gearjax.FAST_COMPILE_OPTIONS`` (the command line's XLA options for one program).
+
+Every route starts cold: ``jax.clear_caches()`` first, so that its first call traces,
+lowers and compiles everything it runs (a route does not reuse the trace of the
+nested programs, or of the whole function, that an earlier route made).
 """
 
 from __future__ import annotations
@@ -61,6 +65,7 @@ def main():
         routes += [("forward, FAST_COMPILE_OPTIONS", jax.jit(eta, **fast)),
                    ("gradient, FAST_COMPILE_OPTIONS", jax.jit(grad, **fast))]
     for label, fn in routes:
+        jax.clear_caches()
         t = time.perf_counter()
         jax.block_until_ready(fn(*a))
         tc = time.perf_counter() - t

@@ -167,18 +167,17 @@ def elliptic_KD(t):
     t = jnp.asarray(t, float)
     kp = jnp.exp(-t)
     m = -jnp.expm1(-2.0 * t)
-    a = jnp.ones_like(kp)
-    b = kp
-    s = jnp.ones_like(kp)
-    w = 0.5
-    total = w * s
-    for _ in range(_AGM_STEPS):
+    one = jnp.ones_like(kp)
+
+    def step(_, c):             # a loop, not unrolled: one body in the compiled program
+        a, b, s, w, total = c
         a_new = 0.5 * (a + b)
-        b = jnp.sqrt(a * b)
         s = s * s * m / (16.0 * a_new * a_new)
-        a = a_new
         w = 2.0 * w
-        total = total + w * s
+        return a_new, jnp.sqrt(a * b), s, w, total + w * s
+
+    a, _, _, _, total = jax.lax.fori_loop(0, _AGM_STEPS, step, (one, kp, one, 0.5 * one,
+                                                                 0.5 * one))
     K = 0.5 * jnp.pi / a
     return K, K * total
 
@@ -248,14 +247,14 @@ def _t_start(log_ratio):
 
 
 def _t_iterate(log_ratio):
-    """Fixed Newton steps on (1): no loop, no line search (the residual is smooth and
-    increasing in t with slope between 3/2 at the circle and 2 as k → ∞)."""
-    t = _t_start(log_ratio)
-    for _ in range(_T_STEPS):
+    """Fixed Newton steps on (1), a loop of fixed length, no line search (the residual
+    is smooth and increasing in t with slope between 3/2 at the circle and 2 as k → ∞)."""
+    def step(_, t):
         r, dr = _ratio_residual_and_slope(t, log_ratio)
         dt = -r / dr
-        t = t + jnp.where(jnp.isfinite(dt), jnp.clip(dt, -4.0, 4.0), 0.0)
-    return t
+        return t + jnp.where(jnp.isfinite(dt), jnp.clip(dt, -4.0, 4.0), 0.0)
+
+    return jax.lax.fori_loop(0, _T_STEPS, step, _t_start(log_ratio))
 
 
 def hertz_exact(F, Rx, Ry, E_prime):

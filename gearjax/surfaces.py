@@ -45,8 +45,8 @@ import jax.numpy as jnp
 from gearjax.newton import NewtonResult, newton_solve
 
 __all__ = [
-    "tangents", "unit_normal", "fundamental_forms", "weingarten", "LocalGeometry",
-    "local_geometry", "principal_curvatures", "normal_curvature", "geodesic_torsion",
+    "tangents", "unit_normal", "point_and_normal", "fundamental_forms", "weingarten",
+    "LocalGeometry", "local_geometry", "principal_curvatures", "normal_curvature", "geodesic_torsion",
     "curvature_in_direction", "meshing_function", "solve_envelope", "GeneratedSurface",
 ]
 
@@ -65,9 +65,24 @@ def tangents(r: Callable, uv):
 
 def unit_normal(r: Callable, uv):
     """Unit normal ``(r_u x r_v)/|r_u x r_v|`` (orientation follows the parametrisation)."""
-    ru, rv = tangents(r, uv)
-    N = jnp.cross(ru, rv)
-    return N / jnp.linalg.norm(N)
+    return point_and_normal(r, uv)[1]
+
+
+def _with_value(f):
+    """``f`` returning its value twice: ``jacfwd(.., has_aux=True)`` then gives the
+    Jacobian and the value of one forward-mode pass (the value is not traced, nor
+    compiled, a second time)."""
+    def g(*args):
+        y = f(*args)
+        return y, y
+    return g
+
+
+def point_and_normal(r: Callable, uv):
+    """``(r(uv), unit_normal(r, uv))`` from one forward-mode pass."""
+    J, p = jax.jacfwd(_with_value(r), has_aux=True)(jnp.asarray(uv, float))
+    N = jnp.cross(J[:, 0], J[:, 1])
+    return p, N / jnp.linalg.norm(N)
 
 
 def fundamental_forms(r: Callable, uv):
@@ -147,14 +162,18 @@ def local_geometry(r: Callable, uv) -> LocalGeometry:
     if isinstance(r, GeneratedSurface):
         return _generated_local_geometry(r, uv)
     uv = jnp.asarray(uv, float)
-    J = jax.jacfwd(r)(uv)
+
+    def nfun(q):                # the normal, with the point and tangents of its pass
+        J, p = jax.jacfwd(_with_value(r), has_aux=True)(q)
+        N = jnp.cross(J[:, 0], J[:, 1])
+        n = N / jnp.linalg.norm(N)
+        return n, (J, p, n)
+
+    Jn, (J, p, n) = jax.jacfwd(nfun, has_aux=True)(uv)
     ru, rv = J[:, 0], J[:, 1]
-    N = jnp.cross(ru, rv)
-    n = N / jnp.linalg.norm(N)
-    Jn = jax.jacfwd(_normal_fn(r))(uv)
     W = Jn @ jnp.linalg.solve(J.T @ J, J.T)
     k1, k2, e1, e2 = _principal_from_W(n, W, ru)
-    return LocalGeometry(r(uv), n, ru, rv, W, k1, k2, e1, e2)
+    return LocalGeometry(p, n, ru, rv, W, k1, k2, e1, e2)
 
 
 def principal_curvatures(r: Callable, uv):
@@ -189,27 +208,40 @@ def geodesic_torsion(r: Callable, uv, t):
 
 # --------------------------------------------------------------------------- envelopes
 
-def meshing_function(family: Callable, uv, psi):
+def _tool_at(family: Callable, uv, psi, normal=None):
+    """``(r_w, n_w, dr_w/dpsi)`` of the tool family at ``(uv, psi)``: the point, its unit
+    normal at fixed ``psi`` (``r_u x r_v/|r_u x r_v|``) and the relative velocity, from
+    one forward-mode pass.  ``normal(uv, psi)``, where given, is that normal in closed
+    form: the pass then needs the ``psi`` direction only."""
+    uv = jnp.asarray(uv, float)
+    psi = jnp.asarray(psi, float)
+    if normal is not None:
+        r, v = jax.jvp(lambda p: family(uv, p), (psi,), (jnp.ones_like(psi),))
+        return r, normal(uv, psi), v
+    (J, v), r = jax.jacfwd(_with_value(family), argnums=(0, 1), has_aux=True)(uv, psi)
+    N = jnp.cross(J[:, 0], J[:, 1])
+    return r, N / jnp.linalg.norm(N), v
+
+
+def meshing_function(family: Callable, uv, psi, normal: Callable | None = None):
     """Envelope (meshing) function ``f = n_w . dr_w/dpsi`` (mm per rad of ``psi``).
 
     ``family(uv, psi) -> (3,)`` is the tool surface in the workpiece frame at motion
-    parameter ``psi``; ``n_w`` is its unit normal at fixed ``psi``.
+    parameter ``psi``; ``n_w`` is its unit normal at fixed ``psi`` (by autodiff, or
+    ``normal(uv, psi)`` where the tool's normal is known in closed form).
     """
-    uv = jnp.asarray(uv, float)
-    # one forward-mode pass for the tangents and the relative velocity
-    J, v = jax.jacfwd(family, argnums=(0, 1))(uv, jnp.asarray(psi, float))
-    N = jnp.cross(J[:, 0], J[:, 1])
-    n = N / jnp.linalg.norm(N)
+    _, n, v = _tool_at(family, uv, psi, normal)
     return jnp.dot(n, v)
 
 
-def solve_envelope(family: Callable, uv, psi0, **newton_options) -> NewtonResult:
+def solve_envelope(family: Callable, uv, psi0, normal: Callable | None = None,
+                   **newton_options) -> NewtonResult:
     """Solve the meshing equation ``f(uv, psi) = 0`` for ``psi`` near ``psi0``.
 
     Returns the :class:`~gearjax.newton.NewtonResult` for ``psi`` (differentiable
     with respect to ``uv`` and anything ``family`` closes over).
     """
-    return newton_solve(lambda psi, q: meshing_function(family, q, psi), psi0,
+    return newton_solve(lambda psi, q: meshing_function(family, q, psi, normal), psi0,
                         jnp.asarray(uv, float), **newton_options)
 
 
@@ -220,6 +252,11 @@ class GeneratedSurface:
     ----------
     family : ``family(uv, psi) -> (3,)`` tool surface in the workpiece frame (mm).
     psi0 : initial guess for the motion parameter: a number or a callable ``psi0(uv)``.
+    normal : optional ``normal(uv, psi) -> (3,)``: the tool's unit normal at fixed
+        ``psi`` in closed form, equal to ``r_u x r_v/|r_u x r_v|`` of ``family`` (with
+        its orientation and its derivatives with respect to everything it closes
+        over); the meshing function and :meth:`at` then differentiate the family in
+        ``psi`` only (a smaller program).  Default: by autodiff.
     newton_options : forwarded to :func:`gearjax.newton.newton_solve`.
 
     Calling the object returns the generated point; ``solve(uv)`` returns the
@@ -229,9 +266,11 @@ class GeneratedSurface:
     every function of this module (curvatures differentiate through the solve).
     """
 
-    def __init__(self, family: Callable, psi0, **newton_options):
+    def __init__(self, family: Callable, psi0, *, normal: Callable | None = None,
+                 **newton_options):
         self.family = family
         self.psi0 = psi0
+        self.normal = normal
         self.newton_options = newton_options
 
     def _psi0(self, uv):
@@ -245,7 +284,7 @@ class GeneratedSurface:
 
     def _solve(self, uv) -> NewtonResult:
         return solve_envelope(self.family, uv, jax.lax.stop_gradient(self._psi0(uv)),
-                              **self.newton_options)
+                              self.normal, **self.newton_options)
 
     def __call__(self, uv):
         uv = jnp.asarray(uv, float)
@@ -264,7 +303,9 @@ class GeneratedSurface:
 
     def _point_normal(self, uv):
         psi = self._solve(uv).x
-        return self.family(uv, psi), unit_normal(lambda q: self.family(q, psi), uv)
+        if self.normal is not None:
+            return self.family(uv, psi), self.normal(uv, psi)
+        return point_and_normal(lambda q: self.family(q, psi), uv)
 
     def at(self, uv, psi):
         """``(point, tool normal, meshing residual)`` at a *given* motion parameter
@@ -276,8 +317,8 @@ class GeneratedSurface:
         uv = jnp.asarray(uv, float)
         psi = jnp.asarray(psi, float)
         if _cacheable(self):
-            return _surface_at_jit("at", self.family, uv, psi)
-        return _at_impl(self.family, uv, psi)
+            return _surface_at_jit("at", self.family, uv, psi, self.normal)
+        return _at_impl(self.family, uv, psi, self.normal)
 
     def local_geometry_at(self, uv, psi) -> "LocalGeometry":
         """:func:`local_geometry` of the generated surface at ``uv`` given the solved
@@ -307,18 +348,19 @@ class GeneratedSurface:
 
 def _cacheable(surf) -> bool:
     P = jax.tree_util.Partial
-    return isinstance(surf.family, P) and (isinstance(surf.psi0, P) or not callable(surf.psi0))
+    return (isinstance(surf.family, P) and (isinstance(surf.psi0, P) or not callable(surf.psi0))
+            and (surf.normal is None or isinstance(surf.normal, P)))
 
 
 def _cached(what, surf, uv):
     psi0 = surf.psi0 if callable(surf.psi0) else jnp.asarray(surf.psi0, float)
     opts = tuple(sorted(surf.newton_options.items()))
-    return _surface_jit(what, opts, surf.family, psi0, uv)
+    return _surface_jit(what, opts, surf.family, psi0, uv, surf.normal)
 
 
 @partial(jax.jit, static_argnums=(0, 1))
-def _surface_jit(what, opts, family, psi0, uv):
-    surf = GeneratedSurface(family, psi0, **dict(opts))
+def _surface_jit(what, opts, family, psi0, uv, normal):
+    surf = GeneratedSurface(family, psi0, normal=normal, **dict(opts))
     if what == "solve":
         return surf._solve(uv)
     if what == "point_normal":
@@ -326,17 +368,15 @@ def _surface_jit(what, opts, family, psi0, uv):
     return _generated_local_geometry_impl(surf, uv)
 
 
-def _at_impl(family, uv, psi):
-    J, v = jax.jacfwd(family, argnums=(0, 1))(uv, psi)
-    N = jnp.cross(J[:, 0], J[:, 1])
-    n = N / jnp.linalg.norm(N)
-    return family(uv, psi), n, jnp.dot(n, v)
+def _at_impl(family, uv, psi, normal=None):
+    r, n, v = _tool_at(family, uv, psi, normal)
+    return r, n, jnp.dot(n, v)
 
 
 @partial(jax.jit, static_argnums=(0,))
-def _surface_at_jit(what, family, uv, psi):
+def _surface_at_jit(what, family, uv, psi, normal=None):
     if what == "at":
-        return _at_impl(family, uv, psi)
+        return _at_impl(family, uv, psi, normal)
     return _generated_local_geometry_at(GeneratedSurface(family, 0.0), uv, psi)
 
 
@@ -374,12 +414,12 @@ def _generated_local_geometry_at(surf: GeneratedSurface, uv, psi) -> LocalGeomet
         return surf.family(z[:2], z[2])
 
     def nf(z):
-        Jz = jax.jacfwd(g)(z)
+        Jz, r = jax.jacfwd(_with_value(g), has_aux=True)(z)
         N = jnp.cross(Jz[:, 0], Jz[:, 1])
         nt = N / jnp.linalg.norm(N)
-        return jnp.concatenate([nt, jnp.stack([jnp.dot(nt, Jz[:, 2])])]), (Jz, nt)
+        return jnp.concatenate([nt, jnp.stack([jnp.dot(nt, Jz[:, 2])])]), (Jz, nt, r)
 
-    D, (Jz, nt) = jax.jacfwd(nf, has_aux=True)(z)      # (4, 3): d(n_t, f)/dz
+    D, (Jz, nt, r) = jax.jacfwd(nf, has_aux=True)(z)      # (4, 3): d(n_t, f)/dz
     psi_uv = -D[3, :2] / D[3, 2]
     J = Jz[:, :2] + jnp.outer(Jz[:, 2], psi_uv)
     ru, rv = J[:, 0], J[:, 1]
@@ -389,4 +429,4 @@ def _generated_local_geometry_at(surf: GeneratedSurface, uv, psi) -> LocalGeomet
     Jn = sgn * (D[:3, :2] + jnp.outer(D[:3, 2], psi_uv))
     W = Jn @ jnp.linalg.solve(J.T @ J, J.T)
     k1, k2, e1, e2 = _principal_from_W(n, W, ru)
-    return LocalGeometry(surf.family(uv, psi), n, ru, rv, W, k1, k2, e1, e2)
+    return LocalGeometry(r, n, ru, rv, W, k1, k2, e1, e2)

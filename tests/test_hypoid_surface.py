@@ -375,3 +375,64 @@ def test_factored_machine_chain_equals_the_full_chain(example):
             np.testing.assert_allclose(np.asarray(body), ref - [0.0, 0.0, 7.5], atol=1e-12)
     # 8/43: generated pinion, formate gear; spiral bevel 10/30: both generated
     assert kinds == ({True, False} if example == "hft_8x43" else {True})
+
+
+def test_closed_form_tool_normal_equals_the_autodiff_normal():
+    """The closed-form normal the TCA's generated flanks carry
+    (gearjax.gears.hypoid.flank.body_normal, the ``normal`` of their GeneratedSurface)
+    against ``r_u x r_v/|r_u x r_v|`` of the tool family by autodiff, at random points
+    and rolls on every generated flank of the 10/30 spiral bevel and the 8/43 hypoid
+    pinion: the values (orientation included), their derivatives by ``(uv, psi)`` (the
+    Newton Jacobians of the contact solves) and by every float field of the flank,
+    the cutter's sign among them (the gradients of the efficiency).  A sign,
+    orientation or normalisation slip, or a formula that agrees only at a real blade
+    (``|sgn| = 1``), fails.  Then ``GeneratedSurface.at`` and its meshing residual with
+    and without the closed form.  Round-off: measured <= 2e-15 (values), tolerance 1e-12."""
+    from gearjax.gears.hypoid.flank import body_family, body_normal, machine_chain
+    from gearjax.surfaces import GeneratedSurface
+
+    def autodiff_normal(k, uv, psi):
+        J = jax.jacfwd(lambda q: body_family(k, jnp.zeros(3), q, psi))(uv)
+        N = jnp.cross(J[:, 0], J[:, 1])
+        return N / jnp.linalg.norm(N)
+
+    rng = np.random.default_rng(11)
+    n_checked = 0
+    for example in ("spiral_bevel_10x30_synthesised", "hft_8x43"):
+        d = load_design(f"example:{example}")
+        for member, flank in FLANKS:
+            fl = d.flank(member, flank)
+            if not fl.machine.generated:
+                continue
+            leaves, tdef = jax.tree_util.tree_flatten(fl)
+            idx = [i for i, v in enumerate(leaves) if np.issubdtype(np.asarray(v).dtype, np.floating)]
+
+            def by_fields(vals, uv, psi, which):
+                L = list(leaves)
+                for j, i in enumerate(idx):
+                    L[i] = vals[j]
+                k = machine_chain(jax.tree_util.tree_unflatten(tdef, L))
+                return body_normal(k, uv, psi) if which else autodiff_normal(k, uv, psi)
+
+            vals = [jnp.asarray(leaves[i], float) for i in idx]
+            k = machine_chain(fl)
+            for _ in range(3):
+                uv = jnp.array([rng.uniform(-0.5, 0.5), rng.uniform(0.5, 12.0)])
+                psi = jnp.asarray(rng.uniform(-0.4, 0.4))
+                np.testing.assert_allclose(body_normal(k, uv, psi), autodiff_normal(k, uv, psi),
+                                           atol=1e-12)
+                for arg in (0, 1):
+                    a = jax.jacfwd(body_normal, argnums=arg + 1)(k, uv, psi)
+                    b = jax.jacfwd(autodiff_normal, argnums=arg + 1)(k, uv, psi)
+                    np.testing.assert_allclose(a, b, atol=1e-12)
+                ja = jax.jacfwd(by_fields)(vals, uv, psi, True)
+                jb = jax.jacfwd(by_fields)(vals, uv, psi, False)
+                for x, y in zip(ja, jb):
+                    np.testing.assert_allclose(x, y, atol=1e-12)
+                fam = jax.tree_util.Partial(body_family, k, jnp.zeros(3))
+                with_n = GeneratedSurface(fam, 0.0, normal=jax.tree_util.Partial(body_normal, k))
+                plain = GeneratedSurface(fam, 0.0)
+                for x, y in zip(with_n.at(uv, psi), plain.at(uv, psi)):
+                    np.testing.assert_allclose(x, y, atol=1e-12)
+                n_checked += 1
+    assert n_checked >= 12            # both generated flanks of three members, 3 points each

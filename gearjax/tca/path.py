@@ -72,7 +72,7 @@ from gearjax.errors import ConvergenceError, check_int, check_range, require_con
 from gearjax.newton import newton_solve, split_derivative
 from gearjax.tca.assembly import Assembly, Misalignment, gear_mount, rotation_about  # re-exported
 from gearjax.tca.multi_pair import MultiPair, multi_pair, pair_arrays  # re-exported
-from gearjax.surfaces import GeneratedSurface, local_geometry, unit_normal
+from gearjax.surfaces import GeneratedSurface, local_geometry, point_and_normal
 
 __all__ = ["pair_arrays", "Misalignment", "Assembly", "contact_equations", "contact_system", "ContactSystem",
            "local_geometry_on", "point_normal", "flank_at", "path_tangent", "relative_to_start",
@@ -220,7 +220,7 @@ def point_normal(surf, uv):
     uv = jnp.asarray(uv, float)
     if isinstance(surf, GeneratedSurface):
         return surf.point_normal(uv)
-    return surf(uv), unit_normal(surf, uv)
+    return point_and_normal(surf, uv)
 
 
 def solve_grid(F, x_prev, x_prev2, phis, tol, max_steps):
@@ -281,8 +281,7 @@ def path_tangent(F, x, phi):
     continuation step."""
     x = jax.lax.stop_gradient(x)
     phi = jax.lax.stop_gradient(phi)
-    J = jax.jacfwd(F)(x, phi)
-    _, F_phi = jax.jvp(lambda p: F(x, p), (phi,), (jnp.ones_like(phi),))
+    J, F_phi = jax.jacfwd(F, (0, 1))(x, phi)          # one forward-mode pass
     return -jnp.linalg.solve(J, F_phi)
 
 

@@ -51,7 +51,8 @@ from gearjax.fields import floats_for_ints
 
 __all__ = ["FaceMillCutter", "make_cutter", "cutter_point", "cutter_normal",
            "cutter_tangents", "fillet_start", "fillet_point", "fillet_normal",
-           "blade_radius", "blade_data", "cone_radius", "cone_point", "cone_normal"]
+           "blade_radius", "blade_data", "cone_radius", "cone_point", "cone_normal",
+           "cone_surface_normal"]
 
 
 @functools.partial(jax.tree_util.register_dataclass,
@@ -146,6 +147,20 @@ def cone_normal(blade, theta):
     ``(sgn cos(alpha) cos(theta), sgn cos(alpha) sin(theta), -sin(alpha))``."""
     return jnp.stack([blade[3] * jnp.cos(theta), blade[3] * jnp.sin(theta),
                       -blade[4] * jnp.ones_like(theta)])
+
+
+def cone_surface_normal(blade, s, theta):
+    """Unit normal ``r_theta x r_s/|r_theta x r_s|`` of :func:`cone_point` in the
+    order of its parameters ``uv = (theta, s)``, in closed form:
+
+        r_theta x r_s = -rho (b2 cos(theta), b2 sin(theta), -b1),   rho = R_p - b1 s,
+
+    with ``b1 = sgn sin(alpha)``, ``b2 = cos(alpha)`` (``blade`` from :func:`blade_data`;
+    any values of ``b1``, ``b2``, so that its derivatives by them are those of the
+    autodiff normal).  ``-sgn`` times :func:`cone_normal` for a real blade."""
+    b1, b2 = blade[1], blade[2]
+    m = -jnp.sign(cone_radius(blade, s)) / jnp.sqrt(b1 * b1 + b2 * b2)
+    return jnp.stack([m * b2 * jnp.cos(theta), m * b2 * jnp.sin(theta), -m * b1])
 
 
 def blade_radius(c: FaceMillCutter, s):

@@ -58,7 +58,8 @@ import numpy as np
 from gearjax import frames
 from gearjax.fields import float64_array, floats_for_ints
 from gearjax.gears.hypoid.cutter import (FaceMillCutter, blade_data, cone_normal, cone_point,
-                                         cutter_normal, cutter_point, fillet_start)
+                                         cone_surface_normal, cutter_normal, cutter_point,
+                                         fillet_start)
 from gearjax.errors import check_int, check_positive, check_range, require_converged
 from gearjax.gears.hypoid.machine import (MachineSettings, cutter_to_cradle, cutter_to_work,
                                           work_to_machine)
@@ -158,7 +159,7 @@ def root_apex_offset(b: MemberBlank):
 def axial_coords(r):
     """(x_A, R_A): axial coordinate from the pitch apex and radius of work-frame point(s)."""
     r = jnp.asarray(r)
-    return r[..., 2], jnp.sqrt(r[..., 0] ** 2 + r[..., 1] ** 2)
+    return r[..., 2], jnp.sqrt(jnp.sum(r[..., :2] ** 2, axis=-1))
 
 
 def pitch_distance(b: MemberBlank, r):
@@ -250,9 +251,17 @@ def machine_chain(fl: FlankSpec) -> MachineChain:
 
 
 def _plane_rotation(angle, v):
-    """``Rz(angle) v`` for one vector (3,)."""
+    """``Rz(angle) v`` for one vector (3,), as the row sums of ``Rz * v``: the solves
+    differentiate this to third order inside ``vmap``, where each element written out
+    (``c v_x - s v_y``, ...) would become its own chain of slices, broadcasts and
+    products in the compiled program (same values; a smaller program).  Not ``Rz @ v``:
+    that product, smaller still, lost every coast contact of the synthesised spiral
+    bevel under :data:`gearjax.FAST_COMPILE_OPTIONS` (XLA's CPU backend at
+    optimisation level 0), while the default options solved them."""
     c, s = jnp.cos(angle), jnp.sin(angle)
-    return jnp.stack([c * v[0] - s * v[1], s * v[0] + c * v[1], v[2]])
+    z, o = jnp.zeros_like(c), jnp.ones_like(c)
+    R = jnp.stack([jnp.stack([c, -s, z]), jnp.stack([s, c, z]), jnp.stack([z, z, o])])
+    return jnp.sum(R * v, axis=1)
 
 
 def _chain(k: MachineChain, v, psi, translate: bool):
@@ -289,6 +298,14 @@ def body_family(k: MachineChain, shift, uv, psi):
     jit caches are shared by every flank function built from it
     (:func:`gearjax.gears.hypoid.pair.flank_function`)."""
     return chain_point(k, uv, psi) - shift
+
+
+def body_normal(k: MachineChain, uv, psi):
+    """Unit normal of :func:`body_family` at fixed ``psi`` in closed form: the cone's
+    parametric normal (:func:`~gearjax.gears.hypoid.cutter.cone_surface_normal`) carried
+    by the chain's rotations, equal to ``r_u x r_v/|r_u x r_v|`` of the family (the
+    ``normal`` of its :class:`~gearjax.surfaces.GeneratedSurface`)."""
+    return _chain(k, cone_surface_normal(k.blade, uv[1], uv[0]), psi, False)
 
 
 def body_point(k: MachineChain, shift, uv):

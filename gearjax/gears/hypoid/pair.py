@@ -246,7 +246,7 @@ def with_point_radius(fl: FlankSpec, d_radius, theta_m) -> FlankSpec:
 def flank_function(fl: FlankSpec, crossing):
     """Flank ``uv = (theta, s) -> (3,)`` in the member's body frame (origin at the
     crossing point): a GeneratedSurface for a generated member, else the placed cone."""
-    from gearjax.gears.hypoid.flank import body_family, body_point, machine_chain
+    from gearjax.gears.hypoid.flank import body_family, body_normal, body_point, machine_chain
     shift = jnp.stack([0.0, 0.0, jnp.asarray(crossing, float)])
     # Partials of module-level functions (pytrees): every flank function built here
     # shares one set of jit caches (gearjax.surfaces, "trace once"); the machine
@@ -254,6 +254,7 @@ def flank_function(fl: FlankSpec, crossing):
     k = machine_chain(fl)
     if fl.machine.generated:
         return GeneratedSurface(jax.tree_util.Partial(body_family, k, shift), 0.0,
+                                normal=jax.tree_util.Partial(body_normal, k),
                                 tol=1e-12, max_steps=30)
     return jax.tree_util.Partial(body_point, k, shift)
 
