@@ -29,6 +29,10 @@ parameter is ``dr_w/dpsi`` (autodiff) and the meshing (envelope) equation is
 The generated surface is the implicit function ``uv -> r_w(uv, psi*(uv))`` with
 ``psi*`` from :func:`gearjax.newton.newton_solve`; its curvatures come from
 differentiating through that solution (implicit function theorem, to any order).
+A tool whose unit normal is known in closed form may hand it over
+(``GeneratedSurface(..., normal=)``, e.g. a blade cone carried by a machine): the
+meshing function then differentiates the family in ``psi`` only; the caller tests
+that normal against the autodiff one.
 
 Reference: do Carmo, *Differential Geometry of Curves and Surfaces*, ch. 3;
 Litvin & Fuentes, *Gear Geometry and Applied Theory*, 2nd ed., ch. 6–8.
@@ -46,8 +50,9 @@ from gearjax.newton import NewtonResult, newton_solve
 
 __all__ = [
     "tangents", "unit_normal", "point_and_normal", "fundamental_forms", "weingarten",
-    "LocalGeometry", "local_geometry", "principal_curvatures", "normal_curvature", "geodesic_torsion",
-    "curvature_in_direction", "meshing_function", "solve_envelope", "GeneratedSurface",
+    "LocalGeometry", "local_geometry", "principal_curvatures", "normal_curvature",
+    "geodesic_torsion", "curvature_in_direction", "meshing_function", "solve_envelope",
+    "GeneratedSurface",
 ]
 
 

@@ -389,7 +389,7 @@ def test_closed_form_tool_normal_equals_the_autodiff_normal():
     (``|sgn| = 1``), fails.  Then ``GeneratedSurface.at`` and its meshing residual with
     and without the closed form.  Round-off: measured <= 2e-15 (values), tolerance 1e-12."""
     from gearjax.gears.hypoid.flank import body_family, body_normal, machine_chain
-    from gearjax.surfaces import GeneratedSurface
+    from gearjax.surfaces import GeneratedSurface, local_geometry, unit_normal
 
     def autodiff_normal(k, uv, psi):
         J = jax.jacfwd(lambda q: body_family(k, jnp.zeros(3), q, psi))(uv)
@@ -405,7 +405,8 @@ def test_closed_form_tool_normal_equals_the_autodiff_normal():
             if not fl.machine.generated:
                 continue
             leaves, tdef = jax.tree_util.tree_flatten(fl)
-            idx = [i for i, v in enumerate(leaves) if np.issubdtype(np.asarray(v).dtype, np.floating)]
+            idx = [i for i, v in enumerate(leaves)
+                   if np.issubdtype(np.asarray(v).dtype, np.floating)]
 
             def by_fields(vals, uv, psi, which):
                 L = list(leaves)
@@ -434,5 +435,14 @@ def test_closed_form_tool_normal_equals_the_autodiff_normal():
                 plain = GeneratedSurface(fam, 0.0)
                 for x, y in zip(with_n.at(uv, psi), plain.at(uv, psi)):
                     np.testing.assert_allclose(x, y, atol=1e-12)
+                # the point and normal of the envelope at the solved roll, both routes
+                for x, y in zip(with_n.point_normal(uv), plain.point_normal(uv)):
+                    np.testing.assert_allclose(x, y, atol=1e-12)
+                # the local geometry's normal is the envelope's r_u x r_v (by autodiff
+                # through the envelope solve), not the tool's, in orientation too
+                g = local_geometry(with_n, uv)
+                n_env = unit_normal(with_n, uv)
+                np.testing.assert_allclose(g.n, n_env, atol=1e-10)
+                np.testing.assert_allclose(g.r, with_n(uv), atol=1e-12)
                 n_checked += 1
     assert n_checked >= 12            # both generated flanks of three members, 3 points each
