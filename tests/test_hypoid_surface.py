@@ -417,7 +417,7 @@ def test_closed_form_tool_normal_equals_the_autodiff_normal():
 
             vals = [jnp.asarray(leaves[i], float) for i in idx]
             k = machine_chain(fl)
-            for _ in range(3):
+            for _ in range(2):
                 uv = jnp.array([rng.uniform(-0.5, 0.5), rng.uniform(0.5, 12.0)])
                 psi = jnp.asarray(rng.uniform(-0.4, 0.4))
                 np.testing.assert_allclose(body_normal(k, uv, psi), autodiff_normal(k, uv, psi),
@@ -445,4 +445,4 @@ def test_closed_form_tool_normal_equals_the_autodiff_normal():
                 np.testing.assert_allclose(g.n, n_env, atol=1e-10)
                 np.testing.assert_allclose(g.r, with_n(uv), atol=1e-12)
                 n_checked += 1
-    assert n_checked >= 12            # both generated flanks of three members, 3 points each
+    assert n_checked >= 12            # both generated flanks of three members, 2 points each
