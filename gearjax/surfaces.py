@@ -122,11 +122,15 @@ class LocalGeometry(NamedTuple):
     e2: jnp.ndarray
 
 
-def _normal_fn(r):
+def _normal_and_first_order(r):
+    """``uv -> (n, (J, r(uv), n))``: the unit normal with the Jacobian and point of its
+    own forward-mode pass as ``jacfwd(..., has_aux=True)``'s aux, so that ``dn/duv``,
+    the tangents and the point come from one pass."""
     def nfun(uv):
-        J = jax.jacfwd(r)(uv)
+        J, p = jax.jacfwd(_with_value(r), has_aux=True)(uv)
         N = jnp.cross(J[:, 0], J[:, 1])
-        return N / jnp.linalg.norm(N)
+        n = N / jnp.linalg.norm(N)
+        return n, (J, p, n)
     return nfun
 
 
@@ -136,8 +140,7 @@ def weingarten(r: Callable, uv):
     ``W = [n_u n_v] (J^T J)^{-1} J^T`` with ``J = [r_u r_v]``.
     """
     uv = jnp.asarray(uv, float)
-    J = jax.jacfwd(r)(uv)
-    Jn = jax.jacfwd(_normal_fn(r))(uv)
+    Jn, (J, _, _) = jax.jacfwd(_normal_and_first_order(r), has_aux=True)(uv)
     return Jn @ jnp.linalg.solve(J.T @ J, J.T)
 
 
@@ -167,14 +170,7 @@ def local_geometry(r: Callable, uv) -> LocalGeometry:
     if isinstance(r, GeneratedSurface):
         return _generated_local_geometry(r, uv)
     uv = jnp.asarray(uv, float)
-
-    def nfun(q):                # the normal, with the point and tangents of its pass
-        J, p = jax.jacfwd(_with_value(r), has_aux=True)(q)
-        N = jnp.cross(J[:, 0], J[:, 1])
-        n = N / jnp.linalg.norm(N)
-        return n, (J, p, n)
-
-    Jn, (J, p, n) = jax.jacfwd(nfun, has_aux=True)(uv)
+    Jn, (J, p, n) = jax.jacfwd(_normal_and_first_order(r), has_aux=True)(uv)
     ru, rv = J[:, 0], J[:, 1]
     W = Jn @ jnp.linalg.solve(J.T @ J, J.T)
     k1, k2, e1, e2 = _principal_from_W(n, W, ru)

@@ -258,10 +258,7 @@ def _plane_rotation(angle, v):
     that product, smaller still, lost every coast contact of the synthesised spiral
     bevel under :data:`gearjax.FAST_COMPILE_OPTIONS` (XLA's CPU backend at
     optimisation level 0), while the default options solved them."""
-    c, s = jnp.cos(angle), jnp.sin(angle)
-    z, o = jnp.zeros_like(c), jnp.ones_like(c)
-    R = jnp.stack([jnp.stack([c, -s, z]), jnp.stack([s, c, z]), jnp.stack([z, z, o])])
-    return jnp.sum(R * v, axis=1)
+    return jnp.sum(frames.matrix_z(angle) * v, axis=1)
 
 
 def _chain(k: MachineChain, v, psi, translate: bool):
