@@ -75,13 +75,46 @@ class NewtonResult(NamedTuple):
     converged: Any
 
 
-def _jacobian(f, x):
-    """``df/dx`` (n x n) of ``f: (n,) -> (n,)`` by forward mode; one ``jvp`` for n = 1
-    (a scalar solve -- the envelope of a generated flank -- is the innermost and most
-    often repeated; ``jacfwd`` would wrap it in a batch of one)."""
+def _value_and_jacobian(f, x):
+    """``(f(x), df/dx)`` (n, n x n) of ``f: (n,) -> (n,)`` from one forward-mode pass
+    (the value is the primal of the same ``jvp``: one trace of ``f``, not two); one
+    ``jvp`` for n = 1 (a scalar solve -- the envelope of a generated flank -- is the
+    innermost and most often repeated; ``jacfwd`` would wrap it in a batch of one)."""
     if x.shape[0] == 1:
-        return jnp.reshape(jax.jvp(f, (x,), (jnp.ones_like(x),))[1], (1, 1))
-    return jax.jacfwd(f)(x)
+        y, t = jax.jvp(f, (x,), (jnp.ones_like(x),))
+        return y, jnp.reshape(t, (1, 1))
+
+    def f_aux(x):
+        y = f(x)
+        return y, y
+    J, y = jax.jacfwd(f_aux, has_aux=True)(x)
+    return y, J
+
+
+def _jacobian(f, x):
+    """``df/dx`` (n x n) of ``f: (n,) -> (n,)`` (:func:`_value_and_jacobian`)."""
+    return _value_and_jacobian(f, x)[1]
+
+
+def _factor(J):
+    """LU factors ``(lu, permutation)`` of ``J`` for :func:`_factored_solve` (a 1 x 1
+    system: ``J`` itself).  Inside the Newton loop only (not differentiated): one
+    factorisation serves the step and every line-search correction."""
+    if J.shape[0] == 1:
+        return J
+    lu, _, perm = jax.lax.linalg.lu(J)
+    return lu, perm
+
+
+def _factored_solve(fac, b):
+    """``J^-1 b`` from :func:`_factor`: ``L U x = P b`` by two triangular solves."""
+    if not isinstance(fac, tuple):
+        return b / fac[0, 0]
+    lu, perm = fac
+    y = jax.lax.linalg.triangular_solve(lu, b[perm][None, :], left_side=False, lower=True,
+                                        transpose_a=True, unit_diagonal=True)
+    return jax.lax.linalg.triangular_solve(lu, y, left_side=False, lower=False,
+                                           transpose_a=True)[0]
 
 
 def _lin_solve(J, b):
@@ -102,20 +135,31 @@ def _loop(F, tol, xtol, max_steps, max_halvings, ls, x0, theta):
         return jnp.reshape(F(jnp.reshape(x, shape), theta), (-1,))
 
     x = jnp.reshape(x0, (-1,))
-    fx = f(x)
-    res0 = jnp.max(jnp.abs(fx))
-    if fx.shape != x.shape:
-        raise ValueError(f"F must return as many equations as unknowns: got {fx.shape[0]} "
-                         f"equations for {x.shape[0]} unknowns")
+
+    def residual(fx):
+        if fx.shape != x.shape:
+            raise ValueError(f"F must return as many equations as unknowns: got "
+                             f"{fx.shape[0]} equations for {x.shape[0]} unknowns")
+        r = jnp.max(jnp.abs(fx))
+        return jnp.where(jnp.isfinite(r), r, jnp.inf)
+
+    if max_steps <= 0:
+        res = residual(f(x))
+        return jnp.reshape(x, shape), res, jnp.asarray(0), jnp.all(jnp.isfinite(x)) & (
+            res <= tol)
 
     def cond(state):
-        x, fx, res, k, done = state
+        x, res, k, done = state
         return (k < max_steps) & jnp.logical_not(done)
 
     def body(state):
-        x, fx, res, k, _ = state
-        J = _jacobian(f, x)
-        dx = _lin_solve(J, -fx)
+        x, _, k, _ = state
+        # the residual at x and the Jacobian from one forward-mode pass: ``F`` is
+        # traced here and in the line search, not a third time before the loop
+        fx, J = _value_and_jacobian(f, x)
+        res = residual(fx)
+        fac = _factor(J)
+        dx = _factored_solve(fac, -fx)
         ok = jnp.all(jnp.isfinite(dx))
         dx = jnp.where(ok, dx, 0.0)
 
@@ -129,42 +173,42 @@ def _loop(F, tol, xtol, max_steps, max_halvings, ls, x0, theta):
             jnp.max(jnp.abs(dx)) <= xtol * (1.0 + jnp.max(jnp.abs(x))))
 
         def ls_cond(s):
-            alpha, xn, fn, rn, theta_n, i = s
+            alpha, xn, rn, theta_n, i = s
             good = rn <= (1.0 - 1e-4 * alpha) * res
             if natural:
                 good = good | (theta_n <= (1.0 - 0.25 * alpha) * dx_norm)
             return (i < 0) | ((i < max_halvings) & jnp.logical_not(good | at_floor))
 
         def ls_body(s):
-            alpha, _, _, _, _, i = s
+            alpha, _, _, _, i = s
             alpha = 0.5 * alpha
             xn = x + alpha * dx
             fn = f(xn)
-            rn = jnp.max(jnp.abs(fn))
-            rn = jnp.where(jnp.isfinite(rn), rn, jnp.inf)
+            rn = residual(fn)
             if natural:
                 # Deuflhard's natural monotonicity test: the simplified Newton
                 # correction J(x)^-1 F(x_new) is shorter than the step
-                theta_n = jnp.linalg.norm(_lin_solve(J, fn))
+                theta_n = jnp.linalg.norm(_factored_solve(fac, fn))
                 theta_n = jnp.where(jnp.isfinite(theta_n), theta_n, jnp.inf)
             else:
                 theta_n = jnp.asarray(jnp.inf, x.dtype)
-            return alpha, xn, fn, rn, theta_n, i + 1
+            return alpha, xn, rn, theta_n, i + 1
 
-        alpha, xn, fn, rn, _, _ = jax.lax.while_loop(
-            ls_cond, ls_body, (jnp.asarray(2.0, x.dtype), x, fx, res,
+        alpha, xn, rn, _, _ = jax.lax.while_loop(
+            ls_cond, ls_body, (jnp.asarray(2.0, x.dtype), x, res,
                                jnp.asarray(jnp.inf, x.dtype), -1))
         step = jnp.max(jnp.abs(alpha * dx))
         small = step <= xtol * (1.0 + jnp.max(jnp.abs(xn)))
         done = jnp.logical_not(ok) | ((rn <= tol) & small) | (rn == 0.0)
         # a failed step (singular Jacobian) leaves x where it was
         xn = jnp.where(ok, xn, x)
-        fn = jnp.where(ok, fn, fx)
         rn = jnp.where(ok, rn, res)
-        return xn, fn, rn, k + 1, done
+        return xn, rn, k + 1, done
 
-    init = (x, fx, jnp.where(jnp.isfinite(res0), res0, jnp.inf), jnp.asarray(0), jnp.asarray(False))
-    x, fx, res, k, _ = jax.lax.while_loop(cond, body, init)
+    # (the residual of the state is that of its x after each step; max_steps >= 1,
+    # so the loop's first pass replaces this initial one)
+    init = (x, jnp.asarray(jnp.inf, x.dtype), jnp.asarray(0), jnp.asarray(False))
+    x, res, k, _ = jax.lax.while_loop(cond, body, init)
     converged = jnp.all(jnp.isfinite(x)) & jnp.isfinite(res) & (res <= tol)
     return jnp.reshape(x, shape), res, k, converged
 

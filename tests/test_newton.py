@@ -122,6 +122,31 @@ def test_line_search_rescues_overshoot():
         assert int(res.steps) == 1
 
 
+def _count_primitive(jaxpr, name):
+    n = 0
+    for eqn in jaxpr.eqns:
+        n += eqn.primitive.name == name
+        for v in eqn.params.values():
+            for sub in (v if isinstance(v, (tuple, list)) else (v,)):
+                inner = getattr(sub, "jaxpr", sub)
+                if hasattr(inner, "eqns"):
+                    n += _count_primitive(inner, name)
+    return n
+
+
+def test_a_solve_evaluates_its_system_in_two_places():
+    """The loop body gets F(x) as the primal of the Jacobian's forward-mode pass, so F
+    appears twice in a solve's program (that pass and the line search), not a third time
+    for a start residual before the loop: in a TCA each appearance is a flank
+    evaluation to trace and compile.  ``atan`` marks F's evaluations (its derivative
+    has none)."""
+    F = lambda x, th: jnp.stack([jnp.arctan(x[0]) - th[0], x[1] - th[1]])  # noqa: E731
+    jaxpr = jax.make_jaxpr(lambda th: newton_solve(F, jnp.array([0.1, 0.2]), th).x)(TH)
+    assert _count_primitive(jaxpr.jaxpr, "atan") == 2
+    sol = newton_solve(F, jnp.array([0.1, 0.2]), jnp.array([0.3, -0.4]))
+    np.testing.assert_allclose(sol.x, [np.tan(0.3), -0.4], rtol=1e-14)
+
+
 def test_mismatched_system_rejected():
     with pytest.raises(ValueError):
         newton_solve(lambda x, th: jnp.stack([x[0], x[1], x[0]]), jnp.zeros(2), ())

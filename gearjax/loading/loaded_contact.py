@@ -300,14 +300,16 @@ def pair_compliance(teeth: MeshTeeth, r_x, load_per_width, model: str = "weber",
                                       alpha_n=0.5 * (al[0] + al[1])).c_prime
         return 1e-3 / (c1 * (E / E_STEEL) * teeth.width)
 
-    def tooth(i):
-        g = tooth_geometry(z[i], teeth.module, al[i], x[i], teeth.ha[i], teeth.hf[i])
-        r = jnp.clip(teeth.r_load[i], g.r_form, g.r_a)
-        return jax.vmap(lambda ri: tooth_compliance(ri, z[i], teeth.module, al[i], x[i],
-                                                    teeth.ha[i], teeth.hf[i], E=E,
-                                                    nu=nu))(r)
+    def tooth(zi, ai, xi, hai, hfi, r_load):
+        g = tooth_geometry(zi, teeth.module, ai, xi, hai, hfi)
+        r = jnp.clip(r_load, g.r_form, g.r_a)
+        return jax.vmap(lambda ri: tooth_compliance(ri, zi, teeth.module, ai, xi, hai, hfi,
+                                                    E=E, nu=nu))(r)
 
-    t1, t2 = tooth(0), tooth(1)
+    # both members in one vmap: the compliance model is traced (and compiled) once
+    both = jax.vmap(tooth)(*(jnp.broadcast_to(jnp.asarray(a, float), (2,) + jnp.shape(a)[1:])
+                             for a in (z, al, x, teeth.ha, teeth.hf, teeth.r_load)))
+    t1, t2 = (jax.tree.map(lambda a, i=i: a[i], both) for i in (0, 1))
     q = (t1.total + t2.total) / teeth.width
     if teeth.line_length is not None:
         # Weber's body depths: from the contact point to each tooth's centre line

@@ -233,8 +233,9 @@ def _fillet_base(g: ToothGeometry):
     lo, hi = jax.lax.fori_loop(0, 60, body, (jax.lax.stop_gradient(lo0),
                                              jax.lax.stop_gradient(hi0)))
     t = jax.lax.stop_gradient(0.5 * (lo + hi))
-    slope = jax.lax.stop_gradient(jax.grad(lambda tt: fillet_point(g, tt)[0])(t))
-    return t - xf(t) / slope
+    # the value and the slope from one forward-mode pass (one evaluation of the fillet)
+    x_t, slope = jax.jvp(xf, (t,), (jnp.ones_like(t),))
+    return t - x_t / jax.lax.stop_gradient(slope)
 
 
 # ---------------------------------------------------------------------------------
@@ -348,14 +349,14 @@ def tooth_compliance(r_load, z, m, alpha, x=0.0, ha=1.0, hf=1.25, rho_f=0.38,
     # fillet part: t from t0 (x = r_f) to the junction (x increases as t decreases)
     t0 = _fillet_base(g)
     tn, tw = _gauss(g.t_junction, t0)
-    fx, fy = fillet_point(g, tn)
-    _, dfx = jax.jvp(lambda tt: fillet_point(g, tt)[0], (tn,), (jnp.ones_like(tn),))
+    # points and their x-derivatives from one forward-mode pass each
+    (fx, fy), (dfx, _) = jax.jvp(lambda tt: fillet_point(g, tt), (tn,), (jnp.ones_like(tn),))
     wf = -tw * dfx                        # integrate from x = r_f upward
     # involute part: roll angle from the form circle to the load point
     eps_f = jnp.sqrt((g.r_form / g.r_b) ** 2 - 1.0)
     en, ew = _gauss(eps_f, eps_m)
-    ix, iy = involute_point(g, en)
-    _, dix = jax.jvp(lambda ee: involute_point(g, ee)[0], (en,), (jnp.ones_like(en),))
+    (ix, iy), (dix, _) = jax.jvp(lambda ee: involute_point(g, ee), (en,),
+                                 (jnp.ones_like(en),))
     wi = ew * dix
 
     xs = jnp.concatenate([fx, ix])

@@ -233,8 +233,16 @@ def solve_grid(F, x_prev, x_prev2, phis, tol, max_steps):
     The scan runs without derivatives; those of its roots are attached after it, one
     implicit-function rule per root (:func:`gearjax.newton.split_derivative`): a
     gradient then neither traces nor compiles the scan's linearisation."""
-    sg = jax.lax.stop_gradient
     F_frozen, attach = split_derivative(F, x_prev, jax.tree.map(lambda a: a[0], phis))
+    sols = _continue_frozen(F_frozen, x_prev, x_prev2, phis, tol, max_steps)
+    return sols._replace(x=jax.vmap(attach)(sols.x, phis))
+
+
+def _continue_frozen(F_frozen, x_prev, x_prev2, phis, tol, max_steps):
+    """The scan of :func:`solve_grid` on a system cut from differentiation
+    (``F_frozen`` of :func:`gearjax.newton.split_derivative`); roots without
+    derivatives."""
+    sg = jax.lax.stop_gradient
 
     def step(carry, phi):
         x_prev, x_prev2 = carry
@@ -245,7 +253,7 @@ def solve_grid(F, x_prev, x_prev2, phis, tol, max_steps):
         return (jnp.where(ok, sol.x, x_prev), x_prev), sol
 
     _, sols = jax.lax.scan(step, (sg(x_prev), sg(x_prev2)), sg(phis))
-    return sols._replace(x=jax.vmap(attach)(sols.x, phis))
+    return sols
 
 
 _solve_grid = solve_grid
@@ -454,21 +462,27 @@ def contact_path(r1: Callable, r2: Callable, asm: Assembly, mis: Misalignment, p
     # it; the first step of each starts from the tangent predictor at the reference
     # (a virtual previous point one grid step behind it), later steps from the
     # linear predictor of the two previous points
-    ref = newton_solve(cs.F, z0, phi1[mid], tol=tol, max_steps=max_steps,
+    # every solve runs without derivatives (``F_frozen``); those of the roots, the
+    # reference included, are attached after the scans in one ``vmap``
+    # (:func:`solve_grid`): one implicit-function rule in the program, not two
+    sg = jax.lax.stop_gradient
+    F_frozen, attach = split_derivative(cs.F, z0, phi1[mid])
+    ref = newton_solve(F_frozen, z0, sg(phi1[mid]), tol=tol, max_steps=max_steps,
                        natural_monotonicity=True)
-    tangent = path_tangent(cs.F, ref.x, phi1[mid])
-    seqs = jnp.stack([phi1[mid + 1:], phi1[:mid][::-1]])
-    behind = ref.x[None, :] - (seqs[:, :1] - phi1[mid]) * tangent[None, :]
-    sols = jax.vmap(lambda x2, s: solve_grid(cs.F, ref.x, x2, s, tol, max_steps))(behind, seqs)
+    tangent = path_tangent(F_frozen, ref.x, phi1[mid])
+    seqs = sg(jnp.stack([phi1[mid + 1:], phi1[:mid][::-1]]))
+    behind = ref.x[None, :] - (seqs[:, :1] - sg(phi1[mid])) * tangent[None, :]
+    sols = jax.vmap(lambda x2, s: _continue_frozen(F_frozen, ref.x, x2, s, tol, max_steps))(
+        behind, seqs)
 
     def whole(two_ways, at_ref):
         return jnp.concatenate([two_ways[1][::-1], at_ref[None], two_ways[0]], axis=0)
 
-    Z = whole(sols.x, ref.x)
+    Z = jax.vmap(attach)(whole(sols.x, ref.x), phi1)
     conv, res = relative_to_start(whole(sols.converged, ref.converged),
                                   whole(sols.residual, ref.residual), ref.converged,
                                   ref.residual)
-    ref_x = cs.split(ref.x)[0]
+    ref_x = cs.split(Z[mid])[0]
 
     def post(z, ph1):
         x, psi1, psi2 = cs.split(z)
