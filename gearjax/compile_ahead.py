@@ -27,8 +27,9 @@ command line's XLA options, for one program.
 
 Inside a trace (``jax.jit``, ``jax.grad`` of a :func:`gearjax.tca_function`) there is
 nothing to compile ahead: :meth:`CompileAhead.submit` returns None and the caller
-runs its stages inline in that trace (:func:`gearjax.tca.family._result`).  A compilation that fails ahead is not reported here: the
-concrete call that follows compiles again and raises the error where it belongs.
+runs its stages inline in that trace (:func:`gearjax.tca.family._result`).  A
+compilation that fails ahead is not reported here: the concrete call that follows
+compiles again and raises the error where it belongs.
 """
 
 from __future__ import annotations
