@@ -200,14 +200,21 @@ def test_a_traced_tca_runs_its_stages_inline():
     programs a concrete run compiles: ``grad`` would trace each nested program and then
     transform its jaxpr again, and partial evaluation across their boundaries kept
     residuals it drops inline (the hypoid efficiency gradient was 7 % larger).  Planted
-    bug caught: the driver calling its jitted programs inside a trace."""
+    bug caught: the driver calling its jitted programs inside a trace, or handing the
+    inline stages its arguments in another order than the programs (the coast side
+    traced as the drive side: the jitted coast path against the concrete one)."""
     des = _toy()
-    f = gj.tca_function(des, side="drive", kinematics=False)
-    jaxpr = jax.make_jaxpr(
-        lambda dE: f(des, gj.Misalignment(dE, 0.0 * dE, 0.0 * dE, 0.0 * dE)).path.phi2)(0.0)
+    f = gj.tca_function(des, side="coast", kinematics=False)
+
+    def phi2(dE):
+        return f(des, gj.Misalignment(dE, 0.0 * dE, 0.0 * dE, 0.0 * dE)).path.phi2
+
+    jaxpr = jax.make_jaxpr(phi2)(0.0)
     names = _call_names(jaxpr.jaxpr, set())
     assert not names & {"_surface_program", "_finish_program"}, names
     assert jaxpr.out_avals[0].shape[0] > 3        # the path itself was traced
+    concrete = f(des).path
+    np.testing.assert_allclose(jax.jit(phi2)(0.0), concrete.phi2, rtol=0, atol=1e-12)
 
 
 def test_an_option_given_as_none_takes_the_family_default(toy_runs):

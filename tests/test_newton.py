@@ -147,6 +147,19 @@ def test_a_solve_evaluates_its_system_in_two_places():
     np.testing.assert_allclose(sol.x, [np.tan(0.3), -0.4], rtol=1e-14)
 
 
+def test_zero_steps_reports_the_start_as_it_is():
+    """``max_steps=0``: no iteration, the start returned with its own residual -- a start
+    that is a root is converged, one that is not is flagged."""
+    root = newton_solve(cube_root_system, exact(TH), TH, max_steps=0)
+    assert bool(root.converged) and int(root.steps) == 0
+    np.testing.assert_array_equal(root.x, exact(TH))
+    off = newton_solve(cube_root_system, jnp.array([1.0, 1.0]), TH, max_steps=0)
+    assert not bool(off.converged) and int(off.steps) == 0
+    np.testing.assert_array_equal(off.x, [1.0, 1.0])
+    np.testing.assert_allclose(float(off.residual), np.max(np.abs(
+        np.asarray(cube_root_system(jnp.array([1.0, 1.0]), TH)))), rtol=1e-15)
+
+
 def test_mismatched_system_rejected():
     with pytest.raises(ValueError):
         newton_solve(lambda x, th: jnp.stack([x[0], x[1], x[0]]), jnp.zeros(2), ())
