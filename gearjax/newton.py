@@ -75,6 +75,16 @@ class NewtonResult(NamedTuple):
     converged: Any
 
 
+def with_value(f):
+    """``f`` returning its value twice: ``jacfwd(.., has_aux=True)`` then gives the
+    Jacobian and the value of one forward-mode pass (the value is not traced, nor
+    compiled, a second time; also :mod:`gearjax.surfaces`)."""
+    def g(*args):
+        y = f(*args)
+        return y, y
+    return g
+
+
 def _value_and_jacobian(f, x):
     """``(f(x), df/dx)`` (n, n x n) of ``f: (n,) -> (n,)`` from one forward-mode pass
     (the value is the primal of the same ``jvp``: one trace of ``f``, not two); one
@@ -83,11 +93,7 @@ def _value_and_jacobian(f, x):
     if x.shape[0] == 1:
         y, t = jax.jvp(f, (x,), (jnp.ones_like(x),))
         return y, jnp.reshape(t, (1, 1))
-
-    def f_aux(x):
-        y = f(x)
-        return y, y
-    J, y = jax.jacfwd(f_aux, has_aux=True)(x)
+    J, y = jax.jacfwd(with_value(f), has_aux=True)(x)
     return y, J
 
 

@@ -46,7 +46,7 @@ from typing import Callable, NamedTuple
 import jax
 import jax.numpy as jnp
 
-from gearjax.newton import NewtonResult, newton_solve
+from gearjax.newton import NewtonResult, with_value, newton_solve
 
 __all__ = [
     "tangents", "unit_normal", "point_and_normal", "fundamental_forms", "weingarten",
@@ -73,19 +73,9 @@ def unit_normal(r: Callable, uv):
     return point_and_normal(r, uv)[1]
 
 
-def _with_value(f):
-    """``f`` returning its value twice: ``jacfwd(.., has_aux=True)`` then gives the
-    Jacobian and the value of one forward-mode pass (the value is not traced, nor
-    compiled, a second time)."""
-    def g(*args):
-        y = f(*args)
-        return y, y
-    return g
-
-
 def point_and_normal(r: Callable, uv):
     """``(r(uv), unit_normal(r, uv))`` from one forward-mode pass."""
-    J, p = jax.jacfwd(_with_value(r), has_aux=True)(jnp.asarray(uv, float))
+    J, p = jax.jacfwd(with_value(r), has_aux=True)(jnp.asarray(uv, float))
     N = jnp.cross(J[:, 0], J[:, 1])
     return p, N / jnp.linalg.norm(N)
 
@@ -127,7 +117,7 @@ def _normal_and_first_order(r):
     own forward-mode pass as ``jacfwd(..., has_aux=True)``'s aux, so that ``dn/duv``,
     the tangents and the point come from one pass."""
     def nfun(uv):
-        J, p = jax.jacfwd(_with_value(r), has_aux=True)(uv)
+        J, p = jax.jacfwd(with_value(r), has_aux=True)(uv)
         N = jnp.cross(J[:, 0], J[:, 1])
         n = N / jnp.linalg.norm(N)
         return n, (J, p, n)
@@ -219,7 +209,7 @@ def _tool_at(family: Callable, uv, psi, normal=None):
     if normal is not None:
         r, v = jax.jvp(lambda p: family(uv, p), (psi,), (jnp.ones_like(psi),))
         return r, normal(uv, psi), v
-    (J, v), r = jax.jacfwd(_with_value(family), argnums=(0, 1), has_aux=True)(uv, psi)
+    (J, v), r = jax.jacfwd(with_value(family), argnums=(0, 1), has_aux=True)(uv, psi)
     N = jnp.cross(J[:, 0], J[:, 1])
     return r, N / jnp.linalg.norm(N), v
 
@@ -415,7 +405,7 @@ def _generated_local_geometry_at(surf: GeneratedSurface, uv, psi) -> LocalGeomet
         return surf.family(z[:2], z[2])
 
     def nf(z):
-        Jz, r = jax.jacfwd(_with_value(g), has_aux=True)(z)
+        Jz, r = jax.jacfwd(with_value(g), has_aux=True)(z)
         N = jnp.cross(Jz[:, 0], Jz[:, 1])
         nt = N / jnp.linalg.norm(N)
         return jnp.concatenate([nt, jnp.stack([jnp.dot(nt, Jz[:, 2])])]), (Jz, nt, r)
