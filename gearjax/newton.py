@@ -331,9 +331,14 @@ def split_derivative(F: Callable, x, theta):
     x = jnp.asarray(x, dtype=jnp.result_type(float))
     converted, consts = jax.closure_convert(lambda z, th: F(z, th), x, theta)
     consts = tuple(consts)
+    # cut here, once, not inside ``frozen``: a scan or loop that calls ``frozen`` then
+    # closes over values without derivatives, and ``grad`` passes it by (cut inside,
+    # the values it closes over carry tangents: the whole scan was linearised, each
+    # tangent to be zeroed again inside)
+    frozen_consts = tuple(jax.lax.stop_gradient(c) for c in consts)
 
     def frozen(z, th):
-        return converted(z, th, *(jax.lax.stop_gradient(c) for c in consts))
+        return converted(z, th, *frozen_consts)
 
     def F_all(z, th_all):
         th, cs = th_all
