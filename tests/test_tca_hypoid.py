@@ -294,25 +294,29 @@ def test_misaligned_contact_points_coincide_in_the_fixed_frame(conjugate, point_
 
 def test_contact_velocity_from_curvatures_equals_the_implicit_derivative(conjugate,
                                                                          point_tca):
-    """The TCA's kinematics take the contact point's velocity and the gear speed at a
-    point contact from the flanks' curvatures (gearjax.tca.result.contact_velocity:
-    the equation of meshing, and Rodrigues' formula on both flanks).  Second route: the
-    implicit derivative of the nested contact equations ``dx/dphi1 = -F_x^-1 F_phi1``
-    (path_kinematics), on the misaligned localised drive pair (measured 2e-13 of the
+    """The TCA's kinematics (contact_kinematics) take the contact point's velocity and
+    the gear speed at a point contact from the flanks' curvatures
+    (gearjax.tca.result.contact_velocity: the equation of meshing, and Rodrigues'
+    formula on both flanks).  Second route: the implicit derivative of the nested
+    contact equations ``dx/dphi1 = -F_x^-1 F_phi1`` (path_kinematics), on the
+    misaligned localised drive pair (measured 2e-13 of the
     largest velocity, 3e-15 in the gear speed; tolerances 1e-10).  A wrong sign of
-    either rotation, of the normal's turn or of ``W2 v12`` moves every point."""
+    either rotation, of the normal's turn or of ``W2 v12``, or the two flanks' curvatures
+    swapped, moves every point.  (The route itself -- curvatures, not the Jacobian -- is
+    held by the cost guard: the lowered TCA's flops.)"""
     from gearjax.gears.hypoid.contact_kinematics import path_kinematics
-    from gearjax.tca.assembly import gear_mount
-    from gearjax.tca.result import contact_velocity
+    from gearjax.tca.result import contact_kinematics
     pair = _modified(conjugate, 2.0, 0.02)
     mis = Misalignment(*(jnp.asarray(v, float) for v in (0.05, 0.1, -0.1, 2e-4)))
     p = point_tca(pair, mis).path
     ref = path_kinematics(pair, p, mis)
-    R, c = gear_mount(th.hypoid_assembly(pair), mis)
-    vc, m21 = jax.jit(jax.vmap(lambda r, n, W1, W2, e: contact_velocity(r, n, W1, W2, e,
-                                                                        R[:, 2], c)))(
-        p.point, p.normal, p.weingarten1, p.weingarten2, p.major_dir)
-    ok = np.asarray(p.converged)
+    r1 = th.flank_function(pair.pinion, pair.pinion_crossing)
+    r2 = th.flank_function(pair.gear, pair.gear_crossing)
+    # the TCA's own kinematics (what run_tca reports), point contact: the curvature route
+    kin = jax.jit(lambda path: contact_kinematics(r1, r2, th.hypoid_assembly(pair), mis, path,
+                                                  line_contact=False))(p)
+    vc, m21 = kin.v_contact, kin.gear_ratio
+    ok = np.asarray(p.converged) & (np.asarray(p.edge_kind) < 0)
     assert ok.sum() >= 10
     v_ref = np.asarray(ref.v_contact)[ok]
     np.testing.assert_allclose(np.asarray(vc)[ok], v_ref, rtol=0,
