@@ -35,10 +35,11 @@ from the implicit derivative of the contact equations, ``dx/dphi1 = -F_x^-1 F_ph
 (:func:`contact_motion`).  The two routes agree to round-off (4e-12 of the largest
 value or better on every packaged point-contact example, misaligned too); the first
 needs no second derivatives of the flanks under ``grad``.  Surface velocities
-relative to the moving contact point, projected on the tangent plane: ``w_i = P (omega_i x (r - a_i) - v_c)``.  The
-*rolling direction* ``t`` is across the contact ellipse (``t = +-n x e_major``; for
-line contact: across the contact line), the direction of the line-contact EHL
-theory, oriented along the entrainment (``u_e >= 0``); along ``t``::
+relative to the moving contact point, projected on the tangent plane:
+``w_i = P (omega_i x (r - a_i) - v_c)``.  The *rolling direction* ``t`` is across the
+contact ellipse (``t = +-n x e_major``; for line contact: across the contact line),
+the direction of the line-contact EHL theory, oriented along the entrainment
+(``u_e >= 0``); along ``t``::
 
     u1 = w1 . t,   u2 = w2 . t,   u_e = (u1 + u2)/2,   u_s = u1 - u2,   SRR = u_s/u_e
 
