@@ -11,7 +11,8 @@ The chain (docs/architecture.md), each step a pure JAX function so that
                      -> kinematics at the contact points       TCAResult.kinematics
                      -> Hertz load, film, friction, losses     gearjax.tribology
                      -> load sharing, mesh efficiency          mesh_efficiency, efficiency_function
-                     -> objective -> gradient -> optimiser     minimize_optax, minimize_lbfgsb, ...
+                     -> objective -> gradient -> optimiser     minimize_constrained, minimize_optax, ...
+                     -> design studies (gearjax optimize)      gearjax.studies
 
 The public face is the ~40 names of ``gearjax.__all__`` (verbs and types of the chain,
 one per job), four family namespaces -- ``gearjax.hypoid``, ``gearjax.involute``,
@@ -40,6 +41,7 @@ from gearjax.tca.result import (SIDES, ContactKinematics, TCAResult, check_desig
                                 contact_kinematics, family_of)
 from gearjax.optimize import (LMResult, OptResult, least_squares_lm, minimize_lbfgsb,  # noqa: E402
                               minimize_optax, status_message)
+from gearjax.augmented_lagrangian import minimize_constrained  # noqa: E402
 from gearjax.io import design_from_dict, example_path, list_examples, load_design  # noqa: E402
 from gearjax.loading.loaded_contact import LoadedContact  # noqa: E402
 from gearjax.loading.mesh_efficiency import (MeshEfficiency, check_operating_point,  # noqa: E402
@@ -132,7 +134,8 @@ __all__ = [
     "mesh_efficiency", "efficiency_function", "MeshEfficiency", "LoadedContact", "Material",
     "pair_material", "check_operating_point", "efficiency_warnings", "efficiency_guard",
     # optimisers and solvers, their results and status
-    "minimize_optax", "minimize_lbfgsb", "least_squares_lm", "OptResult", "LMResult",
+    "minimize_optax", "minimize_lbfgsb", "minimize_constrained", "least_squares_lm",
+    "OptResult", "LMResult",
     "status_message", "newton_solve", "NewtonResult", "ConvergenceError", "NoContactError",
     # compile time: XLA options for jax.jit(..., compiler_options=...) on the CPU
     "FAST_COMPILE_OPTIONS",

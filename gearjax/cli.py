@@ -26,6 +26,8 @@ COMMANDS = [
     "gearjax.commands.kinematics",
     "gearjax.commands.tca",
     "gearjax.commands.efficiency",
+    "gearjax.commands.optimize",
+    "gearjax.commands.sensitivity",
 ]
 
 

@@ -11,7 +11,8 @@ import gearjax
 
 PKG = Path(gearjax.__file__).resolve().parent
 BACKBONE = {"frames", "newton", "surfaces", "kinematics", "tca", "contact", "loading",
-            "optimize", "io", "errors", "progress", "fields", "compile_ahead"}
+            "optimize", "augmented_lagrangian", "io", "errors", "progress", "fields",
+            "compile_ahead"}
 #: the loaded chain (loading/) stands on tribology/; the rest of the backbone below it
 ABOVE_TRIBOLOGY = {"loading"}
 

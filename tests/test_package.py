@@ -51,7 +51,7 @@ def test_readme_has_the_two_commands_and_ci_runs_the_test_command():
     blocks = re.findall(r"```bash\n(.*?)\n```", section, flags=re.S)
     assert len(blocks) == 2 and all("\n" not in b.strip() for b in blocks)
     main_job, tests = (b.strip() for b in blocks)
-    assert "pip install -e ." in main_job and "gearjax involute" in main_job
+    assert "pip install -e ." in main_job and "gearjax optimize example:" in main_job
     assert 'pip install -e ".[test]"' in tests and tests.endswith("python -m pytest -q")
     ci = open(os.path.join(ROOT, ".ci", "run"), encoding="utf-8").read()
     assert "python3 -m venv" in ci and 'pip install -q -e ".[test]" && python -m pytest -q' in ci

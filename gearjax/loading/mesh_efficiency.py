@@ -65,6 +65,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from gearjax.errors import check_range
 from gearjax.loading.efficiency_inputs import (RPM_RANGE, TORQUE_RANGE_NM, check_models,
                                                check_efficiency_inputs, check_operating_point)
 from gearjax.loading.loaded_contact import (LoadedContact, MeshTeeth, contact_stress,
@@ -219,7 +220,8 @@ def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, pinion_r
                            E_prime=STEEL_E_PRIME, poisson=NU_STEEL,
                            compliance: str = DEFAULT_COMPLIANCE,
                            viscosity_model: str = "roelands",
-                           film_method: str = "auto") -> MeshEfficiency:
+                           film_method: str = "auto",
+                           edge_softening_mm: float = 0.0) -> MeshEfficiency:
     """Loaded contact, friction and efficiency of the pair over one mesh cycle
     (traceable; no validation; module docstring).
 
@@ -229,6 +231,16 @@ def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, pinion_r
     ``omega1 = pinion_rpm pi/30`` rad/s inside).  ``E_prime`` (MPa) and ``poisson``:
     the material (module docstring); the tooth compliance takes
     ``E = E_prime (1 - poisson^2)`` and ``poisson``.
+
+    ``edge_softening_mm`` (``delta``, static; default 0: the hard model): the soft active
+    set of the design studies.  A pair whose contact lies within ``delta`` of a flank
+    boundary (margin ``m`` in mm) answers with its compliance divided by
+    ``s(m/delta)``, ``s(t) = 3t^2 - 2t^3`` on [0, 1]: its load falls to zero smoothly as
+    its contact reaches the boundary, instead of jumping from its share to nothing where
+    a grid position crosses the boundary -- the cycle means, maxima and loaded TE are
+    then continuous, with continuous gradients, in the design (a pair entering or
+    leaving contact; docs/optimize.md).  The model is unchanged wherever every loaded
+    contact is more than ``delta`` inside its flank.
     """
     path, kin = res.path, res.kinematics
     n = path.phi1.shape[0]
@@ -257,6 +269,10 @@ def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, pinion_r
         c0 = jnp.zeros_like(q0)
     else:
         c0 = hertz_coefficient(r_x0, r_y0, E_prime)
+    if edge_softening_mm > 0.0:
+        t = jnp.clip(jnp.where(on, res.margin, 0.0) / edge_softening_mm, 0.0, 1.0)
+        soft = jnp.maximum(t * t * (3.0 - 2.0 * t), 1e-30)
+        q0, c0 = q0 / soft, c0 / soft
 
     def pairs(a, fill):
         return pair_arrays(a, steps_per_pitch, K, fill, win)
@@ -343,7 +359,8 @@ def _grid_options(ad, design, tca_options: dict) -> dict:
 
 def efficiency_function(design, *, side=None, compliance: str = DEFAULT_COMPLIANCE,
                         E_prime=None, viscosity_model: str = "roelands",
-                        film_method: str = "auto", **tca_options):
+                        film_method: str = "auto", edge_softening_mm: float = 0.0,
+                        **tca_options):
     """A pure, traceable ``f(pair, torque_Nm, pinion_rpm, oil, surface, mis=None) ->
     (MeshEfficiency, TCAResult)`` of ``design`` for ``jax.grad``/``jit``/``vmap``.
 
@@ -359,6 +376,9 @@ def efficiency_function(design, *, side=None, compliance: str = DEFAULT_COMPLIAN
     ``tca_options`` as for :func:`gearjax.run_tca` (``steps_per_pitch``,
     ``half_pitches``, ``n_pairs``, ...).
 
+    ``edge_softening_mm``: the soft active set of :func:`mesh_efficiency_traced` (mm, >= 0;
+    0, the default, is the hard model of :func:`mesh_efficiency`).
+
     Concrete inputs are validated as by :func:`mesh_efficiency` (the design and the
     options here; ``pair``, torque, speed, oil and surface on every call of ``f`` with
     concrete values); traced values (under ``jit``/``grad``/``vmap``) are not.
@@ -369,6 +389,7 @@ def efficiency_function(design, *, side=None, compliance: str = DEFAULT_COMPLIAN
     mat = pair_material(design, E_prime)
     Ep, nu = float(mat.e_prime_MPa), float(mat.poisson)
     check_models(compliance, viscosity_model, film_method)
+    soft = check_range("edge_softening_mm", edge_softening_mm, 0.0, 10.0, unit="mm")
     check_design(design)
     ad = family_of(design)
     opts = _grid_options(ad, design, tca_options)
@@ -384,16 +405,22 @@ def efficiency_function(design, *, side=None, compliance: str = DEFAULT_COMPLIAN
                                 viscosity_model, film_method)
         check_design(pair)
         res = f_tca(pair, mis)
-        eff = mesh_efficiency_traced(res, teeth_of(pair, res), torque_Nm, pinion_rpm, oil,
-                                     surface, steps_per_pitch=spp, n_pairs=K, E_prime=Ep,
-                                     poisson=nu, compliance=compliance,
-                                     viscosity_model=viscosity_model, film_method=film_method)
-        return eff, res
+        return loaded(pair, res, torque_Nm, pinion_rpm, oil, surface), res
+
+    def loaded(pair, res, torque_Nm, pinion_rpm, oil, surface, edge_softening_mm=soft):
+        """The loaded part of ``f`` on a TCA result ``res`` of ``pair`` (``f`` = the TCA
+        then this); ``edge_softening_mm`` static (e.g. 0: the hard model)."""
+        return mesh_efficiency_traced(res, teeth_of(pair, res), torque_Nm, pinion_rpm, oil,
+                                      surface, steps_per_pitch=spp, n_pairs=K, E_prime=Ep,
+                                      poisson=nu, compliance=compliance,
+                                      viscosity_model=viscosity_model, film_method=film_method,
+                                      edge_softening_mm=edge_softening_mm)
 
     f.pair = pair0
+    f.loaded = loaded
     f.material = mat
     f.options = dict(opts, side=side, compliance=compliance, E_prime_MPa=Ep, poisson=nu,
-                     material_source=mat.source)
+                     material_source=mat.source, edge_softening_mm=soft)
     return f
 
 

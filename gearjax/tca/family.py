@@ -192,6 +192,32 @@ class GearFamily:
         or None (no edge contact solved)."""
         return None
 
+    # -- writing a design back ------------------------------------------------------
+    #: pair field -> (table, key, factor) of the design file: file value = field / factor
+    #: (e.g. a field in rad written as a ``*_deg`` key: factor pi/180)
+    file_fields: dict = {}
+
+    def design_data(self, design, pair, side: str) -> dict:
+        """The design file of ``design`` (dict, file units) with the concrete values of the
+        differentiable ``pair`` (:meth:`user_pair` of the set-up of ``side``) written back:
+        every field of :attr:`file_fields` whose value differs from the design's own.  A
+        field that changed and has no key is a ValueError naming it.  The caller reads
+        the dict back with :func:`gearjax.io.design_from_dict` (which validates it)."""
+        from gearjax.fields import get_fields
+        data = design.to_dict()
+        new = get_fields(pair)
+        old = get_fields(self.user_pair(self.setup(design, side)[0]))
+        for name, value in new.items():
+            v, v0 = float(np.asarray(value)), float(np.asarray(old[name]))
+            if v == v0:
+                continue
+            if name not in self.file_fields:
+                raise ValueError(f"field {name!r} of a {self.name} pair has no design-file key "
+                                 f"(writable: {', '.join(self.file_fields) or 'none'})")
+            table, key, factor = self.file_fields[name]
+            data.setdefault(table, {})[key] = v / factor
+        return data
+
     # -- summaries, loaded contact, plots -------------------------------------------
     summary_keys: tuple = ()
 
@@ -363,6 +389,10 @@ class DriverAdapter:
 
     def check(self, design) -> None:
         self.fam.check(self.fam.pair(design))
+
+    def design_data(self, design, pair, side: str = "drive") -> dict:
+        """:meth:`GearFamily.design_data`: ``design``'s file with ``pair`` written back."""
+        return self.fam.design_data(design, pair, check_side(side))
 
     def _reference(self, pair, side):
         # (None, None): found inside the program (the grid moves with the design)

@@ -71,7 +71,8 @@ from gearjax.io import check_string, dumps_toml, read_toml, register_design_kind
 from gearjax.io import require_key as _req
 
 __all__ = ["HypoidDesign", "load_design", "save_design", "design_from_dict", "defaults_applied",
-           "format_defaults", "cross_check", "CROSS_CHECK_RTOL", "MACHINE_DEFAULTS"]
+           "format_defaults", "cross_check", "CROSS_CHECK_RTOL", "MACHINE_DEFAULTS",
+           "flank_settings_table"]
 
 MEMBERS = ("pinion", "gear")
 FLANKS = ("convex", "concave")
@@ -458,3 +459,24 @@ def save_design(design: HypoidDesign, path) -> Path:
 
 for _kind in KINDS:     # gearjax.io.load_design dispatches on [design] kind
     register_design_kind(_kind, design_from_dict)
+
+
+def flank_settings_table(fl) -> dict:
+    """The design-file tables (``cutter``, ``machine``; file units mm and degrees) of a
+    member flank's cutter and machine settings (a :class:`~gearjax.gears.hypoid.flank.
+    FlankSpec`-like object with ``cutter`` and ``machine``; concrete values)."""
+    import numpy as np
+    c, m = fl.cutter, fl.machine
+    f = lambda a: float(np.asarray(a))
+    dg = lambda a: math.degrees(f(a))
+    return {"cutter": {"point_radius": f(c.point_radius), "blade_angle": dg(c.blade_angle),
+                       "edge_radius": f(c.edge_radius)},
+            "machine": {"type": "generated" if m.generated else "formate",
+                        "radial_distance": f(m.radial_distance), "cradle_angle": dg(m.cradle_angle),
+                        "tilt": dg(m.tilt), "swivel": dg(m.swivel),
+                        "blank_offset": f(m.blank_offset),
+                        "machine_root_angle": dg(m.machine_root_angle),
+                        "sliding_base": f(m.sliding_base), "center_to_back": f(m.center_to_back),
+                        "ratio_of_roll": f(m.ratio_of_roll),
+                        "modified_roll_2c": f(m.modified_roll_2c),
+                        "modified_roll_6d": f(m.modified_roll_6d)}}

@@ -114,6 +114,7 @@ import numpy as np
 
 from gearjax import optimize
 from gearjax.gears.hypoid import tca as th
+from gearjax.gears.hypoid.design_file import flank_settings_table
 from gearjax.gears.hypoid.pair import program_pair
 from gearjax.errors import ConvergenceError, check_int, check_range
 from gearjax.gears.hypoid.formate import generating_gear_pinion
@@ -564,23 +565,6 @@ def pitch_of(pair) -> float:
     return 2.0 * np.pi / pair.z1
 
 
-def flank_settings_table(fl) -> dict:
-    c, m = fl.cutter, fl.machine
-    f = lambda a: float(np.asarray(a))
-    dg = lambda a: math.degrees(f(a))
-    return {"cutter": {"point_radius": f(c.point_radius), "blade_angle": dg(c.blade_angle),
-                       "edge_radius": f(c.edge_radius)},
-            "machine": {"type": "generated" if m.generated else "formate",
-                        "radial_distance": f(m.radial_distance), "cradle_angle": dg(m.cradle_angle),
-                        "tilt": dg(m.tilt), "swivel": dg(m.swivel),
-                        "blank_offset": f(m.blank_offset),
-                        "machine_root_angle": dg(m.machine_root_angle),
-                        "sliding_base": f(m.sliding_base), "center_to_back": f(m.center_to_back),
-                        "ratio_of_roll": f(m.ratio_of_roll),
-                        "modified_roll_2c": f(m.modified_roll_2c),
-                        "modified_roll_6d": f(m.modified_roll_6d)}}
-
-
 def synthesised_design(design, pairs: dict, *, name: str, description: str, source: str):
     """A :class:`~gearjax.gears.hypoid.design_file.HypoidDesign` with the flanks of ``pairs`` (side ->
     :class:`~gearjax.gears.hypoid.tca.HypoidPair`) replacing those of ``design``: the pinion
@@ -590,7 +574,5 @@ def synthesised_design(design, pairs: dict, *, name: str, description: str, sour
     data["design"] = dict(data.get("design", {}), name=name, description=description,
                           source=source)
     for side, pair in pairs.items():
-        f1, f2 = th.SIDES[side]
-        data["pinion"][f1] = flank_settings_table(pair.pinion)
-        data["gear"][f2] = flank_settings_table(pair.gear)
+        data = th.FAMILY.design_data(design_from_dict(data), pair, side)
     return design_from_dict(data)

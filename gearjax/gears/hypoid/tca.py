@@ -301,6 +301,17 @@ class HypoidFamily(GearFamily):
     def user_pair(self, prep):
         return prep.pair
 
+    def design_data(self, design, pair, side):
+        """The design file with the pinion flank and the (complementary) gear flank of
+        ``side`` taken from ``pair``'s machine settings and cutters
+        (:func:`~gearjax.gears.hypoid.design_file.flank_settings_table`, file units)."""
+        from gearjax.gears.hypoid.design_file import flank_settings_table
+        data = design.to_dict()
+        f1, f2 = SIDES[side]
+        data["pinion"][f1] = flank_settings_table(pair.pinion)
+        data["gear"][f2] = flank_settings_table(pair.gear)
+        return data
+
     def program_pair(self, pair, prep):
         # the hand of the mounting found by the set-up
         return SensedPair(replace(pair, hand=prep.pair.hand), jnp.asarray(bool(prep.drive)))

@@ -181,6 +181,42 @@ def _check_tooth_form(pair: InvolutePair) -> None:
                          "(no path of contact); reduce the profile shifts")
 
 
+def tooth_form_margins(pair: InvolutePair) -> dict:
+    """Margins of the tooth-form limits :func:`_check_tooth_form` refuses, traceable (mm;
+    a limit holds where its margin is >= 0), so that an optimiser can keep a pair
+    valid as a constraint.  Keys (member 1 = pinion, 2 = wheel):
+
+    * ``undercut1/2`` = ``(x - x_min) m_n``, ``x_min = 1 - z sin^2(alpha_t)/(2 cos beta)``;
+    * ``tip_thickness1/2`` = the transverse tip thickness
+      ``s_a = 2 r_a (s/(2r) + inv alpha_t - inv alpha_a)``, ``s = m_t (pi/2 + 2 x tan alpha_n)``
+      (> 0: not pointed; shops ask for about 0.2-0.4 m_n);
+    * ``interference1`` = ``rho_A`` (the wheel tip above the pinion base circle) and
+      ``interference2`` = ``g_alpha - rho_E`` (the pinion tip above the wheel's);
+    * ``fillet1/2`` = ``rho_N - rho_F``: the start of the active profile above the form
+      circle of the straight rack flank (roll distances, ISO 21771: ``d_Nf >= d_Ff``);
+    * ``overlap`` = ``rho_E - rho_A``: the tip circles overlap on the line of action.
+    """
+    m, an, b = pair.module, pair.pressure_angle, pair.helix
+    at = jnp.arctan(jnp.tan(an) / jnp.cos(b))
+    mt = m / jnp.cos(b)
+    geo = pair_geometry(pair)
+    g_alpha = geo["a_w"] * jnp.sin(geo["alpha_wt"])
+    rho_N = {1: geo["rho_A"], 2: g_alpha - geo["rho_E"]}
+    out = {}
+    for k, z, x in ((1, pair.z1, pair.x1), (2, pair.z2, pair.x2)):
+        out[f"undercut{k}"] = (x - (1.0 - z * jnp.sin(at) ** 2 / (2.0 * jnp.cos(b)))) * m
+        r = 0.5 * z * mt
+        rb = r * jnp.cos(at)
+        ra = r + m * (1.0 + x)
+        s = mt * (jnp.pi / 2 + 2 * x * jnp.tan(an))
+        out[f"tip_thickness{k}"] = 2 * ra * (s / (2 * r) + _inv(at) - _inv(jnp.arccos(rb / ra)))
+        out[f"fillet{k}"] = rho_N[k] - (r * jnp.sin(at) - m * (1.0 - x) / jnp.sin(at))
+    out["interference1"] = geo["rho_A"]
+    out["interference2"] = g_alpha - geo["rho_E"]
+    out["overlap"] = geo["rho_E"] - geo["rho_A"]
+    return out
+
+
 def check_pair_fields(pair: InvolutePair) -> None:
     """Range check of a pair's fields (internal units mm, rad); traced fields skip it."""
     vals = (pair.module, pair.pressure_angle, pair.helix, pair.x1, pair.x2)

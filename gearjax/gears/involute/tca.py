@@ -304,6 +304,17 @@ class InvoluteFamily(GearFamily):
     summary_keys = SUMMARY_KEYS
     reference_moves_with_design = True
 
+    _DEG = math.pi / 180.0
+    file_fields = {"pair.module": ("pair", "normal_module_mm", 1.0),
+                   "pair.pressure_angle": ("pair", "normal_pressure_angle_deg", _DEG),
+                   "pair.helix": ("pair", "helix_angle_deg", _DEG),
+                   "pair.x1": ("pair", "profile_shift1", 1.0),
+                   "pair.x2": ("pair", "profile_shift2", 1.0),
+                   "face_width": ("pair", "face_width_mm", 1.0),
+                   "dalpha": ("modification", "pressure_angle_change_deg", _DEG),
+                   "profile_crown": ("modification", "profile_crown_per_mm", 1.0),
+                   "lead_crown": ("modification", "lead_crown_per_mm", 1.0)}
+
     def pair(self, design):
         return getattr(design, "design", design)
 

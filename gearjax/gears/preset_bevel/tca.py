@@ -27,6 +27,8 @@ Units: mm, rad.  Reference: [Preset-TE-bevel]; [Litvin2004] ch. 9 (contact equat
 
 from __future__ import annotations
 
+import math
+
 import jax.numpy as jnp
 import numpy as np
 
@@ -84,9 +86,36 @@ class PresetBevelFamily(GearFamily):
     contact_mode_reason = "the profile arcs of radii rho1, rho2 touch at a point"
     summary_keys = SUMMARY_KEYS
 
+    _DEG = math.pi / 180.0
+    file_fields = {"beta": ("pair", "spiral_angle_deg", _DEG),
+                   "alpha_n": ("pair", "normal_pressure_angle_deg", _DEG),
+                   "shaft_angle": ("pair", "shaft_angle_deg", _DEG),
+                   "module_t": ("pair", "outer_transverse_module_mm", 1.0),
+                   "face_width": ("pair", "face_width_mm", 1.0),
+                   "R0": ("flanks", "spiral_R0_mm", 1.0),
+                   "rho1": ("flanks", "profile_radius_pinion_mm", 1.0),
+                   "rho2": ("flanks", "profile_radius_gear_mm", 1.0),
+                   "addendum": ("flanks", "addendum_mm", 1.0),
+                   "dedendum": ("flanks", "dedendum_mm", 1.0),
+                   "kappa": ("preset", "kappa", 1.0)}
+
     def pair(self, design):
         # a design-file object carries the pytree as ``.design``
         return getattr(design, "design", design)
+
+    def design_data(self, design, pair, side):
+        """As :meth:`GearFamily.design_data`; the file gives the preset as the TE at the
+        ends of the contact curve, ``te = kappa (t_min - t_m)^2`` (the inverse of
+        :func:`~gearjax.gears.preset_bevel.geometry.preset_kappa`), so ``kappa`` is
+        written as ``[preset] te_arcsec`` of the new pair."""
+        from gearjax.gears.preset_bevel.geometry import curve_range
+        from gearjax.tca.path import ARCSEC
+        data = super().design_data(design, pair, side)
+        kappa = data.get("preset", {}).pop("kappa", None)
+        if kappa is not None:
+            t0, tm, _ = curve_range(pair)
+            data["preset"]["te_arcsec"] = float(kappa * (t0 - tm) ** 2 / ARCSEC)
+        return data
 
     def check(self, design):
         """The fields in the ranges of the design file, in mm and rad (one-line

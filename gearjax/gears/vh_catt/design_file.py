@@ -37,8 +37,8 @@ import numpy as np
 from gearjax.errors import check_range
 from gearjax.gears.vh_catt.geometry import VHCattPair, flank_grid
 from gearjax.gears.vh_catt.tca import ADAPTER
-from gearjax.io import (FlankGrid, check_integer, check_keys, check_number, check_string,
-                        register_design_kind, require_key)
+from gearjax.io import (DesignFileMixin, FlankGrid, check_integer, check_keys, check_number,
+                        check_string, register_design_kind, require_key)
 from gearjax.tca.result import register_family
 
 __all__ = ["VHCattDesign", "design_from_dict", "FlankGrid", "KIND", "flank_sigma"]
@@ -59,17 +59,13 @@ def flank_sigma(member: str, flank: str) -> int:
     return s if member == "pinion" else -s
 
 
-class VHCattDesign:
+class VHCattDesign(DesignFileMixin):
     """A validated VH-CATT design file (``data`` in file units) and its pair
     (:attr:`pair`, a :class:`~gearjax.gears.vh_catt.geometry.VHCattPair`)."""
 
     def __init__(self, data: dict, pair: VHCattPair):
         self.data = data
         self.pair = pair
-
-    @property
-    def name(self) -> str:
-        return self.data.get("design", {}).get("name", "")
 
     def defaults_lines(self) -> list:
         """No defaults: every key of the schema is required."""

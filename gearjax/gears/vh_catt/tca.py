@@ -32,6 +32,7 @@ Units: mm, rad.  References: [VH-CATT]; [Litvin2004] ch. 9.
 
 from __future__ import annotations
 
+import math
 
 import jax
 import jax.numpy as jnp
@@ -180,6 +181,13 @@ class VHCattFamily(GearFamily):
     contact_mode_reason = "the flanks touch at a point (their traces differ by the blade offset)"
     summary_keys = SUMMARY_KEYS
     reference_moves_with_design = True
+
+    file_fields = {"module": ("pair", "module_mm", 1.0),
+                   "pressure_angle": ("pair", "pressure_angle_deg", math.pi / 180.0),
+                   "cutter_radius1": ("pair", "cutter_radius1_mm", 1.0),
+                   "cutter_radius2": ("pair", "cutter_radius2_mm", 1.0),
+                   "blade_offset": ("pair", "blade_offset_mm", 1.0),
+                   "face_width": ("pair", "face_width_mm", 1.0)}
 
     def pair(self, design):
         return pair_of(design)

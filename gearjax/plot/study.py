@@ -1,0 +1,119 @@
+"""The figure of a design study (``gearjax optimize``): the optimiser's history, the TE
+before and after, the loss per position (loaded studies) or the |SRR| along the path,
+and the change of every variable.  Agg backend; saved atomically by the caller."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from gearjax.plot.style import MIN_WIDTH_IN, report_style, te_axis_limits
+from gearjax.tca.path import ARCSEC
+
+__all__ = ["study_figure"]
+
+
+def _history(ax, hist, title):
+    v = np.asarray(hist.get("objective", []), float)
+    ax.plot(np.arange(1, v.size + 1), v, "o-", color="C0", label="objective J")
+    ax.set_xlabel("iteration")
+    ax.set_ylabel("objective J (scaled)", color="C0")
+    f = np.asarray(hist.get("feasibility", []), float)
+    if f.size and np.any(f > 0):
+        ax2 = ax.twinx()
+        ax2.semilogy(np.arange(1, f.size + 1), np.maximum(f, 1e-16), "s--", color="C3",
+                     label="largest violation")
+        ax2.set_ylabel("largest constraint violation (scaled)", color="C3")
+    ax.set_title(title)
+    ax.grid(True, lw=0.3, alpha=0.6)
+
+
+def _te(ax, res0, res1):
+    for res, lab, c in ((res0, "start", "0.5"), (res1, "optimised", "C0")):
+        phi = np.degrees(np.asarray(res.path.phi1))
+        env = np.asarray(res.multi.envelope) / ARCSEC
+        ptp = float(np.asarray(res.multi.ptp)) / ARCSEC
+        ax.plot(phi - phi[phi.size // 2], env - np.nanmax(env), "-", color=c, lw=1.5,
+                label=f"{lab}: p-t-p {ptp:.3g} arcsec")
+    lims, _, floor = te_axis_limits(np.concatenate([
+        np.asarray(r.multi.envelope).ravel() / ARCSEC - np.nanmax(np.asarray(r.multi.envelope)
+                                                                   / ARCSEC)
+        for r in (res0, res1)]))
+    if lims is not None:        # conjugate pairs: rounding noise at its true size
+        ax.set_ylim(*lims)
+        ax.text(0.02, 0.95, f"conjugate: TE p-t-p < {floor:.2g} arcsec", transform=ax.transAxes,
+                ha="left", va="top")
+    ax.set_xlabel("pinion angle from the reference (deg)")
+    ax.set_ylabel("unloaded TE envelope (arcsec, top at 0)")
+    ax.set_title("transmission error (scenario 1)")
+    ax.grid(True, lw=0.3, alpha=0.6)
+    ax.legend(loc="lower center")
+
+
+def _loss(ax, eff0, eff1):
+    for eff, lab, c in ((eff0, "start", "0.5"), (eff1, "optimised", "C0")):
+        phi = np.degrees(np.asarray(eff.phi1))
+        p = np.where(np.asarray(eff.valid), np.asarray(eff.power_loss), np.nan)
+        eta = float(np.asarray(eff.mean_efficiency))
+        ax.plot(phi - phi[phi.size // 2], p, "o-", color=c, ms=3,
+                label=f"{lab}: mean efficiency {100 * eta:.3f} %")
+    ax.set_xlabel("pinion angle from the reference (deg)")
+    ax.set_ylabel("sliding power loss (W)")
+    ax.set_title("power loss over one mesh cycle (scenario 1; valid positions)")
+    ax.grid(True, lw=0.3, alpha=0.6)
+    ax.legend(loc="best")
+
+
+def _srr(ax, res0, res1, mask0):
+    for res, lab, c in ((res0, "start", "0.5"), (res1, "optimised", "C0")):
+        phi = np.degrees(np.asarray(res.path.phi1))
+        srr = np.where(mask0, np.abs(np.asarray(res.kinematics.srr)), np.nan)
+        ax.plot(phi - phi[phi.size // 2], srr, "o-", color=c, ms=3, label=lab)
+    ax.set_xlabel("pinion angle from the reference (deg)")
+    ax.set_ylabel("|slide-to-roll ratio|")
+    ax.set_title("|SRR| along the path of contact (scenario 1)")
+    ax.grid(True, lw=0.3, alpha=0.6)
+    ax.legend(loc="best")
+
+
+def _variables(ax, variables):
+    names = [v["field"] for v in variables]
+    span = np.array([v["upper"] - v["lower"] for v in variables], float)
+    rel0 = np.array([(v["start"] - v["lower"]) for v in variables], float) / span
+    rel1 = np.array([(v["end"] - v["lower"]) for v in variables], float) / span
+    y = np.arange(len(names))
+    ax.barh(y, rel1 - rel0, left=rel0, color="C0", height=0.5, label="start -> end")
+    ax.plot(rel0, y, "k|", ms=12, label="start")
+    ax.set_yticks(y, [n.split(".")[-1] for n in names])
+    ax.set_xlim(0.0, 1.0)
+    ax.set_xlabel("position in the bounds (0 = lower, 1 = upper)")
+    ax.set_title("variables")
+    ax.grid(True, axis="x", lw=0.3, alpha=0.6)
+    ax.legend(loc="lower right")
+
+
+def study_figure(report: dict, start: tuple, end: tuple, mask=None):
+    """Four panels: history, TE, loss (or |SRR|), variables.  ``start``/``end``:
+    ``(Q, res, eff)`` of :func:`gearjax.studies.study_run.run_study` (scenario 1 is
+    drawn); ``mask``: the start design's on-flank points of scenario 1 (for |SRR|)."""
+    import jax
+    import matplotlib
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    first = lambda tree: jax.tree_util.tree_map(lambda a: np.asarray(a)[0], tree)  # noqa: E731
+    res0, res1 = first(start[1]), first(end[1])
+    with report_style():
+        fig, ax = plt.subplots(2, 2, figsize=(max(MIN_WIDTH_IN, 12.0), 9.0))
+        opt = report["optimizer"]
+        _history(ax[0, 0], report["history"],
+                 f"{report['study']}: {opt['method']}, {opt['iterations']} iterations, "
+                 f"{opt['evaluations']} evaluations")
+        _te(ax[0, 1], res0, res1)
+        if start[2] is not None:
+            _loss(ax[1, 0], first(start[2]), first(end[2]))
+        else:
+            m = np.ones(np.shape(res0.path.phi1), bool) if mask is None else np.asarray(mask)
+            _srr(ax[1, 0], res0, res1, m)
+        _variables(ax[1, 1], report["variables"])
+        fig.tight_layout()
+    return fig

@@ -1,0 +1,254 @@
+"""The named quantities a design study optimises or constrains (``gearjax optimize``).
+
+Each quantity is a traceable scalar of one evaluation of the chain at one scenario
+(operating point and misalignment): of the unloaded TCA (:class:`~gearjax.TCAResult`
+with its kinematics) or, for the loaded ones, of the mesh-efficiency result
+(:class:`~gearjax.MeshEfficiency`).  A study's objective and constraints are written
+with their names (:data:`QUANTITIES`; ``gearjax optimize --quantities`` lists them).
+
+**Smoothness.**  An optimiser needs values whose gradient does not jump where the
+design moves a grid point on or off the flank.  So
+
+* maxima and minima over the positions of a cycle are smooth (log-sum-exp)::
+
+      smax_T(q) = T log sum_i exp(q_i / T)  >=  max_i q_i >= smax_T(q) - T log n
+
+  with a stated temperature ``T`` per quantity (:data:`QUANTITIES`, column
+  ``temperature``): the bias is at most ``T log n`` (n positions), a known amount far
+  below the accuracy an engineer reads these values to;
+* quantities over the contact path use the positions selected by a **fixed mask**,
+  the start design's on-flank points (``mask``), so that no point enters or leaves the
+  sum while the design moves; ``min_margin_mm`` (the smallest boundary margin over the
+  same mask) is then the constraint that keeps those points on the flank -- a study
+  that uses a path quantity gets ``min_margin_mm >= 0`` added (``gearjax.studies.
+  study_file``), so the fixed mask never describes points off the flank at its end;
+* ``te_ptp_arcsec`` and the loaded cycle summaries (mean loss, efficiency, loaded TE)
+  are those of the chain: piecewise smooth in the design, with kinks where the TE
+  envelope hands over between pairs or a position changes validity.  The end design is
+  therefore re-checked with the full forward model (``study_run``), and a study that
+  fails there says so.
+
+Units: those in the names (arcsec, mm, W, MPa; ``srr`` and efficiencies are
+fractions).  References: Litvin & Fuentes, "Gear Geometry and Applied Theory" (2nd
+ed., 2004) for TE and the contact path; Boyd & Vandenberghe, "Convex Optimization"
+(2004, ex. 3.1.5) for the log-sum-exp bound.
+"""
+
+from __future__ import annotations
+
+from typing import Callable, NamedTuple
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from gearjax.tca.path import ARCSEC
+
+__all__ = ["Quantity", "QUANTITIES", "smooth_max", "smooth_min", "te_ptp_continuous",
+           "quantity_values",
+           "needs_loaded", "uses_mask", "start_mask"]
+
+
+def smooth_max(q, mask, temperature):
+    """``T log sum_{mask} exp(q / T)`` (module docstring; traceable; masked entries
+    and non-finite values are left out; ``-inf`` when the mask is empty)."""
+    ok = mask & jnp.isfinite(q)
+    qs = jnp.where(ok, q, 0.0)                     # finite everywhere: safe gradients
+    m = jax.lax.stop_gradient(jnp.max(jnp.where(ok, qs, -jnp.inf)))
+    m0 = jnp.where(jnp.isfinite(m), m, 0.0)
+    s = jnp.sum(jnp.where(ok, jnp.exp((qs - m0) / temperature), 0.0))
+    return jnp.where(jnp.any(ok), m0 + temperature * jnp.log(jnp.maximum(s, 1e-300)), -jnp.inf)
+
+
+def smooth_min(q, mask, temperature):
+    """``-smooth_max(-q)``: at most the minimum, by no more than ``T log n``."""
+    return -smooth_max(-q, mask, temperature)
+
+
+class Quantity(NamedTuple):
+    """A named study quantity: ``unit``, ``loaded`` (needs the loaded chain: an
+    operating point), ``path`` (computed over the fixed on-flank mask), ``temperature``
+    of its smooth extremum (None: no extremum taken here), a one-line ``description``
+    and ``fn(res, eff, mask, pair) -> scalar`` (``eff`` None for unloaded studies;
+    ``pair`` the differentiable pair); ``families``: the families that have it (empty:
+    every family)."""
+
+    unit: str
+    loaded: bool
+    path: bool
+    temperature: float | None
+    description: str
+    fn: Callable
+    families: tuple = ()
+
+
+def _mid(res):
+    return res.path.phi1.shape[0] // 2
+
+
+#: temperature of the smooth top of the TE envelope (arcsec)
+TE_TEMPERATURE = 1e-3
+
+
+def te_ptp_continuous(res):
+    """Peak-to-peak of the unloaded TE envelope (arcsec) with the hand-overs at their
+    continuous positions (traceable).
+
+    The grid value ``res.ptp`` takes the envelope's extremes at grid points: its bottom
+    -- where two tooth pairs hand over, between grid points -- snaps from point to point
+    as the design moves, so its gradient jumps whenever the hand-over crosses one.  Here
+    the bottom is the TE of pair 0 at the two transfer angles ``res.transfer_phi1``
+    (linear interpolation of the crossing, continuous in the design), and the top is the
+    smooth maximum (:data:`TE_TEMPERATURE`) of the envelope over the pitch window, where
+    a localised TE is flat (snapping error ``kappa h^2/8``): the window is pair 0's
+    active interval between the two transfer angles.  For the coast side (the
+    envelope is the minimum over the pairs) top and bottom change roles.  Where a
+    transfer angle is not found (conjugate or touching pairs), or the hand-over is not a
+    crossing of two TE curves on the flank (an edge contact: the envelope jumps there), it
+    is the grid value.
+    """
+    m = res.multi
+    phi = res.path.phi1
+    te_in = m.inside & jnp.isfinite(m.te_pairs)
+    hi = jnp.max(jnp.where(te_in, m.te_pairs, -jnp.inf), axis=0)
+    env = m.envelope
+    ok = jnp.isfinite(env)
+    # +1 when the envelope is the maximum over the pairs (the side pushing forward)
+    sgn = jnp.where(jnp.sum(jnp.where(ok, jnp.abs(env - hi), 0.0)) <= 1e-9 * jnp.maximum(
+        jnp.sum(jnp.where(ok, jnp.abs(env), 0.0)), 1e-300), 1.0, -1.0)
+    sgn = jax.lax.stop_gradient(sgn)
+    k0 = m.te_pairs.shape[0] // 2
+    te0 = jnp.where(te_in[k0], m.te_pairs[k0], 0.0)
+    tin, tout = m.transfer_phi1[0], m.transfer_phi1[1]
+    t = jnp.nan_to_num(jnp.stack([tin, tout]))
+    at = jnp.interp(t, phi, te0)
+    # a crossing of two TE curves: both pairs on the flank at the grid points around each
+    # transfer angle (else the hand-over is at an edge: the grid value is returned)
+    def on(k, tk):
+        return jax.lax.stop_gradient(jnp.interp(tk, phi, te_in[k].astype(float))) > 1.0 - 1e-12
+
+    on = jnp.stack([on(k0, t[0]), on(k0 - 1, t[0]), on(k0, t[1]), on(k0 + 1, t[1])])
+    found = jnp.isfinite(tin) & jnp.isfinite(tout) & jnp.all(on)
+    bottom = jnp.minimum(sgn * at[0], sgn * at[1])
+    lo, up = jnp.minimum(tin, tout), jnp.maximum(tin, tout)
+    window = ok & (phi >= lo) & (phi <= up)         # pair 0 carries the load
+    top = smooth_max(sgn * env / ARCSEC, window, TE_TEMPERATURE) * ARCSEC
+    return jnp.where(found, (top - bottom) / ARCSEC, m.ptp / ARCSEC)
+
+
+def _srr(res, mask):
+    return jnp.abs(jnp.where(mask, res.kinematics.srr, 0.0))
+
+
+def _mean_abs_srr(res, eff, mask, pair):
+    return jnp.sum(_srr(res, mask)) / jnp.maximum(jnp.sum(mask), 1)
+
+
+#: temperature of the smooth peak pressure (MPa)
+P_MAX_TEMPERATURE = 5.0
+
+
+def _peak_pressure(res, eff, mask, pair):
+    loaded = (eff.loaded.load > 0.0) & eff.valid[None, :]
+    return smooth_max(eff.loaded.p_max, loaded, P_MAX_TEMPERATURE)
+
+
+QUANTITIES: dict = {
+    "te_ptp_arcsec": Quantity(
+        "arcsec", False, False, TE_TEMPERATURE,
+        "peak-to-peak of the unloaded TE envelope over one pitch, hand-overs at their "
+        "continuous positions (te_ptp_continuous)",
+        lambda res, eff, mask, pair: te_ptp_continuous(res)),
+    "te_ptp_grid_arcsec": Quantity(
+        "arcsec", False, False, None,
+        "peak-to-peak of the unloaded TE envelope at the grid points (as gearjax tca)",
+        lambda res, eff, mask, pair: res.ptp / ARCSEC),
+    "contact_ratio": Quantity(
+        "", False, False, None, "contact ratio of the unloaded TE envelope",
+        lambda res, eff, mask, pair: res.contact_ratio),
+    "bearing_position": Quantity(
+        "", False, False, None,
+        "contact position at the reference (the family's path coordinate: face-width "
+        "position xi1 of a bevel/hypoid pinion, -1 toe .. +1 heel; radius on the pinion in "
+        "mm otherwise)",
+        lambda res, eff, mask, pair: res.coords["path_position"][_mid(res)]),
+    "margin_ref_mm": Quantity(
+        "mm", False, False, None, "boundary margin of the reference contact (>= 0 on the flank)",
+        lambda res, eff, mask, pair: res.margin[_mid(res)]),
+    "min_margin_mm": Quantity(
+        "mm", False, True, 0.05,
+        "smallest boundary margin over the start design's on-flank points (smooth min)",
+        lambda res, eff, mask, pair: smooth_min(res.margin, mask & res.path.converged, 0.05)),
+    "mean_abs_srr": Quantity(
+        "", False, True, None, "mean |slide-to-roll ratio| over the on-flank points",
+        _mean_abs_srr),
+    "max_abs_srr": Quantity(
+        "", False, True, 0.01, "largest |slide-to-roll ratio| over the on-flank points (smooth)",
+        lambda res, eff, mask, pair: smooth_max(_srr(res, mask), mask, 0.01)),
+    "min_r_eff_mm": Quantity(
+        "mm", False, True, 0.05,
+        "smallest effective radius R_x over the on-flank points (smooth min)",
+        lambda res, eff, mask, pair: smooth_min(res.kinematics.r_x, mask, 0.05)),
+    "power_loss_W": Quantity(
+        "W", True, False, None, "mean sliding power loss over the valid positions of a cycle",
+        lambda res, eff, mask, pair: eff.power_in * (1.0 - eff.mean_efficiency)),
+    "mesh_efficiency": Quantity(
+        "", True, False, None, "mean mesh efficiency over the valid positions (fraction)",
+        lambda res, eff, mask, pair: eff.mean_efficiency),
+    "mean_mu": Quantity(
+        "", True, False, None, "load- and sliding-weighted mean friction coefficient",
+        lambda res, eff, mask, pair: eff.mean_mu),
+    "peak_pressure_MPa": Quantity(
+        "MPa", True, False, P_MAX_TEMPERATURE, "highest Hertz pressure over the loaded contacts (smooth max)",
+        _peak_pressure),
+    "loaded_te_ptp_arcsec": Quantity(
+        "arcsec", True, False, None, "peak-to-peak of the loaded TE over the valid positions",
+        lambda res, eff, mask, pair: eff.te_loaded_ptp / ARCSEC),
+}
+
+
+#: temperature of the smooth minima of the involute tooth-form margins (mm)
+FORM_TEMPERATURE = 0.005
+_FORM_KEYS = ("undercut1", "undercut2", "interference1", "interference2", "fillet1",
+              "fillet2", "overlap")
+
+
+def _form(pair, keys):
+    from gearjax.gears.involute.geometry import tooth_form_margins
+    m = tooth_form_margins(pair.pair)
+    v = jnp.stack([m[k] for k in keys])
+    return smooth_min(v, jnp.ones(v.shape, bool), FORM_TEMPERATURE)
+
+
+QUANTITIES["tooth_form_margin_mm"] = Quantity(
+    "mm", False, False, FORM_TEMPERATURE,
+    "involute pairs: smallest margin of the tooth-form limits (undercut, involute "
+    "interference, tip/fillet interference d_Nf >= d_Ff, tip overlap; smooth min; >= 0 valid)",
+    lambda res, eff, mask, pair: _form(pair, _FORM_KEYS), ("involute",))
+QUANTITIES["tip_thickness_mm"] = Quantity(
+    "mm", False, False, FORM_TEMPERATURE,
+    "involute pairs: smaller transverse tip thickness of pinion and wheel (smooth min)",
+    lambda res, eff, mask, pair: _form(pair, ("tip_thickness1", "tip_thickness2")),
+    ("involute",))
+
+
+def needs_loaded(names) -> bool:
+    """Whether any of the quantities ``names`` needs the loaded chain."""
+    return any(QUANTITIES[n].loaded for n in names)
+
+
+def uses_mask(names) -> bool:
+    """Whether any of ``names`` is a path quantity over the fixed on-flank mask."""
+    return any(QUANTITIES[n].path for n in names)
+
+
+def start_mask(res) -> np.ndarray:
+    """The fixed mask of the path quantities: the on-flank points of a concrete result
+    (the start design at the nominal scenario)."""
+    return np.asarray(res.on_flank)
+
+
+def quantity_values(names, res, eff, mask, pair):
+    """``(len(names),)`` array of the quantities ``names`` (traceable)."""
+    return jnp.stack([jnp.asarray(QUANTITIES[n].fn(res, eff, mask, pair), float)
+                      for n in names])

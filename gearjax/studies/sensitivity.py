@@ -1,0 +1,75 @@
+"""Scaled sensitivities of study quantities to design fields (``gearjax sensitivity``).
+
+For outputs ``q_i`` (named quantities, :data:`gearjax.studies.quantities.QUANTITIES`)
+and design fields ``x_j`` of a design at one scenario (operating point and
+misalignment), the exact Jacobian ``J_ij = dq_i/dx_j`` (forward mode through every
+contact solve, one program) and from it::
+
+    per unit      J_ij                      (output unit per field unit: mm, rad, -)
+    elasticity    e_ij = J_ij x_j / q_i     (% change of q_i per % change of x_j;
+                                             undefined -- null -- where q_i or x_j is 0)
+
+The quantities are those of a study (same masks and smoothing); the fields are named
+as in a study file's ``[[variables]]``.  A field whose value is 0 has no elasticity; its
+per-unit value is the one to read.
+"""
+
+from __future__ import annotations
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from gearjax.compile_ahead import FAST_COMPILE_OPTIONS
+from gearjax.studies.study_file import SCENARIO_KEYS, Study, Term, Variable, check_quantities
+
+__all__ = ["sensitivities"]
+
+def sensitivities(design_source: str, outputs, params, *, side: str = "drive",
+                  operating: dict | None = None, scenario: dict | None = None,
+                  tca: dict | None = None) -> dict:
+    """Values, Jacobian and elasticities of ``outputs`` w.r.t. ``params`` (module
+    docstring) for the design ``design_source`` (a path or ``example:NAME``).
+
+    ``operating``: torque_Nm, pinion_rpm, oil, sigma_um (loaded outputs); ``scenario``:
+    dE_mm, dP_mm, dG_mm, dSigma_deg.  Returns ``{"outputs", "params", "values" (n_out,),
+    "fields" (n_par,), "jacobian" (n_out, n_par), "elasticity" (n_out, n_par; NaN where
+    undefined)}`` (NumPy arrays)."""
+    from gearjax.studies.quantities import uses_mask
+    from gearjax.studies.study_run import evaluator, grid_size, start_point, set_up
+
+    outputs, params = list(outputs), list(params)
+    if not outputs:
+        raise ValueError("--outputs: name at least one quantity")
+    if not params:
+        raise ValueError("--params: name at least one design field")
+    sc = dict(scenario or {})
+    bad = sorted(set(sc) - {"dE_mm", "dP_mm", "dG_mm", "dSigma_deg"})
+    if bad:
+        raise ValueError(f"unknown scenario key {bad[0]!r} (allowed: "
+                         f"{', '.join(k for k in SCENARIO_KEYS if k.startswith('d'))})")
+    study = Study(name="sensitivity", design=design_source, side=side,
+                  variables=tuple(Variable(p, change=(-1.0, 1.0), scale=1.0) for p in params),
+                  objective=tuple(Term(q) for q in outputs), constraints=(),
+                  operating=dict(operating or {}),
+                  scenarios={k: (float(v),) for k, v in sc.items()}, tca=dict(tca or {}))
+    check_quantities(outputs, "--outputs", study.operating)
+    prob = set_up(study)
+    if uses_mask(outputs):      # the fixed on-flank mask needs a first evaluation
+        start_point(prob)
+    else:
+        prob.data = prob.data._replace(mask=jnp.ones((1, grid_size(prob)), bool))
+    ev = evaluator(prob)
+
+    def values(u, d):
+        q = ev(u, d)[0][0]
+        return q, q
+
+    jac = jax.jit(jax.jacfwd(values, has_aux=True), compiler_options=FAST_COMPILE_OPTIONS)
+    J, Q0 = (np.asarray(a) for a in jac(jnp.zeros(len(params)), prob.data))
+    x = np.asarray(prob.x0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        el = J * x[None, :] / Q0[:, None]
+    el = np.where((Q0[:, None] != 0.0) & (x[None, :] != 0.0), el, np.nan)
+    return {"outputs": outputs, "params": params, "values": Q0, "fields": x, "jacobian": J,
+            "elasticity": el}

@@ -1,0 +1,305 @@
+"""Study files: what ``gearjax optimize STUDY.toml`` optimises, read and validated.
+
+A study names a design, the design fields it varies, an objective and constraints
+made of named quantities (:data:`gearjax.studies.quantities.QUANTITIES`), the
+scenarios they are evaluated at, and the optimiser.  Schema (docs/optimize.md has the
+full text with examples)::
+
+    [study]        name (required), description, design ("example:NAME" or a path
+                   relative to the study file; required), side ("drive" | "coast")
+    [operating]    torque_Nm, pinion_rpm, oil (a known oil), sigma_um -- required when a
+                   loaded quantity is used; compliance ("weber" | "iso6336")
+    [scenarios]    optional; torque_Nm, pinion_rpm, dE_mm, dP_mm, dG_mm, dSigma_deg as a
+                   number or a list: every combination is a scenario (one vmapped run)
+    [tca]          optional TCA grid: steps_per_pitch, half_pitches, n_pairs
+    [[variables]]  field (a field of the design's pair, ``gearjax optimize STUDY
+                   --fields`` lists them), lower/upper (absolute) or change = [lo, hi]
+                   (relative to the design's value); unit "" (the field's own: mm, rad,
+                   -) or "deg" for a field in rad; scale (default (upper - lower)/2)
+    [[objective]]  quantity, weight (> 0), sense ("minimize" | "maximize"),
+                   over ("mean" | "max": the scenario reduction; "max" is smooth),
+                   scale (default |value at the start|)
+    [[constraints]] quantity, lower and/or upper (every scenario), scale (default
+                   |bound|, 1 for a bound 0)
+    [optimizer]    method ("augmented_lagrangian" | "slsqp"), max_iterations,
+                   tolerance (on the scaled KKT measures), starts (multi-start), seed
+
+Every entry is checked before any work; a bad one is a one-line ``ValueError`` naming
+it (``[[variables]] 2: field 'pair.x3' is not a field of ...``).  Fields are checked
+against the design when the study is set up (:mod:`gearjax.studies.study_run`), here
+only their form.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+
+from gearjax.io.toml import (check_integer, check_keys, check_number, check_string, is_number,
+                             read_toml, require_key)
+from gearjax.studies.quantities import QUANTITIES, uses_mask
+
+__all__ = ["Variable", "Term", "Constraint", "Study", "read_study", "list_studies",
+           "study_path", "check_quantities", "SCENARIO_KEYS", "METHODS"]
+
+#: scenario key -> unit (misalignment keys in mm and degrees, as ``--misalign``)
+SCENARIO_KEYS = {"torque_Nm": "N m", "pinion_rpm": "rpm", "dE_mm": "mm", "dP_mm": "mm",
+                 "dG_mm": "mm", "dSigma_deg": "deg"}
+METHODS = ("augmented_lagrangian", "slsqp")
+_OPERATING = {"torque_Nm", "pinion_rpm", "oil", "sigma_um", "compliance", "edge_softening_mm"}
+_TCA = {"steps_per_pitch", "half_pitches", "n_pairs"}
+
+
+@dataclass(frozen=True)
+class Variable:
+    """A design field varied by the study: absolute bounds (the field's units) or a
+    change relative to the design's value, and the scale of one optimiser unit."""
+
+    field: str
+    lower: float | None = None
+    upper: float | None = None
+    change: tuple | None = None
+    unit: str = ""
+    scale: float | None = None
+
+    @property
+    def factor(self) -> float:
+        """Field units per file unit (pi/180 for ``unit = "deg"``)."""
+        return math.pi / 180.0 if self.unit == "deg" else 1.0
+
+    def bounds(self, x0: float) -> tuple:
+        """``(lower, upper)`` in the field's units around its start value ``x0``."""
+        if self.change is not None:
+            return x0 + self.change[0] * self.factor, x0 + self.change[1] * self.factor
+        return self.lower * self.factor, self.upper * self.factor
+
+
+@dataclass(frozen=True)
+class Term:
+    quantity: str
+    weight: float = 1.0
+    sense: str = "minimize"
+    over: str = "mean"
+    scale: float | None = None
+
+
+@dataclass(frozen=True)
+class Constraint:
+    quantity: str
+    lower: float | None = None
+    upper: float | None = None
+    scale: float | None = None
+    added: bool = False      # added by the study (the fixed mask's margin), not the file
+
+
+@dataclass(frozen=True)
+class Study:
+    """A validated study file (module docstring)."""
+
+    name: str
+    design: str
+    side: str
+    variables: tuple
+    objective: tuple
+    constraints: tuple
+    description: str = ""
+    operating: dict = field(default_factory=dict)
+    scenarios: dict = field(default_factory=dict)
+    tca: dict = field(default_factory=dict)
+    method: str = "augmented_lagrangian"
+    max_iterations: int = 30
+    tolerance: float = 1e-4
+    starts: int = 1
+    seed: int = 0
+    source: str = ""
+
+    @property
+    def quantities(self) -> list:
+        """The quantities the study evaluates (objective first, then constraints)."""
+        out = []
+        for q in [t.quantity for t in self.objective] + [c.quantity for c in self.constraints]:
+            if q not in out:
+                out.append(q)
+        return out
+
+
+def list_studies() -> list[str]:
+    """Names of the packaged studies (``example:NAME`` for ``gearjax optimize``)."""
+    root = resources.files("gearjax") / "examples" / "studies"
+    return sorted(p.name[:-5] for p in root.iterdir() if p.name.endswith(".toml"))
+
+
+def study_path(name: str):
+    """Path of a packaged study; ValueError naming the known ones."""
+    names = list_studies()
+    if name not in names:
+        raise ValueError(f"unknown example study {name!r} (known: {', '.join(names)})")
+    return resources.files("gearjax") / "examples" / "studies" / f"{name}.toml"
+
+
+def check_quantities(names, where: str, operating: dict) -> None:
+    """Each of ``names`` a known quantity, and the operating point's keys given when one
+    needs the loaded chain (one-line ValueError naming ``where`` and the entry)."""
+    for q in names:
+        if q not in QUANTITIES:
+            raise ValueError(f"{where}: unknown quantity {q!r} (known: {', '.join(QUANTITIES)})")
+    loaded = [q for q in names if QUANTITIES[q].loaded]
+    missing = [k for k in ("torque_Nm", "pinion_rpm", "oil", "sigma_um") if k not in operating]
+    if loaded and missing:
+        raise ValueError(f"{where}: the loaded quantity {loaded[0]!r} needs the operating "
+                         f"point: {missing[0]} is missing")
+
+
+def _entries(data, key) -> list:
+    v = data.get(key, [])
+    if not isinstance(v, list) or not all(isinstance(e, dict) for e in v):
+        raise ValueError(f"[[{key}]] must be an array of tables ([[{key}]] ... entries)")
+    return v
+
+
+def _quantity(where, e) -> str:
+    q = check_string(where, "quantity", require_key(where, e, "quantity"))
+    if q not in QUANTITIES:
+        raise ValueError(f"{where}: unknown quantity {q!r} (known: {', '.join(QUANTITIES)})")
+    return q
+
+
+def _scale(where, e):
+    if "scale" not in e:
+        return None
+    s = check_number(where, "scale", e["scale"])
+    if s <= 0.0:
+        raise ValueError(f"{where}: scale = {s:g} must be > 0")
+    return s
+
+
+def _variable(i, e) -> Variable:
+    w = f"[[variables]] {i}"
+    check_keys(w, e, {"field", "lower", "upper", "change", "unit", "scale"})
+    name = check_string(w, "field", require_key(w, e, "field"))
+    unit = check_string(w, "unit", e.get("unit", ""), ("", "deg"))
+    has_abs = "lower" in e or "upper" in e
+    if has_abs == ("change" in e):
+        raise ValueError(f"{w} ({name}): give either lower and upper (absolute) or change = "
+                         "[lo, hi] (relative to the design's value)")
+    lo = hi = change = None
+    if has_abs:
+        lo = check_number(w, "lower", require_key(w, e, "lower"))
+        hi = check_number(w, "upper", require_key(w, e, "upper"))
+        empty = not lo < hi
+    else:
+        c = e["change"]
+        if not (isinstance(c, list) and len(c) == 2 and all(is_number(v) for v in c)):
+            raise ValueError(f"{w} ({name}): change = {c!r} must be two numbers [lo, hi]")
+        change = (check_number(w, "change[0]", c[0]), check_number(w, "change[1]", c[1]))
+        empty = not change[0] <= 0.0 <= change[1] or not change[0] < change[1]
+    if empty:
+        what = f"[{lo:g}, {hi:g}]" if has_abs else f"change {list(change)}"
+        raise ValueError(f"{w} ({name}): empty or invalid bounds {what} (need lower < upper"
+                         + ("" if has_abs else ", and the range must contain 0") + ")")
+    return Variable(name, lo, hi, change, unit, _scale(w, e))
+
+
+def _term(i, e) -> Term:
+    w = f"[[objective]] {i}"
+    check_keys(w, e, {"quantity", "weight", "sense", "over", "scale"})
+    q = _quantity(w, e)
+    wt = check_number(w, "weight", e.get("weight", 1.0))
+    if wt <= 0.0:
+        raise ValueError(f"{w} ({q}): weight = {wt:g} must be > 0 (use sense = 'maximize')")
+    return Term(q, wt, check_string(w, "sense", e.get("sense", "minimize"),
+                                    ("minimize", "maximize")),
+                check_string(w, "over", e.get("over", "mean"), ("mean", "max")), _scale(w, e))
+
+
+def _constraint(i, e) -> Constraint:
+    w = f"[[constraints]] {i}"
+    check_keys(w, e, {"quantity", "lower", "upper", "scale"})
+    q = _quantity(w, e)
+    lo = check_number(w, "lower", e["lower"]) if "lower" in e else None
+    hi = check_number(w, "upper", e["upper"]) if "upper" in e else None
+    if lo is None and hi is None:
+        raise ValueError(f"{w} ({q}): give lower, upper or both")
+    if lo is not None and hi is not None and not lo < hi:
+        raise ValueError(f"{w} ({q}): empty range [{lo:g}, {hi:g}] (need lower < upper)")
+    return Constraint(q, lo, hi, _scale(w, e))
+
+
+def _scenarios(sc) -> dict:
+    check_keys("scenarios", sc, set(SCENARIO_KEYS))
+    out = {}
+    for k, v in sc.items():
+        vals = v if isinstance(v, list) else [v]
+        if not vals:
+            raise ValueError(f"[scenarios] {k} = [] is empty (give a number or a list)")
+        out[k] = tuple(check_number("scenarios", k, x, SCENARIO_KEYS[k]) for x in vals)
+    return out
+
+
+def _design_source(design: str, base) -> str:
+    if design.startswith("example:") or base is None or os.path.isabs(design):
+        return design
+    return str(Path(base).parent / design)
+
+
+def read_study(source) -> Study:
+    """Read and validate a study file (a path, or ``example:NAME`` for a packaged study)."""
+    if isinstance(source, str) and source.startswith("example:"):
+        path, base = study_path(source[len("example:"):]), None
+    else:
+        path, base = source, source
+    data = read_toml(path)
+    check_keys("", data, {"study", "operating", "scenarios", "tca", "variables", "objective",
+                          "constraints", "optimizer"})
+    st = require_key("", data, "study")
+    check_keys("study", st, {"name", "description", "design", "side"})
+    name = check_string("study", "name", require_key("study", st, "name"))
+    if not name or not all(c.isalnum() or c in "_-" for c in name):
+        raise ValueError(f"[study] name = {name!r} must be a non-empty word of letters, digits, "
+                         "'_' and '-' (it names the output files)")
+    design = _design_source(check_string("study", "design", require_key("study", st, "design")),
+                            base)
+    side = check_string("study", "side", st.get("side", "drive"), ("drive", "coast"))
+    variables = tuple(_variable(i + 1, e) for i, e in enumerate(_entries(data, "variables")))
+    if not variables:
+        raise ValueError("the study has no [[variables]] (name at least one design field)")
+    fields = [v.field for v in variables]
+    dup = sorted({f for f in fields if fields.count(f) > 1})
+    if dup:
+        raise ValueError(f"[[variables]]: field {dup[0]!r} is given more than once")
+    objective = tuple(_term(i + 1, e) for i, e in enumerate(_entries(data, "objective")))
+    if not objective:
+        raise ValueError("the study has no [[objective]] term (name at least one quantity)")
+    constraints = [_constraint(i + 1, e) for i, e in enumerate(_entries(data, "constraints"))]
+    names = [t.quantity for t in objective] + [c.quantity for c in constraints]
+    if uses_mask(names) and not any(c.quantity == "min_margin_mm" and c.lower is not None
+                                    for c in constraints):
+        # the path quantities' fixed mask stays on the flank (gearjax.studies.quantities)
+        constraints.append(Constraint("min_margin_mm", 0.0, None, 1.0, added=True))
+    op = data.get("operating", {})
+    check_keys("operating", op, _OPERATING)
+    check_quantities(names, "[operating]", op)
+    opt = data.get("optimizer", {})
+    check_keys("optimizer", opt, {"method", "max_iterations", "tolerance", "starts", "seed"})
+    method = check_string("optimizer", "method", opt.get("method", METHODS[0]), METHODS)
+    max_it = check_integer("optimizer", "max_iterations", opt.get("max_iterations", 30), 1)
+    tol = check_number("optimizer", "tolerance", opt.get("tolerance", 1e-4))
+    if not 0.0 < tol < 1.0:
+        raise ValueError(f"[optimizer] tolerance = {tol:g} must be in (0, 1)")
+    starts = check_integer("optimizer", "starts", opt.get("starts", 1), 1)
+    if method == "slsqp" and starts > 1:
+        raise ValueError(f"[optimizer] starts = {starts}: the slsqp method runs one start "
+                         "(multi-start is for augmented_lagrangian)")
+    tca = data.get("tca", {})
+    check_keys("tca", tca, _TCA)
+    return Study(name=name, design=design, side=side, variables=variables,
+                 objective=objective, constraints=tuple(constraints),
+                 description=check_string("study", "description", st.get("description", "")),
+                 operating=dict(op), scenarios=_scenarios(data.get("scenarios", {})),
+                 tca={k: check_number("tca", k, v) for k, v in tca.items()}, method=method,
+                 max_iterations=max_it, tolerance=tol, starts=starts,
+                 seed=check_integer("optimizer", "seed", opt.get("seed", 0), 0),
+                 source=str(source))

@@ -1,0 +1,185 @@
+"""Study files (gearjax.studies.study_file) and design write-back (GearFamily.design_data):
+every bad entry refused with one line naming it, before any compilation; every family's
+design round-trips through its file with a changed field."""
+
+import math
+
+import numpy as np
+import pytest
+
+import gearjax as gj
+from gearjax.io import design_from_dict
+from gearjax.studies.study_file import list_studies, read_study
+from gearjax.tca.result import family_of
+
+GOOD = """
+[study]
+name = "s1"
+design = "example:khk_spur_12x24"
+
+[operating]
+torque_Nm = 60.0
+pinion_rpm = 3000.0
+oil = "mineral_vg100"
+sigma_um = 0.4
+
+[[variables]]
+field = "pair.x1"
+lower = 0.3
+upper = 0.75
+
+[[objective]]
+quantity = "power_loss_W"
+
+[[constraints]]
+quantity = "contact_ratio"
+lower = 1.25
+"""
+
+
+def _write(tmp_path, text, name="s.toml"):
+    p = tmp_path / name
+    p.write_text(text)
+    return str(p)
+
+
+def test_good_file_and_defaults(tmp_path):
+    st = read_study(_write(tmp_path, GOOD))
+    assert st.name == "s1" and st.side == "drive" and st.method == "augmented_lagrangian"
+    assert st.quantities == ["power_loss_W", "contact_ratio"]
+    v = st.variables[0]
+    assert v.bounds(0.6) == (0.3, 0.75)
+    # a change relative to the design's value, in degrees for a field in rad
+    st2 = read_study(_write(tmp_path, GOOD.replace(
+        'field = "pair.x1"\nlower = 0.3\nupper = 0.75',
+        'field = "pair.pressure_angle"\nchange = [-1.0, 2.0]\nunit = "deg"')))
+    lo, hi = st2.variables[0].bounds(0.35)
+    assert lo == pytest.approx(0.35 - math.radians(1.0)) and hi == pytest.approx(
+        0.35 + math.radians(2.0))
+
+
+def test_path_quantity_adds_the_mask_margin_constraint(tmp_path):
+    st = read_study(_write(tmp_path, GOOD.replace('quantity = "power_loss_W"',
+                                                  'quantity = "max_abs_srr"')))
+    added = [c for c in st.constraints if c.added]
+    assert len(added) == 1 and added[0].quantity == "min_margin_mm" and added[0].lower == 0.0
+
+
+@pytest.mark.parametrize("old, new, match", [
+    ('quantity = "power_loss_W"', 'quantity = "power_los_W"', r"\[\[objective\]\] 1: unknown "
+                                                               r"quantity 'power_los_W'"),
+    ("lower = 0.3\nupper = 0.75", "lower = 0.75\nupper = 0.3", r"\[\[variables\]\] 1 "
+                                                                r"\(pair.x1\): empty"),
+    ("lower = 0.3\nupper = 0.75", "change = [0.1, 0.2]", r"must contain 0"),
+    ("lower = 0.3\nupper = 0.75", "lower = 0.3", r"missing the required key 'upper'"),
+    ("lower = 0.3\nupper = 0.75", "", r"either lower and upper"),
+    ('sigma_um = 0.4\n', "", r"'power_loss_W' needs the operating point: sigma_um"),
+    ('[[objective]]\nquantity = "power_loss_W"\n', "", r"no \[\[objective\]\]"),
+    ('lower = 1.25', 'lower = 1.25\nupper = 1.0', r"empty range \[1.25, 1\]"),
+    ('lower = 1.25', 'bound = 1.25', r"unknown key '\[\[constraints\]\] 1.bound'"),
+    ('name = "s1"', 'name = "s 1"', r"\[study\] name = 's 1'"),
+    ('[[objective]]\nquantity = "power_loss_W"',
+     '[[objective]]\nquantity = "power_loss_W"\nweight = 0', r"weight = 0 must be > 0"),
+    ('sigma_um = 0.4\n', 'sigma_um = 0.4\n[optimizer]\nmethod = "bfgs"\n',
+     r"method = 'bfgs' must be one of"),
+    ('sigma_um = 0.4\n', 'sigma_um = 0.4\n[optimizer]\nmethod = "slsqp"\nstarts = 3\n',
+     r"starts = 3: the slsqp method runs one start"),
+    ('sigma_um = 0.4\n', 'sigma_um = 0.4\n[scenarios]\ndE_mm = []\n', r"dE_mm = \[\] is empty"),
+    ('sigma_um = 0.4\n', 'sigma_um = 0.4\n[scenarios]\ndQ_mm = 1\n', r"unknown key 'scenarios.dQ_mm'"),
+])
+def test_bad_entries_are_refused_with_one_line(tmp_path, old, new, match):
+    assert old in GOOD
+    with pytest.raises(ValueError, match=match) as exc:
+        read_study(_write(tmp_path, GOOD.replace(old, new, 1)))
+    assert "\n" not in str(exc.value)
+
+
+def test_duplicate_variable_and_unknown_field(tmp_path):
+    dup = GOOD.replace("[[objective]]", '[[variables]]\nfield = "pair.x1"\nchange = [-0.1, '
+                       '0.1]\n\n[[objective]]')
+    with pytest.raises(ValueError, match="'pair.x1' is given more than once"):
+        read_study(_write(tmp_path, dup))
+    from gearjax.studies.study_run import set_up
+    st = read_study(_write(tmp_path, GOOD.replace('"pair.x1"', '"pair.x3"')))
+    with pytest.raises(ValueError, match=r"\[\[variables\]\] 1: field 'pair.x3' is not a field "
+                                         r"of the design's pair \(fields: pair.module"):
+        set_up(st)
+    # the design's own value outside absolute bounds
+    st = read_study(_write(tmp_path, GOOD.replace("lower = 0.3", "lower = 0.65")))
+    with pytest.raises(ValueError, match=r"design's value 0.6 is outside \[0.65, 0.75\]"):
+        set_up(st)
+    # a scenario out of range, before any work
+    st = read_study(_write(tmp_path, GOOD.replace("sigma_um = 0.4\n", "sigma_um = 0.4\n"
+                                                  "[scenarios]\ntorque_Nm = [60, -5]\n")))
+    with pytest.raises(ValueError, match=r"scenario 2: torque_Nm = -5"):
+        set_up(st)
+
+
+def test_packaged_studies_read():
+    names = list_studies()
+    assert {"spur_efficiency", "hypoid_efficiency_te"} <= set(names)
+    for n in names:
+        st = read_study(f"example:{n}")
+        assert st.name == n and st.variables and st.objective
+
+
+@pytest.mark.parametrize("example, field, delta, key", [
+    ("khk_spur_12x24", "pair.x1", 0.05, ("pair", "profile_shift1", 0.65)),
+    ("khk_helical_12x60", "lead_crown", 1e-4, ("modification", "lead_crown_per_mm", 1e-4)),
+    ("khk_spur_12x24", "pair.pressure_angle", math.radians(0.5),
+     ("pair", "normal_pressure_angle_deg", 20.5)),
+    ("vh_catt_17x23", "cutter_radius1", 5.0, ("pair", "cutter_radius1_mm", 405.0)),
+    ("preset_te_bevel_10x30", "rho1", 1.0, ("flanks", "profile_radius_pinion_mm", 17.0)),
+])
+def test_design_write_back_round_trips(example, field, delta, key):
+    d = gj.load_design(f"example:{example}")
+    ad = family_of(d)
+    p = ad.fam.user_pair(ad.fam.setup(d, "drive")[0])
+    v = float(np.asarray(gj.get_fields(p, [field])[field]))
+    data = ad.design_data(d, gj.with_fields(p, {field: v + delta}), "drive")
+    table, k, expect = key
+    assert data[table][k] == pytest.approx(expect, rel=1e-12)
+    back = ad.fam.pair(design_from_dict(data))
+    assert float(np.asarray(gj.get_fields(back, [field])[field])) == pytest.approx(
+        v + delta, rel=1e-12, abs=1e-15)
+    # the unchanged fields are not written
+    assert data == {**d.to_dict(), table: {**d.to_dict().get(table, {}), k: data[table][k]}}
+
+
+def test_preset_kappa_is_written_as_the_preset_te():
+    d = gj.load_design("example:preset_te_bevel_10x30")
+    ad = family_of(d)
+    p = ad.fam.pair(d)
+    k = float(p.kappa)
+    data = ad.design_data(d, gj.with_fields(p, {"kappa": 1.25 * k}), "drive")
+    # te = kappa (t_min - t_m)^2 is linear in kappa at fixed geometry
+    assert data["preset"]["te_arcsec"] == pytest.approx(1.25 * d.data["preset"]["te_arcsec"],
+                                                        rel=1e-10)
+    back = ad.fam.pair(design_from_dict(data))
+    assert float(back.kappa) == pytest.approx(1.25 * k, rel=1e-10)
+
+
+def test_hypoid_write_back_and_refusal_of_an_unwritable_field():
+    d = gj.load_design("example:hypoid_iso_10x41_synthesised")
+    ad = family_of(d)
+    p = ad.fam.user_pair(ad.fam.setup(d, "drive")[0])
+    name = "pinion.machine.tilt"
+    v = float(gj.get_fields(p, [name])[name])
+    data = ad.design_data(d, gj.with_fields(p, {name: v + 0.01}), "drive")
+    assert data["pinion"]["concave"]["machine"]["tilt"] == pytest.approx(
+        math.degrees(v + 0.01), rel=1e-12)
+    back = ad.fam.user_pair(ad.fam.setup(design_from_dict(data), "drive")[0])
+    assert float(gj.get_fields(back, [name])[name]) == pytest.approx(v + 0.01, rel=1e-12)
+    # a field without a design-file key (an involute pair's tooth numbers are static; its
+    # tip, a traced array here, has none) is refused by name
+    s = gj.load_design("example:khk_spur_12x24")
+    sp = family_of(s).fam.pair(s)
+    fam = family_of(s).fam
+    saved = dict(fam.file_fields)
+    try:
+        fam.file_fields = {k: v for k, v in saved.items() if k != "face_width"}
+        with pytest.raises(ValueError, match="field 'face_width' of a involute pair has no "
+                                             "design-file key"):
+            family_of(s).design_data(s, gj.with_fields(sp, {"face_width": 25.0}), "drive")
+    finally:
+        fam.file_fields = saved
