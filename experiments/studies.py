@@ -94,7 +94,8 @@ def markdown(rows) -> str:
         lines.append(f"| {r['study']} | {r['method']} | {r['objective_quantity']} | "
                      f"{r['start']:.6g} | {r['end']:.6g} | {ch:+.2f} % | {hard} | "
                      f"{r['iterations']} | {r['evaluations']} | {r['optimizer_s']:.1f} | "
-                     f"{r['wall_s']:.1f} | {'yes' if r['accepted'] else 'no: ' + '; '.join(r['reasons'])} |")
+                     f"{r['wall_s']:.1f} | "
+                     f"{'yes' if r['accepted'] else 'no: ' + '; '.join(r['reasons'])} |")
     return "\n".join(lines)
 
 

@@ -11,7 +11,7 @@ The chain (docs/architecture.md), each step a pure JAX function so that
                      -> kinematics at the contact points       TCAResult.kinematics
                      -> Hertz load, film, friction, losses     gearjax.tribology
                      -> load sharing, mesh efficiency          mesh_efficiency, efficiency_function
-                     -> objective -> gradient -> optimiser     minimize_constrained, minimize_optax, ...
+                     -> objective -> gradient -> optimiser     minimize_constrained, ...
                      -> design studies (gearjax optimize)      gearjax.studies
 
 The public face is the ~40 names of ``gearjax.__all__`` (verbs and types of the chain,

@@ -67,7 +67,7 @@ import jax.numpy as jnp
 import numpy as np
 
 # importing gearjax (here through gearjax.optimize) switches on float64
-from gearjax.optimize import CONVERGED, FAILED, MAX_ITERATIONS, status_message
+from gearjax.optimize import CONVERGED, FAILED, MAX_ITERATIONS, status_properties
 
 __all__ = ["ConstrainedResult", "minimize_constrained"]
 
@@ -99,13 +99,7 @@ class ConstrainedResult(NamedTuple):
     history_stationarity: jnp.ndarray
     history_x: jnp.ndarray
 
-    @property
-    def message(self) -> str:
-        return status_message(self.status)
-
-    @property
-    def converged(self) -> bool:
-        return int(self.status) == CONVERGED
+    message, converged = status_properties()
 
 
 def _pg(x, grad, lo, hi):

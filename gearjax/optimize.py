@@ -83,6 +83,16 @@ def status_message(status) -> str:
     return STATUS_MESSAGES[code]
 
 
+def status_properties():
+    """``(message, converged)``: the two properties every result with an integer
+    ``status`` field has (``message``: :func:`status_message`; ``converged``: status
+    :data:`CONVERGED`; concrete results only)."""
+    return (property(lambda self: status_message(self.status),
+                     doc="the text of ``status``"),
+            property(lambda self: int(self.status) == CONVERGED,
+                     doc="``status`` is CONVERGED"))
+
+
 class OptResult(NamedTuple):
     """x: final parameters; value: objective there; history: objective before each
     step (``steps`` values) ; x_history: parameters before each step
@@ -99,13 +109,7 @@ class OptResult(NamedTuple):
     steps: int
     status: jnp.ndarray = np.asarray(MAX_ITERATIONS)
 
-    @property
-    def message(self) -> str:
-        return status_message(self.status)
-
-    @property
-    def converged(self) -> bool:
-        return int(self.status) == CONVERGED
+    message, converged = status_properties()
 
 
 def value_and_grad(fun: Callable, mode: str = "rev") -> Callable:
@@ -270,13 +274,7 @@ class LMResult(NamedTuple):
     history: jnp.ndarray
     residual_history: jnp.ndarray
 
-    @property
-    def message(self) -> str:
-        return status_message(self.status)
-
-    @property
-    def converged(self) -> bool:
-        return int(self.status) == CONVERGED
+    message, converged = status_properties()
 
 
 _RUNNING = -1

@@ -38,3 +38,11 @@ def test_quickstart_runs_and_its_gradient_matches(tmp_path):
     assert float(m.group(1)) < 1e-6
     flags = re.search(r"flags\s+(\{.*\})", text).group(1)
     assert "'converged': True" in flags
+
+
+def test_design_study_notebook_runs_and_converges(tmp_path):
+    nb = _run(ROOT / "notebooks" / "02_design_study.ipynb", tmp_path)
+    text = _text(nb)
+    assert "converged:" in text and "accepted: True []" in text, text[-2000:]
+    kkt = re.search(r"stationarity ([0-9.e+-]+), feasibility ([0-9.e+-]+)", text)
+    assert float(kkt.group(1)) <= 1e-4 and float(kkt.group(2)) <= 1e-4

@@ -85,7 +85,8 @@ def test_path_quantity_adds_the_mask_margin_constraint(tmp_path):
     ('sigma_um = 0.4\n', 'sigma_um = 0.4\n[optimizer]\nmethod = "slsqp"\nstarts = 3\n',
      r"starts = 3: the slsqp method runs one start"),
     ('sigma_um = 0.4\n', 'sigma_um = 0.4\n[scenarios]\ndE_mm = []\n', r"dE_mm = \[\] is empty"),
-    ('sigma_um = 0.4\n', 'sigma_um = 0.4\n[scenarios]\ndQ_mm = 1\n', r"unknown key 'scenarios.dQ_mm'"),
+    ('sigma_um = 0.4\n', 'sigma_um = 0.4\n[scenarios]\ndQ_mm = 1\n',
+     r"unknown key 'scenarios.dQ_mm'"),
 ])
 def test_bad_entries_are_refused_with_one_line(tmp_path, old, new, match):
     assert old in GOOD

@@ -123,6 +123,11 @@ class MeshEfficiency(NamedTuple):
     n_valid : number of valid positions, over which the four summaries are taken.
     te_loaded_ptp : peak-to-peak of the loaded TE over the valid positions (rad; NaN
         when none).
+    edge_share : (M,) the part of the mesh stiffness the soft active set takes away,
+        ``sum_k k_k (1 - s_k) / sum_k k_k`` over the pairs in contact (``k_k`` a pair's
+        linear stiffness, ``s_k`` its softening factor within ``edge_softening_mm`` of a
+        flank boundary; 0 without softening): where it is not small the softened model
+        is not the hard one (:func:`mesh_efficiency_traced`).
     """
 
     phi1: jax.Array
@@ -144,6 +149,7 @@ class MeshEfficiency(NamedTuple):
     degenerate: jax.Array
     n_valid: jax.Array
     te_loaded_ptp: jax.Array
+    edge_share: jax.Array
 
 
 class CycleSummary(NamedTuple):
@@ -269,6 +275,8 @@ def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, pinion_r
         c0 = jnp.zeros_like(q0)
     else:
         c0 = hertz_coefficient(r_x0, r_y0, E_prime)
+    soft = jnp.ones_like(q0)
+    k_hard = 1.0 / q0                     # the pairs' linear stiffness before softening
     if edge_softening_mm > 0.0:
         t = jnp.clip(jnp.where(on, res.margin, 0.0) / edge_softening_mm, 0.0, 1.0)
         soft = jnp.maximum(t * t * (3.0 - 2.0 * t), 1e-30)
@@ -313,6 +321,11 @@ def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, pinion_r
     fr = FrictionResult(*(jnp.swapaxes(v, 0, 1) for v in ml.friction))
     loaded_on = F > 0.0
     share = l1 * F / T1
+    # the stiffness the softening takes from the pairs in contact (closing: w > 0)
+    k_in = jnp.where(act & (w > 0.0), pairs(jnp.where(on, k_hard, 0.0), 0.0), 0.0)
+    k_all = jnp.sum(k_in, axis=0)
+    edge_share = (jnp.sum(k_in * (1.0 - pairs(jnp.where(on, soft, 1.0), 1.0)), axis=0)
+                  / jnp.where(k_all > 0.0, k_all, 1.0))
     lc = LoadedContact(F, share, w, p_max, a_ax, b_ax, y, te_loaded, bal, conv,
                        jnp.sum(loaded_on, axis=0))
     # coverage: pair 0 on the flank where no pair of the window sees it
@@ -345,7 +358,7 @@ def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, pinion_r
     sm = cycle_summary(ml.power_loss, power_in, ml.mu.T, F, us, p_max, te_loaded, valid)
     return MeshEfficiency(path.phi1[win], lc, ue, us, R_x, R_y, fr, ml.power_loss, ml.efficiency,
                           sm.mean_efficiency, sm.mean_mu, sm.max_p_max, power_in, valid, truncated,
-                          edge_loaded, degenerate, sm.n_valid, sm.te_loaded_ptp)
+                          edge_loaded, degenerate, sm.n_valid, sm.te_loaded_ptp, edge_share)
 
 
 def _grid_options(ad, design, tca_options: dict) -> dict:

@@ -199,8 +199,15 @@ QUANTITIES: dict = {
         "", True, False, None, "load- and sliding-weighted mean friction coefficient",
         lambda res, eff, mask, pair: eff.mean_mu),
     "peak_pressure_MPa": Quantity(
-        "MPa", True, False, P_MAX_TEMPERATURE, "highest Hertz pressure over the loaded contacts (smooth max)",
+        "MPa", True, False, P_MAX_TEMPERATURE,
+        "highest Hertz pressure over the loaded contacts (smooth max)",
         _peak_pressure),
+    "edge_load_share": Quantity(
+        "", True, False, None,
+        "mean over the valid positions of the part of the mesh stiffness the soft active "
+        "set takes away (contacts within edge_softening_mm of a flank boundary; 0 without)",
+        lambda res, eff, mask, pair: jnp.sum(jnp.where(eff.valid, eff.edge_share, 0.0))
+        / jnp.maximum(jnp.sum(eff.valid), 1)),
     "loaded_te_ptp_arcsec": Quantity(
         "arcsec", True, False, None, "peak-to-peak of the loaded TE over the valid positions",
         lambda res, eff, mask, pair: eff.te_loaded_ptp / ARCSEC),

@@ -115,12 +115,16 @@ class Study:
     starts: int = 1
     seed: int = 0
     source: str = ""
+    #: quantities evaluated and reported but in neither the objective nor a constraint
+    reported: tuple = ()
 
     @property
     def quantities(self) -> list:
-        """The quantities the study evaluates (objective first, then constraints)."""
+        """The quantities the study evaluates (objective, constraints, then those only
+        reported)."""
         out = []
-        for q in [t.quantity for t in self.objective] + [c.quantity for c in self.constraints]:
+        for q in ([t.quantity for t in self.objective] + [c.quantity for c in self.constraints]
+                  + list(self.reported)):
             if q not in out:
                 out.append(q)
         return out

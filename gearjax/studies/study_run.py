@@ -148,6 +148,10 @@ def set_up(study: Study) -> Problem:
         # since the loader's concrete checks do not run on traced values
         study = dataclasses.replace(study, constraints=study.constraints + (
             Constraint("tooth_form_margin_mm", 0.0, None, 0.1, added=True),))
+    soft = float(chain.options["edge_softening_mm"]) if loaded else 0.0
+    if soft > 0.0 and "edge_load_share" not in study.quantities:
+        # reported: how much of the mesh stiffness the softening takes (docs/optimize.md)
+        study = dataclasses.replace(study, reported=study.reported + ("edge_load_share",))
     known = field_names(pair0)
     x0, lo, hi, sc = [], [], [], []
     for i, v in enumerate(study.variables):
@@ -165,8 +169,7 @@ def set_up(study: Study) -> Problem:
     scen = _scenario_list(study)
     _check_scenarios(scen, loaded)
     prob = Problem(study, design, chain, [v.field for v in study.variables], np.array(x0),
-                   np.array(lo), np.array(hi), scen, loaded,
-                   soft=float(chain.options["edge_softening_mm"]) if loaded else 0.0)
+                   np.array(lo), np.array(hi), scen, loaded, soft=soft)
     oil = surface = None
     if loaded:
         oil = dataclasses.replace(gj.tribology.get_oil(str(study.operating["oil"])), name="")
