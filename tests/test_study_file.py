@@ -184,3 +184,71 @@ def test_hypoid_write_back_and_refusal_of_an_unwritable_field():
             family_of(s).design_data(s, gj.with_fields(sp, {"face_width": 25.0}), "drive")
     finally:
         fam.file_fields = saved
+
+
+def test_scale_and_bounds_in_degrees_and_scenario_combinations(tmp_path):
+    from gearjax.studies.study_run import set_up
+    text = GOOD.replace('field = "pair.x1"\nlower = 0.3\nupper = 0.75',
+                        'field = "pair.pressure_angle"\nchange = [-1.0, 2.0]\nunit = "deg"\n'
+                        'scale = 0.5')
+    text = text.replace("sigma_um = 0.4\n", "sigma_um = 0.4\n[scenarios]\ntorque_Nm = [40, 60]\n"
+                        "dE_mm = [0.0, 0.02, -0.03]\n")
+    prob = set_up(read_study(_write(tmp_path, text)))
+    deg = math.pi / 180.0
+    assert float(prob.data.scale[0]) == pytest.approx(0.5 * deg, rel=1e-14)
+    # u bounds: change / scale, both in degrees
+    assert prob.lower[0] == pytest.approx(-2.0) and prob.upper[0] == pytest.approx(4.0)
+    # every combination of the lists, in order
+    combos = [(s["torque_Nm"], s["dE_mm"]) for s in prob.scenarios]
+    assert combos == [(40, 0.0), (40, 0.02), (40, -0.03), (60, 0.0), (60, 0.02), (60, -0.03)]
+    assert np.asarray(prob.data.mis.dE).tolist() == [0.0, 0.02, -0.03] * 2
+    assert all(s["pinion_rpm"] == 3000.0 for s in prob.scenarios)
+
+
+def test_a_margin_bound_from_above_still_gets_the_mask_constraint(tmp_path):
+    text = GOOD.replace('quantity = "power_loss_W"', 'quantity = "max_abs_srr"')
+    text += '\n[[constraints]]\nquantity = "min_margin_mm"\nupper = 5.0\n'
+    st = read_study(_write(tmp_path, text))
+    added = [c for c in st.constraints if c.added]
+    assert [(c.quantity, c.lower, c.upper) for c in added] == [("min_margin_mm", 0.0, None)]
+
+
+def test_acceptance_reasons_each_check():
+    from gearjax.studies.study_run import acceptance_reasons
+    ok = dict(converged=True, edge_contact=False, n_valid=13)
+    good = dict(opt={"converged": True, "message": "converged"}, feasibility=0.0, tol=1e-4,
+                file_error=None, difference=0.0, x=np.array([1.0, 2.0]), flags0=[ok],
+                flags1=[dict(ok)], hard=(1.0, 0.9))
+    assert acceptance_reasons(**good) == []
+    cases = [
+        (dict(opt={"converged": False, "message": "step limit"}), "stopping test"),
+        (dict(feasibility=2e-4), "constraints violated by 0.0002"),
+        (dict(file_error="x1 undercuts"), "refused by its design-file checks: x1 undercuts"),
+        (dict(difference=1e-6), "does not reproduce"),
+        (dict(hard=(1.0, 1.01)), "hard model"),
+        (dict(flags1=[dict(ok, converged=False)]), "scenario 1: the end design's TCA"),
+        (dict(flags1=[dict(ok, edge_contact=True)]), "scenario 1: the end design has edge"),
+        (dict(flags1=[dict(ok, n_valid=12)]), "fewer valid positions of the cycle at the end "
+                                              "(12 < 13)"),
+    ]
+    for change, text in cases:
+        r = acceptance_reasons(**{**good, **change})
+        assert len(r) == 1 and text in r[0], (change, r)
+    # an edge contact present at the start is not a new one; no hard model: not checked
+    assert acceptance_reasons(**{**good, "flags0": [dict(ok, edge_contact=True)],
+                                 "flags1": [dict(ok, edge_contact=True)], "hard": None}) == []
+
+
+def test_soften_edges():
+    import jax.numpy as jnp
+    from gearjax.loading.mesh_efficiency import soften_edges
+    q, c = jnp.array([1e-5, 2e-5, 3e-5]), jnp.array([1e-4, 0.0, 2e-4])
+    m = jnp.array([0.05, 0.1, 0.5])
+    q2, c2, s = soften_edges(q, c, m, 0.2)
+    t = np.array([0.25, 0.5, 1.0])
+    np.testing.assert_allclose(np.asarray(s), 3 * t ** 2 - 2 * t ** 3, rtol=1e-14)
+    # the whole pair compliance (linear and Hertz) grows as 1/s
+    np.testing.assert_allclose(np.asarray(q2), np.asarray(q) / np.asarray(s), rtol=1e-14)
+    np.testing.assert_allclose(np.asarray(c2), np.asarray(c) / np.asarray(s), rtol=1e-14)
+    q3, c3, s3 = soften_edges(q, c, m, 0.0)
+    assert q3 is q and c3 is c and np.all(np.asarray(s3) == 1.0)

@@ -80,7 +80,7 @@ from gearjax.tribology.lubricant import Oil
 
 __all__ = ["MeshEfficiency", "mesh_efficiency", "DEFAULT_COMPLIANCE", "COMPLIANCE_HELP",
            "check_efficiency_inputs", "efficiency_function", "mesh_efficiency_traced",
-           "cycle_window", "check_operating_point", "cycle_summary", "CycleSummary",
+           "cycle_window", "check_operating_point", "cycle_summary", "CycleSummary", "soften_edges",
            "TORQUE_RANGE_NM", "RPM_RANGE", "FILM_MIN_MM"]
 
 
@@ -221,6 +221,19 @@ def _equivalent_ry(F, r_x, L, E_prime):
     return r_x * (k / 1.0339) ** (1.0 / 0.636)
 
 
+def soften_edges(q, c, margin, delta):
+    """The soft active set (:func:`mesh_efficiency_traced`): ``(q/s, c/s, s)`` with
+    ``s = 3t^2 - 2t^3``, ``t = clip(margin/delta, 0, 1)`` (floored at 1e-30), for the
+    linear compliance ``q`` (mm/N) and the Hertz coefficient ``c`` (mm/N^(2/3)) of
+    contacts ``margin`` mm inside their flank boundaries: the whole pair compliance
+    grows as ``1/s`` towards the edge.  ``delta`` (mm, static) 0: unchanged, ``s = 1``."""
+    if delta <= 0.0:
+        return q, c, jnp.ones_like(q)
+    t = jnp.clip(margin / delta, 0.0, 1.0)
+    s = jnp.maximum(t * t * (3.0 - 2.0 * t), 1e-30)
+    return q / s, c / s, s
+
+
 def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, pinion_rpm, oil: Oil,
                            surface: Surface, *, steps_per_pitch: int, n_pairs: int,
                            E_prime=STEEL_E_PRIME, poisson=NU_STEEL,
@@ -275,12 +288,8 @@ def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, pinion_r
         c0 = jnp.zeros_like(q0)
     else:
         c0 = hertz_coefficient(r_x0, r_y0, E_prime)
-    soft = jnp.ones_like(q0)
     k_hard = 1.0 / q0                     # the pairs' linear stiffness before softening
-    if edge_softening_mm > 0.0:
-        t = jnp.clip(jnp.where(on, res.margin, 0.0) / edge_softening_mm, 0.0, 1.0)
-        soft = jnp.maximum(t * t * (3.0 - 2.0 * t), 1e-30)
-        q0, c0 = q0 / soft, c0 / soft
+    q0, c0, soft = soften_edges(q0, c0, jnp.where(on, res.margin, 0.0), edge_softening_mm)
 
     def pairs(a, fill):
         return pair_arrays(a, steps_per_pitch, K, fill, win)

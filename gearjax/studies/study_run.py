@@ -50,7 +50,7 @@ from gearjax.studies.study_file import Constraint, Study
 from gearjax.tca.assembly import Misalignment
 
 __all__ = ["Problem", "StudyResult", "set_up", "evaluate", "evaluator", "grid_size", "start_point",
-           "run_study"]
+           "run_study", "acceptance_reasons"]
 
 #: smooth maximum over scenarios: temperature in units of the term's scale
 SCENARIO_TEMPERATURE = 0.01
@@ -411,6 +411,39 @@ def _run_al(prob: Problem, callback):
     return _scenario(rs, best), {"starts": st.starts, "best_start": best, "per_start": per}
 
 
+def acceptance_reasons(opt: dict, feasibility: float, tol: float, file_error, difference,
+                       x, flags0: list, flags1: list, hard=None) -> list:
+    """Why an end design is not accepted (empty: accepted; module docstring): the
+    optimiser's stopping test (``opt["converged"]``), the scaled constraint violation
+    against ``tol``, the design file (``file_error`` of the loader; ``difference`` of its
+    fields from the optimiser's ``x``, relative 1e-9), per scenario the TCA flags and
+    valid positions (``flags0``/``flags1`` at start/end), and ``hard = (J0, J1)``, the
+    objective with the hard model when the study softens the edges."""
+    reasons = []
+    if not opt["converged"]:
+        reasons.append(f"the optimiser did not meet its stopping test ({opt['message']})")
+    if feasibility > tol:
+        reasons.append(f"constraints violated by {feasibility:.3g} (scaled; tolerance {tol:g})")
+    if file_error is not None:
+        reasons.append(f"the end design is refused by its design-file checks: {file_error}")
+    elif difference > 1e-9 * (1.0 + float(np.max(np.abs(x)))):
+        reasons.append(f"the design file does not reproduce the end design (field difference "
+                       f"{difference:.3g})")
+    if hard is not None and hard[1] > hard[0] + tol:
+        reasons.append(f"with the hard model (no edge softening, as gearjax efficiency) the "
+                       f"objective rose {hard[0]:.6g} -> {hard[1]:.6g}")
+    for k, (a, b) in enumerate(zip(flags0, flags1)):
+        where = f"scenario {k + 1}"
+        if not b["converged"]:
+            reasons.append(f"{where}: the end design's TCA did not converge")
+        if b["edge_contact"] and not a["edge_contact"]:
+            reasons.append(f"{where}: the end design has edge contact")
+        if "n_valid" in b and b["n_valid"] < a["n_valid"]:
+            reasons.append(f"{where}: fewer valid positions of the cycle at the end "
+                           f"({b['n_valid']} < {a['n_valid']})")
+    return reasons
+
+
 def _round_trip(prob: Problem, end_pair):
     """The end design written to a design file and read back through the family's
     validating loader; ``(data, error or None, max |field difference|)``."""
@@ -474,30 +507,9 @@ def run_study(prob: Problem, callback=None, phase=None) -> StudyResult:
                                                  for i, n in enumerate(prob.fields)})
         data, err, diff = _round_trip(prob, end_pair)
         flags0, flags1 = _flags(prob, res0, eff0), _flags(prob, res1, eff1)
-    reasons = []
-    if not opt["converged"]:
-        reasons.append(f"the optimiser did not meet its stopping test ({opt['message']})")
     feas = float(np.max(np.asarray(g1), initial=0.0))
-    if feas > st.tolerance:
-        reasons.append(f"constraints violated by {feas:.3g} (scaled; tolerance {st.tolerance:g})")
-    if err is not None:
-        reasons.append(f"the end design is refused by its design-file checks: {err}")
-    elif diff > 1e-9 * (1.0 + float(np.max(np.abs(x)))):
-        reasons.append(f"the design file does not reproduce the end design (field difference "
-                       f"{diff:.3g})")
-    soft = prob.soft > 0.0
-    if soft and Jh1 > Jh0 + st.tolerance:
-        reasons.append(f"with the hard model (no edge softening, as gearjax efficiency) the "
-                       f"objective rose {Jh0:.6g} -> {Jh1:.6g}")
-    for k, (a, b) in enumerate(zip(flags0, flags1)):
-        where = f"scenario {k + 1}"
-        if not b["converged"]:
-            reasons.append(f"{where}: the end design's TCA did not converge")
-        if b["edge_contact"] and not a["edge_contact"]:
-            reasons.append(f"{where}: the end design has edge contact")
-        if "n_valid" in b and b["n_valid"] < a["n_valid"]:
-            reasons.append(f"{where}: fewer valid positions of the cycle at the end "
-                           f"({b['n_valid']} < {a['n_valid']})")
+    reasons = acceptance_reasons(opt, feas, st.tolerance, err, diff, x, flags0, flags1,
+                                 (Jh0, Jh1) if prob.soft > 0.0 else None)
     scale = np.asarray(prob.data.scale)
     variables = [{"field": v.field, "unit": v.unit or "field",
                   "lower": (prob.x0[i] + scale[i] * prob.lower[i]) / v.factor,
