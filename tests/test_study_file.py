@@ -76,7 +76,9 @@ def test_path_quantity_adds_the_mask_margin_constraint(tmp_path):
     ('sigma_um = 0.4\n', "", r"'power_loss_W' needs the operating point: sigma_um"),
     ('[[objective]]\nquantity = "power_loss_W"\n', "", r"no \[\[objective\]\]"),
     ('lower = 1.25', 'lower = 1.25\nupper = 1.0', r"empty range \[1.25, 1\]"),
-    ('lower = 1.25', 'bound = 1.25', r"unknown key '\[\[constraints\]\] 1.bound'"),
+    ('lower = 1.25', 'bound = 1.25', r"unknown key 'bound' in \[\[constraints\]\] 1 \(allowed"),
+    ("lower = 0.3\nupper = 0.75", "lower = nan\nupper = 0.75",
+     r"^\[\[variables\]\] 1: lower = nan must be a finite number$"),
     ('name = "s1"', 'name = "s 1"', r"\[study\] name = 's 1'"),
     ('[[objective]]\nquantity = "power_loss_W"',
      '[[objective]]\nquantity = "power_loss_W"\nweight = 0', r"weight = 0 must be > 0"),
@@ -87,6 +89,10 @@ def test_path_quantity_adds_the_mask_margin_constraint(tmp_path):
     ('sigma_um = 0.4\n', 'sigma_um = 0.4\n[scenarios]\ndE_mm = []\n', r"dE_mm = \[\] is empty"),
     ('sigma_um = 0.4\n', 'sigma_um = 0.4\n[scenarios]\ndQ_mm = 1\n',
      r"unknown key 'scenarios.dQ_mm'"),
+    ('oil = "mineral_vg100"', 'oil = "olive"', r"\[operating\] oil = 'olive' must be one of"),
+    ('torque_Nm = 60.0', 'torque_Nm = "60"', r"\[operating\] torque_Nm = '60' must be a number"),
+    ('sigma_um = 0.4', 'sigma_um = 0.4\nedge_softening_mm = -1',
+     r"\[operating\] edge_softening_mm = -1"),
 ])
 def test_bad_entries_are_refused_with_one_line(tmp_path, old, new, match):
     assert old in GOOD

@@ -202,6 +202,23 @@ def readonly_dir(tmp: Path) -> dict:
     raise RuntimeError("no read-only directory available to this user")
 
 
+def study_file(*replacements, name: str = "study.toml"):
+    """Setup: the packaged study ``spur_sliding`` with text ``replacements`` ``(old,
+    new)`` applied, written to ``{tmp}/name`` -> ``{study}``."""
+
+    def setup(tmp: Path) -> dict:
+        text = (EXAMPLES_DIR / "studies" / "spur_sliding.toml").read_text(encoding="utf-8")
+        for old, new in replacements:
+            if old not in text:
+                raise RuntimeError(f"study_file: {old!r} not in spur_sliding.toml")
+            text = text.replace(old, new, 1)
+        p = tmp / name
+        p.write_text(text, encoding="utf-8")
+        return {"study": str(p)}
+
+    return setup
+
+
 def plain_file(name: str = "afile"):
     """Setup: a regular file, to be used as if it were a directory -> ``{file}``."""
 
@@ -801,6 +818,53 @@ def build_cases() -> list[Case]:
     add("efficiency.compliance=steel", ["efficiency", TCA_INV, *_argv(eff),
                                         "--compliance", "steel"], "refuse",
         "unknown compliance model")
+
+    # ---------------------------------------------------------------- optimize
+    add("optimize.ok.list", ["optimize", "--list"], "ok", "packaged studies")
+    add("optimize.ok.quantities", ["optimize", "--quantities"], "ok", "the quantity table")
+    add("optimize.ok.fields", ["optimize", "example:spur_sliding", "--fields"], "ok",
+        "the design fields of a study's design")
+    add("optimize.ok.sliding", ["optimize", "example:spur_sliding", "--out", "{tmp}/o",
+                                "--no-plot"], "ok", "a packaged study, converged", heavy=True)
+    add("optimize.no_study", ["optimize"], "refuse", "STUDY missing")
+    add("optimize.unknown_example", ["optimize", "example:nope"], "refuse",
+        "unknown packaged study")
+    add("optimize.missing_file", ["optimize", "{tmp}/no_such_study.toml"], "refuse",
+        "study file missing")
+    add("optimize.max_iterations=0", ["optimize", "example:spur_sliding",
+                                      "--max-iterations", "0"], "refuse", "--max-iterations 0")
+    add("optimize.out_is_a_file", ["optimize", "example:spur_sliding", "--out", "{file}"],
+        "refuse", "--out names a file", setup=plain_file())
+    for cid, old, new, why in (
+            ("unknown_quantity", 'quantity = "max_abs_srr"', 'quantity = "max_srr"',
+             "unknown quantity"),
+            ("empty_bounds", "lower = 0.3\nupper = 0.9", "lower = 0.9\nupper = 0.3",
+             "empty bounds"),
+            ("unknown_field", 'field = "pair.x1"', 'field = "pair.x9"',
+             "a field the design does not have"),
+            ("nan_bound", "lower = 0.3", "lower = nan", "NaN bound"),
+            ("unknown_key", "[optimizer]", "[optimizer]\nspeed = 3", "unknown key"),
+            ("loaded_without_operating", 'quantity = "max_abs_srr"',
+             'quantity = "power_loss_W"', "loaded quantity without an operating point")):
+        add(f"optimize.study.{cid}", ["optimize", "{study}", "--out", "{tmp}/o"], "refuse", why,
+            setup=study_file((old, new)))
+
+    # ---------------------------------------------------------------- sensitivity
+    sens = ["sensitivity", "example:khk_spur_12x24"]
+    add("sensitivity.ok.json", [*sens, "--outputs", "contact_ratio,mean_abs_srr", "--params",
+                                "pair.x1,pair.x2", "--json"], "ok",
+        "exact sensitivities of two TCA quantities", heavy=True)
+    for cid, outs, params, why in (
+            ("unknown_output", "contact_rate", "pair.x1", "unknown quantity"),
+            ("unknown_param", "contact_ratio", "pair.x9", "unknown field"),
+            ("duplicate_param", "contact_ratio", "pair.x1,pair.x1", "a field twice"),
+            ("empty_outputs", ",", "pair.x1", "no output named"),
+            ("loaded_without_operating", "power_loss_W", "pair.x1",
+             "a loaded quantity without --torque-Nm etc.")):
+        add(f"sensitivity.{cid}", [*sens, "--outputs", outs, "--params", params], "refuse", why)
+    add("sensitivity.plot_dir_missing", [*sens, "--outputs", "contact_ratio", "--params",
+                                         "pair.x1", "--plot", "{tmp}/no/dir/t.png"], "refuse",
+        "--plot into a missing directory: refused before any work")
     return cs
 
 

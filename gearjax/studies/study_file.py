@@ -157,6 +157,25 @@ def check_quantities(names, where: str, operating: dict) -> None:
                          f"point: {missing[0]} is missing")
 
 
+def _entry_messages(fn):
+    """Entry readers' errors as ``[[variables]] 2: lower = nan ...``: the table helpers of
+    :mod:`gearjax.io.toml` write ``[where] key``, which for an array entry would read
+    ``[[[variables]] 2] key``."""
+    import functools
+    import re
+
+    @functools.wraps(fn)
+    def read(i, e):
+        try:
+            return fn(i, e)
+        except ValueError as exc:
+            msg = re.sub(r"in \[(\[\[\w+\]\] \d+)\]", r"in \1", str(exc))
+            msg = re.sub(r"\[(\[\[\w+\]\] \d+)\]", r"\1:", msg)
+            msg = re.sub(r"'\[\[\w+\]\] \d+\.", "'", msg)
+            raise ValueError(msg.replace("::", ":")) from None
+    return read
+
+
 def _entries(data, key) -> list:
     v = data.get(key, [])
     if not isinstance(v, list) or not all(isinstance(e, dict) for e in v):
@@ -180,6 +199,7 @@ def _scale(where, e):
     return s
 
 
+@_entry_messages
 def _variable(i, e) -> Variable:
     w = f"[[variables]] {i}"
     check_keys(w, e, {"field", "lower", "upper", "change", "unit", "scale"})
@@ -207,6 +227,7 @@ def _variable(i, e) -> Variable:
     return Variable(name, lo, hi, change, unit, _scale(w, e))
 
 
+@_entry_messages
 def _term(i, e) -> Term:
     w = f"[[objective]] {i}"
     check_keys(w, e, {"quantity", "weight", "sense", "over", "scale"})
@@ -219,6 +240,7 @@ def _term(i, e) -> Term:
                 check_string(w, "over", e.get("over", "mean"), ("mean", "max")), _scale(w, e))
 
 
+@_entry_messages
 def _constraint(i, e) -> Constraint:
     w = f"[[constraints]] {i}"
     check_keys(w, e, {"quantity", "lower", "upper", "scale"})
@@ -230,6 +252,31 @@ def _constraint(i, e) -> Constraint:
     if lo is not None and hi is not None and not lo < hi:
         raise ValueError(f"{w} ({q}): empty range [{lo:g}, {hi:g}] (need lower < upper)")
     return Constraint(q, lo, hi, _scale(w, e))
+
+
+def _operating(op) -> dict:
+    """The ``[operating]`` table with every value checked (type, allowed names, ranges of
+    the softening; torque and speed against their ranges when the study is set up)."""
+    from gearjax.errors import check_range
+    from gearjax.loading import COMPLIANCE_MODELS
+    from gearjax.tribology import OILS
+    check_keys("operating", op, _OPERATING)
+    out = {}
+    for k, v in op.items():
+        if k == "oil":
+            out[k] = check_string("operating", k, v, OILS)
+        elif k == "compliance":
+            out[k] = check_string("operating", k, v, COMPLIANCE_MODELS)
+        else:
+            out[k] = check_number("operating", k, v)
+    if "edge_softening_mm" in out:
+        try:
+            check_range("edge_softening_mm", out["edge_softening_mm"], 0.0, 10.0, unit="mm")
+        except ValueError as exc:
+            raise ValueError(f"[operating] {exc}") from None
+    if "sigma_um" in out and not out["sigma_um"] > 0.0:
+        raise ValueError(f"[operating] sigma_um = {out['sigma_um']:g} must be > 0 (um)")
+    return out
 
 
 def _scenarios(sc) -> dict:
@@ -255,7 +302,10 @@ def read_study(source) -> Study:
         path, base = study_path(source[len("example:"):]), None
     else:
         path, base = source, source
-    data = read_toml(path)
+    try:
+        data = read_toml(path)
+    except ValueError as exc:      # the reader speaks of design files
+        raise ValueError(str(exc).replace("design file", "study file")) from None
     check_keys("", data, {"study", "operating", "scenarios", "tca", "variables", "objective",
                           "constraints", "optimizer"})
     st = require_key("", data, "study")
@@ -283,8 +333,7 @@ def read_study(source) -> Study:
                                     for c in constraints):
         # the path quantities' fixed mask stays on the flank (gearjax.studies.quantities)
         constraints.append(Constraint("min_margin_mm", 0.0, None, 1.0, added=True))
-    op = data.get("operating", {})
-    check_keys("operating", op, _OPERATING)
+    op = _operating(data.get("operating", {}))
     check_quantities(names, "[operating]", op)
     opt = data.get("optimizer", {})
     check_keys("optimizer", opt, {"method", "max_iterations", "tolerance", "starts", "seed"})
@@ -302,7 +351,7 @@ def read_study(source) -> Study:
     return Study(name=name, design=design, side=side, variables=variables,
                  objective=objective, constraints=tuple(constraints),
                  description=check_string("study", "description", st.get("description", "")),
-                 operating=dict(op), scenarios=_scenarios(data.get("scenarios", {})),
+                 operating=op, scenarios=_scenarios(data.get("scenarios", {})),
                  tca={k: check_number("tca", k, v) for k, v in tca.items()}, method=method,
                  max_iterations=max_it, tolerance=tol, starts=starts,
                  seed=check_integer("optimizer", "seed", opt.get("seed", 0), 0),
