@@ -195,10 +195,6 @@ class Progress:
             self._draw()
         return self
 
-    def note(self, text: str):
-        """A permanent line (e.g. one optimiser iteration), where progress is shown."""
-        self._finish_line(text)
-
     def update(self, n: int = 1):
         """Advance the bar by ``n`` steps (clipped at ``total``)."""
         self.k = min(self.k + int(n), self.total)

@@ -182,16 +182,13 @@ def _run(study, out, args) -> int:
     from gearjax.progress import Progress
     from gearjax.studies.study_run import run_study, set_up
 
-    with Progress(study.max_iterations, f"optimize {study.name}") as bar:
+    # no per-iteration callback inside the optimiser's program: a host callback would
+    # keep the program out of the persistent compilation cache (a repeated run would
+    # compile it again); the phases show the elapsed time, the history comes at the end
+    with Progress(1, f"optimize {study.name}") as bar:
         with bar.phase("setting up the design"):
             prob = set_up(study)
-
-        def step(k, J, feas, stat):
-            bar.update(1)
-            bar.note(f"  iteration {int(k):3d}: J = {float(J):.6g}, largest violation "
-                             f"{float(feas):.2e}")
-
-        result = run_study(prob, callback=step, phase=bar.phase)
+        result = run_study(prob, phase=bar.phase)
     rep = result.report
     name = study.name
     files = {"design": None, "history": os.path.join(out, f"{name}_history.json"),
@@ -214,6 +211,9 @@ def _run(study, out, args) -> int:
     text, bad = dumps_json(rep, indent=1)
     atomic_write(files["history"], text + "\n")
     warn_nonfinite(bad)
+    hist = rep["history"]
+    for k, (J, feas) in enumerate(zip(hist.get("objective", []), hist.get("feasibility", []))):
+        sys.stderr.write(f"  iteration {k + 1:3d}: J = {J:.6g}, largest violation {feas:.2e}\n")
     print(_table(rep))
     print(f"files: {', '.join(p for p in files.values() if p)}")
     for why in result.reasons:
