@@ -63,6 +63,22 @@ def test_slsqp_finds_the_same_optimum(sliding_run):
     for d in r.report["variables"]:
         assert d["end"] == pytest.approx(end_al[d["field"]], abs=1e-6)
     assert r.report["objective"]["end"] == pytest.approx(rep["objective"]["end"], abs=1e-9)
+    # SLSQP runs on the forward-mode Jacobian of the quantities.  At this point on the
+    # tooth-form limit (an SLSQP iterate) the margin's and the contact ratio's tangents
+    # were NaN (jnp.min's derivative, see gearjax.tca.path.smallest_margin) and SLSQP
+    # stopped ("Singular matrix E").  The point is a kink of both (the pinion's form
+    # circle and the gear's tip limit the path together): each derivative is one of the
+    # one-sided differences
+    u = np.array([0.5161506371832055, 0.6])
+    dQ, Q = (np.asarray(a)[0] for a in sr.quantity_jacobian(prob)(u, prob.data))
+    h = 1e-7
+    for j in range(2):
+        e = np.eye(2)[j] * h
+        q0 = np.asarray(sr.evaluate(prob, u)[0][0])
+        right = (np.asarray(sr.evaluate(prob, u + e)[0][0]) - q0) / h
+        left = (q0 - np.asarray(sr.evaluate(prob, u - e)[0][0])) / h
+        err = np.minimum(np.abs(dQ[:, j] - right), np.abs(dQ[:, j] - left))
+        assert np.all(err <= 1e-4 * np.abs(dQ[:, j]) + 1e-6), (j, dQ[:, j], left, right)
 
 
 @pytest.fixture(scope="module")
@@ -129,6 +145,20 @@ def test_smooth_extrema_bounds():
     assert float(smooth_max(q, jnp.zeros(5, bool), T)) == -math.inf
 
 
+def test_smallest_margin_takes_the_derivative_of_the_smallest_part():
+    import jax
+    from gearjax.tca.path import smallest_margin
+
+    def parts(x):                       # three parts at two points; the smallest differ
+        return jnp.stack([jnp.array([x[0], 5.0]), jnp.array([2.0, x[1] ** 2]),
+                          jnp.array([3.0, 7.0])])
+    x = jnp.array([1.0, 2.0])
+    np.testing.assert_array_equal(smallest_margin(parts(x)), jnp.min(parts(x), axis=0))
+    for jac in (jax.jacfwd, jax.jacrev):
+        np.testing.assert_array_equal(jac(lambda x: smallest_margin(parts(x)))(x),
+                                      [[1.0, 0.0], [0.0, 4.0]])
+
+
 def test_continuous_te_ptp_meets_the_synthesis_target():
     """The ISO 10/41 pinion was synthesised for a TE drop of 8 arcsec at half a pitch
     from the apex: with the hand-overs at their continuous positions the p-t-p is 8
@@ -169,27 +199,28 @@ def test_tooth_form_margins_agree_with_the_loader():
 
 
 def test_sensitivity_command_against_central_differences(capsys):
-    rc = main(["sensitivity", "example:khk_spur_12x24", "--outputs",
-               "te_ptp_arcsec,contact_ratio,mean_abs_srr", "--params", "pair.x1,pair.x2",
-               "--json"])
+    """The outputs are the sliding study's quantities on its design and fields, so the
+    command runs the Jacobian program SLSQP compiled above (one program)."""
+    outs = ("max_abs_srr", "contact_ratio", "min_margin_mm", "tooth_form_margin_mm")
+    rc = main(["sensitivity", "example:khk_spur_12x24", "--outputs", ",".join(outs),
+               "--params", "pair.x1,pair.x2", "--json"])
     assert rc == 0
     rep = json.loads(capsys.readouterr().out)
     d = gj.load_design("example:khk_spur_12x24")
     f = gj.tca_function(d)
     from gearjax.studies.quantities import QUANTITIES
+    mask = np.asarray(f(f.pair).on_flank)
 
     def outputs(x1, x2):
         p = gj.with_fields(f.pair, {"pair.x1": x1, "pair.x2": x2})
         r = f(p)
-        mask = np.asarray(f(f.pair).on_flank)
-        return np.array([float(QUANTITIES[q].fn(r, None, mask, p))
-                         for q in ("contact_ratio", "mean_abs_srr")])
+        return np.array([float(QUANTITIES[q].fn(r, None, mask, p)) for q in outs])
 
     h = 1e-5
     for j, name in enumerate(("pair.x1", "pair.x2")):
         e = np.array([h, 0.0]) if j == 0 else np.array([0.0, h])
         cd = (outputs(0.6 + e[0], 0.36 + e[1]) - outputs(0.6 - e[0], 0.36 - e[1])) / (2 * h)
-        for i, q in enumerate(("contact_ratio", "mean_abs_srr")):
+        for i, q in enumerate(outs):
             o = next(o for o in rep["outputs"] if o["name"] == q)
             pu = next(p["per_unit"] for p in o["params"] if p["field"] == name)
             assert pu == pytest.approx(cd[i], rel=1e-5, abs=1e-8), (q, name)

@@ -3,7 +3,8 @@
 For outputs ``q_i`` (named quantities, :data:`gearjax.studies.quantities.QUANTITIES`)
 and design fields ``x_j`` of a design at one scenario (operating point and
 misalignment), the exact Jacobian ``J_ij = dq_i/dx_j`` (forward mode through every
-contact solve, one program) and from it::
+contact solve, one program: that SciPy's SLSQP runs on a study with the same design,
+fields and quantities) and from it::
 
     per unit      J_ij                      (output unit per field unit: mm, rad, -)
     elasticity    e_ij = J_ij x_j / q_i     (% change of q_i per % change of x_j;
@@ -16,11 +17,9 @@ per-unit value is the one to read.
 
 from __future__ import annotations
 
-import jax
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax.compile_ahead import FAST_COMPILE_OPTIONS
 from gearjax.studies.study_file import SCENARIO_KEYS, Study, Term, Variable, check_quantities
 
 __all__ = ["sensitivities"]
@@ -36,7 +35,7 @@ def sensitivities(design_source: str, outputs, params, *, side: str = "drive",
     "fields" (n_par,), "jacobian" (n_out, n_par), "elasticity" (n_out, n_par; NaN where
     undefined)}`` (NumPy arrays)."""
     from gearjax.studies.quantities import uses_mask
-    from gearjax.studies.study_run import evaluator, grid_size, start_point, set_up
+    from gearjax.studies.study_run import grid_size, quantity_jacobian, set_up, start_point
 
     outputs, params = list(outputs), list(params)
     if not outputs:
@@ -59,14 +58,9 @@ def sensitivities(design_source: str, outputs, params, *, side: str = "drive",
         start_point(prob)
     else:
         prob.data = prob.data._replace(mask=jnp.ones((1, grid_size(prob)), bool))
-    ev = evaluator(prob)
-
-    def values(u, d):
-        q = ev(u, d)[0][0]
-        return q, q
-
-    jac = jax.jit(jax.jacfwd(values, has_aux=True), compiler_options=FAST_COMPILE_OPTIONS)
-    J, Q0 = (np.asarray(a) for a in jac(jnp.zeros(len(params)), prob.data))
+    # the study's quantities are the outputs, then any it adds (the tooth form)
+    J, Q0 = (np.asarray(a)[0, :len(outputs)]
+             for a in quantity_jacobian(prob)(jnp.zeros(len(params)), prob.data))
     x = np.asarray(prob.x0)
     with np.errstate(divide="ignore", invalid="ignore"):
         el = J * x[None, :] / Q0[:, None]

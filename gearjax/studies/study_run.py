@@ -92,6 +92,7 @@ class Problem:
     data: Data = None
     evaluate_program: object = None
     fun: object = None
+    jacobian_program: object = None
 
 
 def _scenario_list(study: Study) -> list:
@@ -344,19 +345,47 @@ class _SlsqpResult(NamedTuple):
     history_feasibility: list
 
 
+def quantity_jacobian(prob: Problem):
+    """``(u, data) -> (dQ/du (S, nq, n), Q (S, nq))``: the quantities of the study (soft
+    model) and their exact Jacobian by forward mode (``jax.jacfwd``: a study has few
+    variables).  One program serves SciPy's SLSQP (which needs the Jacobian of every
+    constraint) and ``gearjax sensitivity``; the same study or the same outputs, fields
+    and design give the same program, so the persistent compilation cache shares it."""
+    if prob.jacobian_program is None:
+        ev = evaluator(prob)
+
+        def quantity_jacobian(u, data):
+            q = ev(u, data)[0]
+            return q, q
+
+        prob.jacobian_program = jax.jit(jax.jacfwd(quantity_jacobian, has_aux=True),
+                                        compiler_options=FAST_COMPILE_OPTIONS)
+    return prob.jacobian_program
+
+
 def _run_slsqp(prob: Problem, callback):
-    """SciPy's SLSQP on the same scaled problem with the exact Jacobians of the jitted
-    program (``jax.jacrev`` of ``[J, g]``); one program gives value and Jacobian."""
+    """SciPy's SLSQP on the same scaled problem with exact Jacobians: those of the
+    quantities (:func:`quantity_jacobian`) carried through ``[J, g]`` of
+    :func:`_combine` by the chain rule (a small program of its own)."""
     from scipy.optimize import minimize
 
-    fun = prob.fun
+    study, prog = prob.study, quantity_jacobian(prob)
 
-    def stacked(u, data):
-        J, g = fun(u, data)
+    def stacked(Q, data):
+        J, g = _combine(study, Q, data)
         return jnp.concatenate([jnp.reshape(J, (1,)), g])
 
-    vj = jax.jit(lambda u, d: (stacked(u, d), jax.jacrev(stacked)(u, d)),
-                 compiler_options=FAST_COMPILE_OPTIONS)
+    def chain_rule(dQ, Q, data):        # d[J, g]/du = d[J, g]/dQ . dQ/du
+        jv = jax.vmap(lambda t: jax.jvp(lambda q: stacked(q, data), (Q,), (t,))[1],
+                      in_axes=-1, out_axes=-1)
+        return stacked(Q, data), jv(dQ)
+
+    combine = jax.jit(chain_rule)
+
+    def vj(u, data):
+        dQ, Q = prog(u, data)
+        return combine(dQ, Q, data)
+
     cache = {}
     hist_v, hist_f, count = [], [], [0]
 

@@ -78,7 +78,7 @@ __all__ = ["pair_arrays", "Misalignment", "Assembly", "contact_equations", "cont
            "local_geometry_on", "point_normal", "flank_at", "path_tangent", "relative_to_start",
            "whole_turns_removed",
            "solve_grid", "gear_mount",
-           "ContactPath", "contact_path", "te_arcsec", "require_path",
+           "ContactPath", "contact_path", "te_arcsec", "smallest_margin", "require_path",
            "ARCSEC", "ellipse_from_weingarten", "rotation_about", "relative_curvature",
            "MultiPair", "multi_pair", "DEFAULT_APPROACH", "NoContactError",
            "check_on_flank_converged", "check_tca_options", "pinion_angle_grid"]
@@ -160,6 +160,21 @@ def newton_work(steps):
     steps = jnp.asarray(steps)
     lanes = int(np.prod(steps.shape[:-1]))
     return lanes * jnp.sum(jnp.max(steps.reshape(lanes, -1), axis=0))
+
+
+def smallest_margin(parts):
+    """The boundary margin (mm) from its parts (k, ...): the smallest part, taken by
+    index so that its derivative is that of the part that is smallest.
+
+    ``jnp.min``'s derivative divides by the number of parts equal to the minimum; where
+    the compiled program computes the parts twice (once for the minimum, once for the
+    equality test) with different round-off, none is equal and the tangent is
+    0/0 = NaN -- seen in forward mode on an involute pair at its tooth-form limit, with
+    the CPU backend at optimisation level 0.  ``jnp.minimum``'s derivative tests
+    equality the same way (a zero tangent there)."""
+    parts = jnp.asarray(parts)
+    k = jnp.argmin(parts, axis=0)
+    return jnp.take_along_axis(parts, k[None], axis=0)[0]
 
 
 def te_arcsec(te_rad):

@@ -70,7 +70,7 @@ from gearjax.gears.hypoid.flank import (FlankSpec, face_cone_gap, mid_estimate, 
 from gearjax.gears.hypoid.machine import MachineSettings, cutter_to_cradle
 from gearjax.surfaces import GeneratedSurface
 from gearjax.tca.assembly import Assembly
-from gearjax.tca.path import ContactPath
+from gearjax.tca.path import ContactPath, smallest_margin
 
 __all__ = ["SIDES", "HypoidPair", "program_pair", "pair_flanks", "mean_dedendum", "complementary_pinion",
            "with_point_radius", "flank_function", "hypoid_assembly", "mean_point",
@@ -373,7 +373,7 @@ def hypoid_margin(pair: HypoidPair, path: ContactPath):
     for k, fl, t, pb in ((1, pair.pinion, pair.pinion_crossing, path.p1_body),
                          (2, pair.gear, pair.gear_crossing, path.p2_body)):
         face, rest, xi, above_root = jax.vmap(lambda p: _member_margins(fl, t, p))(pb)
-        margins.append(jnp.minimum(face, rest))
+        margins += [face, rest]
         out[f"xi{k}"] = xi
         out[f"h{k}"] = above_root
-    return jnp.minimum(margins[0], margins[1]), out
+    return smallest_margin(jnp.stack(margins)), out

@@ -17,7 +17,7 @@ import jax
 import jax.numpy as jnp
 
 from gearjax.gears.involute.geometry import pair_geometry
-from gearjax.tca.path import ContactPath
+from gearjax.tca.path import ContactPath, smallest_margin
 
 __all__ = ["MemberLimits", "signed_roll", "flank_limits", "involute_margin",
            "involute_face_ends", "involute_limits"]
@@ -114,7 +114,7 @@ def involute_margin(des, path: ContactPath):
     in roll distance, :class:`MemberLimits`)."""
     lim1, lim2, hb = flank_limits(des)
     parts = jnp.stack(_margins(lim1, lim2, hb, path.p1_body, path.p2_body, path.uv1, path.uv2))
-    return jnp.min(parts, axis=0), parts
+    return smallest_margin(parts), parts
 
 
 

@@ -38,6 +38,7 @@ from gearjax.gears.preset_bevel.geometry import (PresetBevelDesign, cone_distanc
                                                  gear_assembly_rotation, gear_flank,
                                                  pinion_flank, pitch_angles)
 from gearjax.tca.assembly import Assembly
+from gearjax.tca.path import smallest_margin
 
 __all__ = ["SIDE_FLANKS", "preset_assembly", "side_flanks", "side_phase", "drives_forward", "side_code",
            "flank_coordinates", "preset_margin", "reference_contact",
@@ -99,7 +100,7 @@ def preset_margin(des: PresetBevelDesign, p1_body, p2_body):
     L2, h2 = flank_coordinates(des, p2_body, 2)
     parts = jnp.stack([Ao - L1, L1 - Ai, des.addendum - h1, h1 + des.dedendum,
                        Ao - L2, L2 - Ai, des.addendum - h2, h2 + des.dedendum])
-    return jnp.min(parts, axis=0), {"L1": L1, "h1": h1, "L2": L2, "h2": h2}
+    return smallest_margin(parts), {"L1": L1, "h1": h1, "L2": L2, "h2": h2}
 
 
 def preset_face_ends(des: PresetBevelDesign):

@@ -40,7 +40,7 @@ import jax.numpy as jnp
 from gearjax.tca.family import DriverAdapter, GearFamily
 from gearjax.gears.vh_catt.geometry import VHCattPair, generated_flank, pair_geometry
 from gearjax.loading.loaded_contact import TeethOf
-from gearjax.tca.path import ContactPath
+from gearjax.tca.path import ContactPath, smallest_margin
 from gearjax.tca.assembly import Assembly
 from gearjax.tca.result import register_family
 
@@ -117,7 +117,7 @@ def vh_margin(pair: VHCattPair, path: ContactPath, pinion: VHCattPair | None = N
                        hb - jnp.abs(path.axial1),
                        ra2 - path.radial2, _root_margin(path.radial2, path.uv2[:, 0], *c2),
                        hb - jnp.abs(path.axial2)])
-    return jnp.min(parts, axis=0), parts
+    return smallest_margin(parts), parts
 
 
 def margin_parts(pair: VHCattPair):
