@@ -41,7 +41,8 @@ Procedure 18.2; initial scaling ``y^T y / s^T y``; carried from one outer iterat
 next, which about halved the evaluations on the test problems).  The step follows the projection arc
 ``x(a) = P(x + a d)``, ``a = 1`` first, backtracking by safeguarded quadratic interpolation
 until the Armijo condition ``L(x(a)) <= L(x) + 1e-4 grad^T (x(a) - x)`` holds.  Each
-inner evaluation is one ``jax.value_and_grad`` (forward + reverse) of ``L_rho``; every
+inner evaluation is one ``jax.value_and_grad`` (forward + reverse) of ``L_rho`` (or, with
+``derivatives="forward"``, one ``jax.jacfwd``: n tangents in one batched pass); every
 evaluation of ``fun`` is counted in ``evaluations``.
 
 Everything, outer loop included, is one ``jax.jit`` program of nested ``lax.while_loop``;
@@ -147,8 +148,10 @@ def _direction(x, grad, B, fresh, lo, hi):
 _RESET, _TRIAL = 0, 1
 
 
-@functools.partial(jax.jit, static_argnames=("fun", "max_outer", "max_inner", "callback"))
-def _run(fun, max_outer, max_inner, callback, x0, lo, hi, tol, rho0, args):
+@functools.partial(jax.jit, static_argnames=("fun", "max_outer", "max_inner", "callback",
+                                             "derivatives"))
+def _run(fun, max_outer, max_inner, callback, x0, lo, hi, tol, rho0, args,
+         derivatives="reverse"):
     """One ``lax.while_loop`` with one evaluation of ``fun`` (and its gradient) per pass:
     the model appears once in the program, whatever the iteration logic around it.  A
     pass evaluates either the current point afresh (``_RESET``: at the start and after a
@@ -165,7 +168,16 @@ def _run(fun, max_outer, max_inner, callback, x0, lo, hi, tol, rho0, args):
         pen = jnp.sum(jnp.maximum(0.0, lam + rho * g) ** 2 - lam ** 2) / (2.0 * rho)
         return f + pen, (f, g)
 
-    vg = jax.value_and_grad(aug, has_aux=True)
+    if derivatives == "reverse":
+        vg = jax.value_and_grad(aug, has_aux=True)
+    else:
+        # forward mode: n tangents at once (one jvp of the model, batched)
+        def vg(x, lam, rho):
+            def la(x):
+                L, aux = aug(x, lam, rho)
+                return L, (L, aux)
+            grad, (L, aux) = jax.jacfwd(la, has_aux=True)(x)
+            return (L, aux), grad
     nan = jnp.nan * jnp.ones(max_outer, dt)
     z = jnp.zeros((), dt)
     max_evals = max_outer * (max_inner * (_MAX_BACKTRACK + 1) + 1)
@@ -265,7 +277,8 @@ def _concrete(v):
 
 def minimize_constrained(fun: Callable, x0, *, lower=None, upper=None, args=(),
                          max_outer: int = 30, max_inner: int = 60, tol=1e-6, rho0=10.0,
-                         callback: Callable | None = None) -> ConstrainedResult:
+                         callback: Callable | None = None,
+                         derivatives: str = "reverse") -> ConstrainedResult:
     """Minimise ``f`` subject to ``g(x) <= 0`` and ``lower <= x <= upper`` (module docstring).
 
     ``fun(x, *args) -> (f, g)``: scalar objective and constraint vector (shape ``(m,)``,
@@ -274,9 +287,14 @@ def minimize_constrained(fun: Callable, x0, *, lower=None, upper=None, args=(),
     (multiplier) iterations; ``max_inner``: quasi-Newton steps per inner solve; ``tol``:
     KKT tolerance; ``rho0``: initial penalty; ``callback(outer_iteration, value,
     feasibility, stationarity)``: called once per outer iteration (1-based count) through
-    ``jax.debug.callback`` (under ``vmap`` also for members already finished).  Compiled
-    once per (``fun``, ``max_outer``, ``max_inner``, ``callback``, shapes).
+    ``jax.debug.callback`` (under ``vmap`` also for members already finished);
+    ``derivatives``: ``"reverse"`` (one ``jax.value_and_grad``: any number of variables)
+    or ``"forward"`` (``jax.jacfwd``, n tangents in one batched pass: for few variables,
+    and where reverse mode fails, see docs/optimize.md).  Compiled once per (``fun``,
+    ``max_outer``, ``max_inner``, ``callback``, ``derivatives``, shapes).
     """
+    if derivatives not in ("reverse", "forward"):
+        raise ValueError(f"derivatives = {derivatives!r} must be 'reverse' or 'forward'")
     for name, val in (("max_outer", max_outer), ("max_inner", max_inner)):
         if int(val) != val or int(val) < 1:
             raise ValueError(f"{name} = {val!r} must be an integer >= 1")
@@ -299,4 +317,5 @@ def minimize_constrained(fun: Callable, x0, *, lower=None, upper=None, args=(),
         raise ValueError(f"x0[{i}] = {float(x0[i])} must be finite")
     x0 = jnp.clip(x0, lo, hi)
     return _run(fun, int(max_outer), int(max_inner), callback, x0, lo, hi,
-                jnp.asarray(tol, x0.dtype), jnp.asarray(rho0, x0.dtype), tuple(args))
+                jnp.asarray(tol, x0.dtype), jnp.asarray(rho0, x0.dtype), tuple(args),
+                derivatives=derivatives)

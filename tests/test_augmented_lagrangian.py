@@ -220,12 +220,27 @@ def test_evaluations_are_counted_exactly():
     (dict(tol=0.0), "tol"), (dict(tol=-1e-3), "tol"), (dict(rho0=0.0), "rho0"),
     (dict(lower=[0.0, 2.0], upper=[1.0, 1.0]), r"lower\[1\]"),
     (dict(x0=[0.0, np.nan]), r"x0\[1\]"),
+    (dict(derivatives="central"), "derivatives"),
 ])
 def test_bad_arguments(kwargs, name):
     x0 = kwargs.pop("x0", [0.0, 0.0])
     with pytest.raises(ValueError, match=name) as err:
         minimize_constrained(disk, jnp.array(x0), **kwargs)
     assert "\n" not in str(err.value)
+
+
+@pytest.mark.parametrize("name", ["hs43", "hs76"])
+def test_forward_mode_gives_the_same_run(name):
+    """``derivatives="forward"`` (jacfwd) reaches the same optimum with the same iterates
+    to round-off (the gradients agree to round-off, so does every step)."""
+    fun, x0, lo, hi = PROBLEMS[name][:4]
+    r = minimize_constrained(fun, jnp.array(x0), lower=lo, upper=hi, tol=TOL,
+                             derivatives="forward")
+    ref = solved(name)
+    assert r.converged and int(r.outer_iterations) == int(ref.outer_iterations)
+    assert int(r.evaluations) == int(ref.evaluations)
+    np.testing.assert_allclose(r.x, ref.x, atol=1e-10)
+    np.testing.assert_allclose(r.multipliers, ref.multipliers, atol=1e-9)
 
 
 TRACES = []

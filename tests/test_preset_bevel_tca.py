@@ -119,6 +119,13 @@ def test_preset_absorbs_part_of_a_misalignment(runs):
     regular = np.median(steps)
     assert steps.max() > 5 * regular
     assert abs(steps.max() - g0) <= 2 * regular
+    # the study quantity is the smooth maximum of the two gaps (within T log 2, above)
+    from gearjax.studies.quantities import GAP_TEMPERATURE, QUANTITIES
+    for case in ("plain_dG", "mod_dG", "mod", "mod_coast"):
+        res = runs[case]
+        g = max(float(v) for v in A.transfer_gaps(res, 10, 16)) / gj.ARCSEC
+        q = float(QUANTITIES["transfer_gap_arcsec"].fn(res, None, None, None))
+        assert g <= q <= g + GAP_TEMPERATURE * math.log(2), case
 
 
 def test_summary_is_the_result_at_the_reference(runs):

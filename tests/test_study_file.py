@@ -11,6 +11,7 @@ import gearjax as gj
 from gearjax.io import design_from_dict
 from gearjax.studies.study_file import list_studies, read_study
 from gearjax.tca.result import family_of
+from gearjax.studies.study_run import set_up
 
 GOOD = """
 [study]
@@ -106,7 +107,6 @@ def test_duplicate_variable_and_unknown_field(tmp_path):
                        '0.1]\n\n[[objective]]')
     with pytest.raises(ValueError, match="'pair.x1' is given more than once"):
         read_study(_write(tmp_path, dup))
-    from gearjax.studies.study_run import set_up
     st = read_study(_write(tmp_path, GOOD.replace('"pair.x1"', '"pair.x3"')))
     with pytest.raises(ValueError, match=r"\[\[variables\]\] 1: field 'pair.x3' is not a field "
                                          r"of the design's pair \(fields: pair.module"):
@@ -124,10 +124,12 @@ def test_duplicate_variable_and_unknown_field(tmp_path):
 
 def test_packaged_studies_read():
     names = list_studies()
-    assert {"spur_efficiency", "hypoid_efficiency_te"} <= set(names)
+    assert {"spur_efficiency", "hypoid_efficiency_te", "preset_bevel_robust_kappa"} <= set(names)
     for n in names:
         st = read_study(f"example:{n}")
         assert st.name == n and st.variables and st.objective
+        prob = set_up(st)          # fields, bounds and scenarios checked (no compilation)
+        assert len(prob.scenarios) == (4 if n == "preset_bevel_robust_kappa" else 1)
 
 
 @pytest.mark.parametrize("example, field, delta, key", [

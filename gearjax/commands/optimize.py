@@ -44,7 +44,8 @@ HISTORY_KEYS_DOC = """JSON keys of NAME_history.json:
   optimizer         method, status, converged, message, iterations, evaluations,
                     tolerance, seconds; augmented_lagrangian also stationarity,
                     feasibility, complementarity (the KKT measures) and multipliers;
-                    starts (and best_start, per_start with several)
+                    starts (and best_start, per_start with several), derivatives
+                    ("reverse" or "forward": how its gradient was taken)
   history           objective, feasibility (and stationarity) per iteration
   checks            accepted, reasons (why not), round_trip_difference (largest
                     |field| difference of the design file read back), flags_start and

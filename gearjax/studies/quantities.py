@@ -42,6 +42,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from gearjax.tca.multi_pair import transfer_gaps
 from gearjax.tca.path import ARCSEC
 
 __all__ = ["Quantity", "QUANTITIES", "smooth_max", "smooth_min", "te_ptp_continuous",
@@ -136,6 +137,18 @@ def te_ptp_continuous(res):
     return jnp.where(found, (top - bottom) / ARCSEC, m.ptp / ARCSEC)
 
 
+#: temperature of the smooth largest transfer gap (arcsec)
+GAP_TEMPERATURE = 0.01
+
+
+def _transfer_gap(res, eff, mask, pair):
+    """Smooth maximum (:data:`GAP_TEMPERATURE`) of the TE gaps where tooth pair 0 enters
+    and leaves the flanks (arcsec; :func:`gearjax.tca.multi_pair.transfer_gaps`): > 0
+    the envelope jumps there, < 0 the curves cross inside the overlap."""
+    gaps = jnp.stack(transfer_gaps(res.path, res.margin, res.multi)) / ARCSEC
+    return smooth_max(gaps, jnp.ones(2, bool), GAP_TEMPERATURE)
+
+
 def _srr(res, mask):
     return jnp.abs(jnp.where(mask, res.kinematics.srr, 0.0))
 
@@ -163,6 +176,11 @@ QUANTITIES: dict = {
         "arcsec", False, False, None,
         "peak-to-peak of the unloaded TE envelope at the grid points (as gearjax tca)",
         lambda res, eff, mask, pair: res.ptp / ARCSEC),
+    "transfer_gap_arcsec": Quantity(
+        "arcsec", False, False, GAP_TEMPERATURE,
+        "largest TE gap where tooth pair 0 enters or leaves the flanks: > 0 a jump of the "
+        "TE envelope at the transfer, < 0 the TE curves cross inside the overlap",
+        _transfer_gap),
     "contact_ratio": Quantity(
         "", False, False, None, "contact ratio of the unloaded TE envelope",
         lambda res, eff, mask, pair: res.contact_ratio),

@@ -417,16 +417,26 @@ def _run_slsqp(prob: Problem, callback):
                         count[0], int(r.nit), hist_v, hist_f)
 
 
+def derivatives(prob: Problem) -> str:
+    """How the augmented Lagrangian differentiates the study: reverse mode (one
+    ``value_and_grad``) for one scenario, forward mode (``jacfwd``) for several.  Reverse
+    mode through the scenarios' ``vmap`` returned NaN gradients on the preset-TE bevel
+    pair (every quantity, also at a single batched scenario; unbatched and in forward
+    mode they are finite and equal central differences): an open defect of the batched
+    reverse pass, avoided here (docs/optimize.md)."""
+    return "forward" if len(prob.scenarios) > 1 else "reverse"
+
+
 def _run_al(prob: Problem, callback):
     """The augmented Lagrangian from the design (one start) or from ``starts`` points at
     once; returns the chosen run and what the starts found."""
     from gearjax.augmented_lagrangian import minimize_constrained
     st = prob.study
     kw = dict(lower=prob.lower, upper=prob.upper, args=(prob.data,),
-              max_outer=st.max_iterations, tol=st.tolerance)
+              max_outer=st.max_iterations, tol=st.tolerance, derivatives=derivatives(prob))
     if st.starts == 1:
         return minimize_constrained(prob.fun, np.zeros(prob.lower.size), callback=callback,
-                                    **kw), {"starts": 1}
+                                    **kw), {"starts": 1, "derivatives": kw["derivatives"]}
     X0 = _random_starts(prob, st.starts)
     rs = jax.vmap(lambda x0: minimize_constrained(prob.fun, x0, **kw))(jnp.asarray(X0))
     feas = np.asarray(rs.feasibility) <= st.tolerance
@@ -437,7 +447,8 @@ def _run_al(prob: Problem, callback):
     per = [{"start": X0[i].tolist(), "value": float(vals[i]),
             "feasibility": float(np.asarray(rs.feasibility)[i]),
             "status": int(np.asarray(rs.status)[i])} for i in range(st.starts)]
-    return _scenario(rs, best), {"starts": st.starts, "best_start": best, "per_start": per}
+    return _scenario(rs, best), {"starts": st.starts, "best_start": best, "per_start": per,
+                                 "derivatives": kw["derivatives"]}
 
 
 def acceptance_reasons(opt: dict, feasibility: float, tol: float, file_error, difference,

@@ -12,10 +12,12 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
+import jax
 import jax.numpy as jnp
 import numpy as np
 
-__all__ = ["MultiPair", "multi_pair", "pair_arrays"]
+__all__ = ["MultiPair", "multi_pair", "pair_arrays", "interp_uniform", "flank_crossings",
+           "transfer_gaps"]
 
 
 class MultiPair(NamedTuple):
@@ -34,6 +36,9 @@ class MultiPair(NamedTuple):
         flank, divided by the angular pitch 2 pi/z1 (boundary crossings
         interpolated linearly in the boundary margin); NaN (not found) unless pair 0
         enters the flanks before it leaves them within the grid.
+    pitch : the pinion's angular pitch 2 pi/z1 (rad).
+    sign : +1 where the envelope is the maximum over the pairs (the flank pushing the
+        gear forward), -1 where it is the minimum.
     """
 
     te_pairs: jnp.ndarray
@@ -43,6 +48,8 @@ class MultiPair(NamedTuple):
     ptp: jnp.ndarray
     transfer_phi1: jnp.ndarray
     contact_ratio: jnp.ndarray
+    pitch: jnp.ndarray = float("nan")
+    sign: jnp.ndarray = 1.0
 
 
 def _crossing(phi, f):
@@ -119,4 +126,68 @@ def multi_pair(path, margin, steps_per_pitch: int, z1: int, drive: bool = True,
     # not found (NaN) unless pair 0 enters before it leaves: where it touches in several
     # intervals that reach the ends of the grid, its first entry may follow its last exit
     cr = jnp.where(hi > lo, (hi - lo) / (2.0 * jnp.pi / z1), jnp.nan)
-    return MultiPair(te_pairs, inside, env, active, ptp, transfer, cr)
+    return MultiPair(te_pairs, inside, env, active, ptp, transfer, cr,
+                     jnp.asarray(2.0 * np.pi / z1), sgn)
+
+
+def interp_uniform(x0, h, f, x):
+    """Quadratic (3-point Lagrange) interpolation of samples ``f`` on the uniform grid
+    ``x0 + h i`` at ``x`` (the stencil's index carries no derivative)."""
+    n = f.shape[0]
+    i = jnp.clip(jnp.round(jax.lax.stop_gradient((x - x0) / h)).astype(int), 1, n - 2)
+    s = (x - x0) / h - i
+    return (f[i - 1] * 0.5 * s * (s - 1.0) + f[i] * (1.0 - s * s)
+            + f[i + 1] * 0.5 * s * (s + 1.0))
+
+
+def flank_crossings(path, margin):
+    """``(phi_in, phi_out)``: pinion angles where pair 0's boundary margin crosses zero
+    entering and leaving the flanks (bracketed on the grid, then two Newton steps on the
+    quadratic interpolant of the margin: error O(h^3); NaN if none).  Traceable."""
+    phi = path.phi1
+    m = jnp.where(path.converged, margin, -1.0)
+
+    def first_up(p, f):
+        hit = (f[:-1] < 0.0) & (f[1:] >= 0.0)
+        i = jnp.argmax(hit)
+        w = f[i] / (f[i] - f[i + 1])
+        return jnp.where(jnp.any(hit), p[i] + w * (p[i + 1] - p[i]), jnp.nan)
+
+    h = phi[1] - phi[0]
+
+    def refine(x):
+        for _ in range(2):
+            mx, dm = jax.jvp(lambda y: interp_uniform(phi[0], h, m, y), (x,),
+                             (jnp.ones_like(x),))
+            x = x - mx / dm
+        return x
+
+    return refine(first_up(phi, m)), refine(first_up(phi[::-1], m[::-1]))
+
+
+def transfer_gaps(path, margin, multi: MultiPair):
+    """``(gap_in, gap_out)`` (rad): the TE gaps where tooth pair 0 enters and leaves the
+    flanks (traceable).
+
+    Where pair 0 enters (``phi_in``, :func:`flank_crossings`) pair -1 -- pair 0 one
+    pitch ``p`` later, ``TE_{-1}(phi) = TE_0(phi + p)`` -- carries the motion, where it
+    leaves pair +1 (``TE_0(phi - p)``); with ``s = multi.sign``::
+
+        gap_in  = s (TE_0(phi_in)  - TE_0(phi_in + p)),
+        gap_out = s (TE_0(phi_out) - TE_0(phi_out - p)).
+
+    ``> 0``: the TE envelope jumps at the transfer (the entering pair is ahead of the
+    one carrying the load, or the leaving one runs off its flank while still ahead);
+    ``< 0``: the TE curves cross inside the overlap (a smooth transfer, the gap its
+    reserve).  TE of pair 0 between grid points by quadratic interpolation of the
+    contact path's TE, which continues beyond the flank boundaries (the surfaces are
+    extended there), so it is smooth across them."""
+    phi = path.phi1
+    h = phi[1] - phi[0]
+    a, b = flank_crossings(path, margin)
+    p, s = multi.pitch, multi.sign
+
+    def te0(x):
+        return interp_uniform(phi[0], h, path.te, x)
+
+    return s * (te0(a) - te0(a + p)), s * (te0(b) - te0(b - p))

@@ -45,6 +45,8 @@ import jax.numpy as jnp
 import numpy as np
 
 from gearjax.gears.preset_bevel.geometry import PresetBevelDesign, cone_distances
+from gearjax.tca.multi_pair import flank_crossings, interp_uniform
+from gearjax.tca.multi_pair import transfer_gaps as transfer_gaps_of
 from gearjax.tca.path import ARCSEC
 from gearjax.tca.result import TCAResult
 
@@ -74,54 +76,18 @@ def preset_deviation(des: PresetBevelDesign, res: TCAResult, on=None):
     return jnp.max(jnp.where(on, d, 0.0))
 
 
-def interp_uniform(x0, h, f, x):
-    """Quadratic (3-point Lagrange) interpolation of samples ``f`` on the uniform grid
-    ``x0 + h i`` at ``x`` (the stencil's index carries no derivative)."""
-    n = f.shape[0]
-    i = jnp.clip(jnp.round(jax.lax.stop_gradient((x - x0) / h)).astype(int), 1, n - 2)
-    s = (x - x0) / h - i
-    return (f[i - 1] * 0.5 * s * (s - 1.0) + f[i] * (1.0 - s * s)
-            + f[i + 1] * 0.5 * s * (s + 1.0))
-
-
 def margin_crossings(res: TCAResult):
     """``(phi_in, phi_out)``: pinion angles where pair 0's margin crosses zero entering
     and leaving the flanks (bracketed on the grid, refined on the quadratic interpolant
     of the margin; NaN if none)."""
-    phi = res.path.phi1
-    m = jnp.where(res.path.converged, res.margin, -1.0)
-
-    def first_up(p, f):
-        hit = (f[:-1] < 0.0) & (f[1:] >= 0.0)
-        i = jnp.argmax(hit)
-        w = f[i] / (f[i] - f[i + 1])
-        return jnp.where(jnp.any(hit), p[i] + w * (p[i + 1] - p[i]), jnp.nan)
-
-    h = phi[1] - phi[0]
-
-    def refine(x):
-        # two Newton steps on the quadratic interpolant of the margin (error O(h^3))
-        for _ in range(2):
-            mx, dm = jax.jvp(lambda y: interp_uniform(phi[0], h, m, y), (x,), (jnp.ones_like(x),))
-            x = x - mx / dm
-        return x
-
-    return refine(first_up(phi, m)), refine(first_up(phi[::-1], m[::-1]))
+    return flank_crossings(res.path, res.margin)
 
 
 def transfer_gaps(res: TCAResult, z1: int, steps_per_pitch: int):
-    """``(gap_in, gap_out)`` (rad, module docstring): > 0 is a TE jump at the transfer."""
-    phi = res.path.phi1
-    h = phi[1] - phi[0]
-    p = 2.0 * np.pi / z1
-    te = res.path.te
-    a, b = margin_crossings(res)
-    sgn = 1.0 if res.side == "coast" else -1.0      # max envelope on the coast side
-
-    def te0(x):
-        return interp_uniform(phi[0], h, te, x)
-
-    return (sgn * (te0(a) - te0(a + p)), sgn * (te0(b) - te0(b - p)))
+    """``(gap_in, gap_out)`` (rad, module docstring): > 0 is a TE jump at the transfer
+    (:func:`gearjax.tca.multi_pair.transfer_gaps`; ``z1`` and ``steps_per_pitch`` are
+    those of the result's grid, kept for the callers)."""
+    return transfer_gaps_of(res.path, res.margin, res.multi)
 
 
 def transfer_jump(res: TCAResult, z1: int, steps_per_pitch: int):
