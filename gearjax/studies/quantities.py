@@ -111,13 +111,9 @@ def te_ptp_continuous(res):
     m = res.multi
     phi = res.path.phi1
     te_in = m.inside & jnp.isfinite(m.te_pairs)
-    hi = jnp.max(jnp.where(te_in, m.te_pairs, -jnp.inf), axis=0)
     env = m.envelope
     ok = jnp.isfinite(env)
-    # +1 when the envelope is the maximum over the pairs (the side pushing forward)
-    sgn = jnp.where(jnp.sum(jnp.where(ok, jnp.abs(env - hi), 0.0)) <= 1e-9 * jnp.maximum(
-        jnp.sum(jnp.where(ok, jnp.abs(env), 0.0)), 1e-300), 1.0, -1.0)
-    sgn = jax.lax.stop_gradient(sgn)
+    sgn = m.sign          # +1 when the envelope is the maximum over the pairs
     k0 = m.te_pairs.shape[0] // 2
     te0 = jnp.where(te_in[k0], m.te_pairs[k0], 0.0)
     tin, tout = m.transfer_phi1[0], m.transfer_phi1[1]
