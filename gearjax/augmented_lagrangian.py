@@ -149,22 +149,27 @@ _RESET, _TRIAL = 0, 1
 
 
 @functools.partial(jax.jit, static_argnames=("fun", "max_outer", "max_inner", "callback",
-                                             "derivatives"))
+                                             "derivatives", "m"))
 def _run(fun, max_outer, max_inner, callback, x0, lo, hi, tol, rho0, args,
-         derivatives="reverse"):
+         derivatives="reverse", m=None):
     """One ``lax.while_loop`` with one evaluation of ``fun`` (and its gradient) per pass:
     the model appears once in the program, whatever the iteration logic around it.  A
     pass evaluates either the current point afresh (``_RESET``: at the start and after a
     multiplier update, which changes ``L_rho``) or a trial point of the line search
-    (``_TRIAL``); the outer update runs in the pass where an inner solve ends."""
+    (``_TRIAL``); the outer update runs in the pass where an inner solve ends.  ``m``:
+    the number of constraints, else found by a trace of ``fun`` (a shape probe)."""
     n = x0.shape[0]
-    m = jax.eval_shape(lambda x: fun(x, *args), x0)[1].shape[0]
+    if m is None:
+        m = jax.eval_shape(lambda x: fun(x, *args), x0)[1].shape[0]
     dt = x0.dtype
 
     def aug(x, lam, rho):
         f, g = fun(x, *args)
         f = jnp.asarray(f, dt)
-        g = jnp.reshape(jnp.asarray(g, dt), (m,))
+        g = jnp.asarray(g, dt)
+        if g.size != m:
+            raise ValueError(f"fun returned {g.size} constraint values; n_constraints = {m}")
+        g = jnp.reshape(g, (m,))
         pen = jnp.sum(jnp.maximum(0.0, lam + rho * g) ** 2 - lam ** 2) / (2.0 * rho)
         return f + pen, (f, g)
 
@@ -278,7 +283,8 @@ def _concrete(v):
 def minimize_constrained(fun: Callable, x0, *, lower=None, upper=None, args=(),
                          max_outer: int = 30, max_inner: int = 60, tol=1e-6, rho0=10.0,
                          callback: Callable | None = None,
-                         derivatives: str = "reverse") -> ConstrainedResult:
+                         derivatives: str = "reverse",
+                         n_constraints: int | None = None) -> ConstrainedResult:
     """Minimise ``f`` subject to ``g(x) <= 0`` and ``lower <= x <= upper`` (module docstring).
 
     ``fun(x, *args) -> (f, g)``: scalar objective and constraint vector (shape ``(m,)``,
@@ -290,11 +296,16 @@ def minimize_constrained(fun: Callable, x0, *, lower=None, upper=None, args=(),
     ``jax.debug.callback`` (under ``vmap`` also for members already finished);
     ``derivatives``: ``"reverse"`` (one ``jax.value_and_grad``: any number of variables)
     or ``"forward"`` (``jax.jacfwd``, n tangents in one batched pass: for few variables,
-    and where reverse mode fails, see docs/optimize.md).  Compiled once per (``fun``,
-    ``max_outer``, ``max_inner``, ``callback``, ``derivatives``, shapes).
+    and where reverse mode fails, see docs/optimize.md); ``n_constraints``: m, where the
+    caller knows it (else ``fun`` is traced once more for the shape of ``g``: for an
+    expensive model seconds of tracing).  Compiled once per (``fun``, ``max_outer``,
+    ``max_inner``, ``callback``, ``derivatives``, ``n_constraints``, shapes).
     """
     if derivatives not in ("reverse", "forward"):
         raise ValueError(f"derivatives = {derivatives!r} must be 'reverse' or 'forward'")
+    if n_constraints is not None and (int(n_constraints) != n_constraints
+                                      or int(n_constraints) < 0):
+        raise ValueError(f"n_constraints = {n_constraints!r} must be an integer >= 0")
     for name, val in (("max_outer", max_outer), ("max_inner", max_inner)):
         if int(val) != val or int(val) < 1:
             raise ValueError(f"{name} = {val!r} must be an integer >= 1")
@@ -318,4 +329,5 @@ def minimize_constrained(fun: Callable, x0, *, lower=None, upper=None, args=(),
     x0 = jnp.clip(x0, lo, hi)
     return _run(fun, int(max_outer), int(max_inner), callback, x0, lo, hi,
                 jnp.asarray(tol, x0.dtype), jnp.asarray(rho0, x0.dtype), tuple(args),
-                derivatives=derivatives)
+                derivatives=derivatives,
+                m=None if n_constraints is None else int(n_constraints))

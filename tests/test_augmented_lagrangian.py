@@ -262,6 +262,23 @@ def test_the_model_appears_once_in_the_program():
     assert len(TRACES) == 2
 
 
+def test_a_given_constraint_count_saves_the_shape_probe():
+    """With ``n_constraints`` the model is traced once (no shape probe: a study's chain
+    costs seconds per trace) and the run is the same; a wrong count is refused by name,
+    not left to a reshape."""
+    TRACES.clear()
+    r = minimize_constrained(hs43_traced, jnp.zeros(4), max_outer=6, max_inner=13,
+                             n_constraints=3)
+    assert len(TRACES) == 1
+    ref = minimize_constrained(hs43, jnp.zeros(4), max_outer=6, max_inner=13)
+    np.testing.assert_array_equal(np.asarray(r.x), np.asarray(ref.x))
+    assert int(r.evaluations) == int(ref.evaluations)
+    with pytest.raises(ValueError, match="fun returned 3 constraint values; n_constraints = 2"):
+        minimize_constrained(hs43, jnp.zeros(4), max_outer=6, n_constraints=2)
+    with pytest.raises(ValueError, match="n_constraints = -1 must be an integer >= 0"):
+        minimize_constrained(hs43, jnp.zeros(4), n_constraints=-1)
+
+
 #: evaluations of the model per problem, recorded at 47800e8 (deterministic for the code;
 #: a change to the algorithm that costs more must be deliberate: re-record here)
 EVALUATIONS = {"quad_inactive": 3, "disk": 13, "hs21": 2, "hs35": 23, "hs43": 42, "hs76": 26,

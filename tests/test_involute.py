@@ -332,3 +332,24 @@ def test_zero_backlash_measured_on_the_generated_flanks():
         assert np.all(s[k] > 0)
         pitch = 2 * np.pi * a_w / (pair.z1 + pair.z2)
         assert abs(s[k, 0] + s[k, 1] - pitch) < 1e-11, (k, s[k], pitch)
+
+
+def test_range_check_skips_traced_tooth_numbers():
+    """Inside a traced TCA (``jax.jit(jax.grad(...))`` of ``tca_function``'s ``f``) the
+    involute programs carry the tooth numbers as traced values (``split_teeth``); the
+    range check must skip them as it skips other traced fields.  Planted bug caught:
+    ``check_int`` on a traced z1 ("z1 = JitTracer(float64[]) must be an integer",
+    what a jitted gradient of the quick start's max |SRR| raised).  A concrete bad
+    tooth number is still refused."""
+    from dataclasses import replace
+
+    from gearjax.gears.involute.geometry import check_pair_fields
+    pair = InvolutePair.create(25, 41, 2.0, 20.0)
+
+    def f(teeth):
+        check_pair_fields(replace(pair, z1=teeth[0], z2=teeth[1]))
+        return teeth.sum()
+
+    assert float(jax.jit(f)(jnp.array([25.0, 41.0]))) == 66.0
+    with pytest.raises(ValueError, match=r"z1 = 5 is outside the allowed range \[6, "):
+        check_pair_fields(replace(pair, z1=5))

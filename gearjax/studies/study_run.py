@@ -178,10 +178,9 @@ def set_up(study: Study) -> Problem:
     col = {k: jnp.array([s[k] for s in scen]) for k in scen[0]}
     mis = Misalignment(col["dE_mm"], col["dP_mm"], col["dG_mm"],
                        col["dSigma_deg"] * (math.pi / 180.0))
-    nq = len(study.quantities)
     prob.data = Data(pair0, jnp.asarray(x0), jnp.asarray(sc), col["torque_Nm"],
-                     col["pinion_rpm"], mis, oil, surface, None, jnp.ones(nq),
-                     jnp.ones(len(study.constraints)))
+                     col["pinion_rpm"], mis, oil, surface, None,
+                     jnp.ones(len(study.objective)), jnp.ones(len(study.constraints)))
     prob.evaluate_program = jax.jit(evaluator(prob, hard=True),
                                     compiler_options=FAST_COMPILE_OPTIONS)
     prob.fun = _objective(prob)
@@ -235,6 +234,14 @@ def _combine(study: Study, Q, data):
         if con.lower is not None:
             g.append(con.lower / data.con_scale[c] - q)
     return J, (jnp.concatenate(g) if g else jnp.zeros((0,)))
+
+
+def n_constraint_rows(prob: Problem) -> int:
+    """Length of ``g`` of :func:`_combine`: one row per bound of each constraint and
+    scenario (given to the optimiser, which would otherwise trace the chain once more
+    to find it)."""
+    bounds = sum((c.upper is not None) + (c.lower is not None) for c in prob.study.constraints)
+    return len(prob.scenarios) * bounds
 
 
 def _objective(prob: Problem):
@@ -433,7 +440,8 @@ def _run_al(prob: Problem, callback):
     from gearjax.augmented_lagrangian import minimize_constrained
     st = prob.study
     kw = dict(lower=prob.lower, upper=prob.upper, args=(prob.data,),
-              max_outer=st.max_iterations, tol=st.tolerance, derivatives=derivatives(prob))
+              max_outer=st.max_iterations, tol=st.tolerance, derivatives=derivatives(prob),
+              n_constraints=n_constraint_rows(prob))
     if st.starts == 1:
         return minimize_constrained(prob.fun, np.zeros(prob.lower.size), callback=callback,
                                     **kw), {"starts": 1, "derivatives": kw["derivatives"]}

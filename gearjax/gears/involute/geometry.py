@@ -220,8 +220,8 @@ def tooth_form_margins(pair: InvolutePair) -> dict:
 def check_pair_fields(pair: InvolutePair) -> None:
     """Range check of a pair's fields (internal units mm, rad); traced fields skip it."""
     vals = (pair.module, pair.pressure_angle, pair.helix, pair.x1, pair.x2)
-    if any(is_traced(v) for v in vals) or any(np.ndim(v) for v in vals):
-        return                      # traced, or a batch of pairs (vmap data): not checked here
+    if any(is_traced(v) for v in vals + (pair.z1, pair.z2)) or any(np.ndim(v) for v in vals):
+        return          # traced (tooth numbers: inside a shared program), or a batch of pairs
     check_int("z1", pair.z1, lo=6, hi=MAX_TEETH)
     check_int("z2", pair.z2, lo=6, hi=MAX_TEETH)
     check_range("module", pair.module, MODULE_RANGE_MM[0], MODULE_RANGE_MM[1], unit="mm")
