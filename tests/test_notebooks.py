@@ -46,3 +46,17 @@ def test_design_study_notebook_runs_and_converges(tmp_path):
     assert "converged:" in text and "accepted: True []" in text, text[-2000:]
     kkt = re.search(r"stationarity ([0-9.e+-]+), feasibility ([0-9.e+-]+)", text)
     assert float(kkt.group(1)) <= 1e-4 and float(kkt.group(2)) <= 1e-4
+
+
+def test_ehl_check_notebook_meets_its_references(tmp_path):
+    """The EHL notebook (48²: the programs of test_ehl.py): the smooth film against
+    Hamrock-Dowson, the fast model against the numerical rough contact, and the adjoint
+    gradients against central differences (what the notebook prints, read back)."""
+    text = _text(_run(ROOT / "notebooks" / "03_ehl_check.ipynb", tmp_path))
+    assert "converged True" in text and "numerical solve converged True" in text, text[-2000:]
+    ratio = float(re.search(r"h_c  numerical .* ratio ([0-9.]+)", text).group(1))
+    assert 0.9 <= ratio <= 1.1
+    mu = re.search(r"^mu\s+([0-9.]+)\s+([0-9.]+)\s+([0-9.]+)$", text, re.M)
+    assert 0.7 <= float(mu.group(3)) <= 1.3, mu.group(0)
+    worst = float(re.search(r"largest relative difference ([0-9.e+-]+)", text).group(1))
+    assert worst < 1e-5
