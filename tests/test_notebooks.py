@@ -60,3 +60,16 @@ def test_ehl_check_notebook_meets_its_references(tmp_path):
     assert 0.7 <= float(mu.group(3)) <= 1.3, mu.group(0)
     worst = float(re.search(r"largest relative difference ([0-9.e+-]+)", text).group(1))
     assert worst < 1e-5
+
+
+def test_vh_catt_notebook_efficiency_and_its_gradient(tmp_path):
+    """The VH-CATT notebook: the efficiency at the operating point of docs/vh_catt.md
+    (0.987854, the table there), every sweep point valid, and the jitted gradient of the
+    efficiency by the cutter radii against central differences."""
+    text = _text(_run(ROOT / "notebooks" / "04_vh_catt_efficiency.ipynb", tmp_path))
+    eta = float(re.search(r"mean mesh efficiency ([0-9.]+)", text).group(1))
+    assert abs(eta - 0.987854) <= 2e-6, text[-2000:]
+    rows = re.findall(r"^\s+[0-9.]+\s+([0-9.]+)\s+[0-9.]+\s+[0-9.]+\s+(\d+)$", text, re.M)
+    assert len(rows) == 15 and all(int(n) == 24 for _, n in rows), rows
+    worst = float(re.search(r"largest relative error ([0-9.e+-]+)", text).group(1))
+    assert worst < 5e-5
