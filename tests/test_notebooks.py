@@ -73,3 +73,20 @@ def test_vh_catt_notebook_efficiency_and_its_gradient(tmp_path):
     assert len(rows) == 15 and all(int(n) == 24 for _, n in rows), rows
     worst = float(re.search(r"largest relative error ([0-9.e+-]+)", text).group(1))
     assert worst < 5e-5
+
+
+def test_preset_te_bevel_notebook_preset_sweep_and_derivatives(tmp_path):
+    """The preset-TE bevel notebook (the TCA programs of test_preset_bevel_tca.py): the
+    preset parabola followed (docs/preset_te_bevel.md: 0.21 arcsec), smooth transfers
+    aligned, the jump under dG shrinking as kappa grows, and the forward-mode
+    derivatives by kappa and rho1 against central differences."""
+    text = _text(_run(ROOT / "notebooks" / "05_preset_te_bevel.ipynb", tmp_path))
+    dev = float(re.search(r"preset parabola ([0-9.]+) arcsec", text).group(1))
+    assert dev < 0.5, text[-2000:]
+    gaps = re.search(r"preset .* transfer gaps ([-+0-9.]+) / ([-+0-9.]+) arcsec", text)
+    assert float(gaps.group(1)) < 0 and float(gaps.group(2)) < 0
+    rows = re.findall(r"^\s+([0-9.]+)\s+[0-9.]+\s+[0-9.]+\s+([-0-9.]+)\s+(?:\[|none)", text, re.M)
+    jumps = [float(g) for _, g in rows]
+    assert len(jumps) == 4 and all(a > b for a, b in zip(jumps, jumps[1:])), rows
+    worst = float(re.search(r"largest relative error ([0-9.e+-]+)", text).group(1))
+    assert worst < 1e-5
