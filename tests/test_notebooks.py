@@ -29,6 +29,11 @@ def _text(nb):
     return "\n".join(out)
 
 
+def _images(nb):
+    """Number of figures the notebook displays (PNG outputs)."""
+    return sum("image/png" in o.get("data", {}) for c in nb.cells for o in c.get("outputs", []))
+
+
 def test_quickstart_runs_and_its_gradient_matches(tmp_path):
     nb = _run(ROOT / "notebooks" / "01_quickstart.ipynb", tmp_path)
     text = _text(nb)
@@ -43,6 +48,7 @@ def test_quickstart_runs_and_its_gradient_matches(tmp_path):
 def test_design_study_notebook_runs_and_converges(tmp_path):
     nb = _run(ROOT / "notebooks" / "02_design_study.ipynb", tmp_path)
     text = _text(nb)
+    assert _images(nb) == 1         # the study figure, in the kernel's inline backend
     assert "converged:" in text and "accepted: True []" in text, text[-2000:]
     kkt = re.search(r"stationarity ([0-9.e+-]+), feasibility ([0-9.e+-]+)", text)
     assert float(kkt.group(1)) <= 1e-4 and float(kkt.group(2)) <= 1e-4
@@ -90,3 +96,19 @@ def test_preset_te_bevel_notebook_preset_sweep_and_derivatives(tmp_path):
     assert len(jumps) == 4 and all(a > b for a, b in zip(jumps, jumps[1:])), rows
     worst = float(re.search(r"largest relative error ([0-9.e+-]+)", text).group(1))
     assert worst < 1e-5
+
+
+def test_cutter_radius_notebook_table_fields_and_derivatives(tmp_path):
+    """The cutter-radius notebook (7 x 5: the programs of test_cutter_radius_study.py):
+    the seed's Table 1 trends, the curvature-interference case found, the sweep's
+    derivatives against central differences, and the field maps displayed (a plot
+    module that forced the Agg backend on import hid them)."""
+    nb = _run(ROOT / "notebooks" / "06_cutter_radius_study.ipynb", tmp_path)
+    text = _text(nb)
+    rows = re.findall(r"^(\S+in)\s+[0-9.]+\s+([0-9.]+)\s+[0-9.]+\s+([0-9.]+)", text, re.M)
+    d1 = [float(r[1]) for r in rows]
+    assert len(rows) == 3 and d1[0] > d1[1] > d1[2], rows
+    assert "curvature interference inside: True" in text
+    worst = float(re.search(r"central difference ([0-9.e+-]+)$", text, re.M).group(1))
+    assert worst < 1e-6
+    assert _images(nb) == 2

@@ -78,8 +78,8 @@ def _report(args, r, operating, scenario):
 
 
 def _tornado(rep, path):
-    import matplotlib
-    matplotlib.use("Agg", force=False)
+    from gearjax.plot import headless
+    headless()
     import matplotlib.pyplot as plt
     import numpy as np
 

@@ -39,8 +39,8 @@ def plot_flank_axial(grid, blank=None, ax=None, label: str = "flank", color="C0"
 
 
 def _draw_flank(grid, blank, ax, label, color):
-    import matplotlib
-    matplotlib.use("Agg", force=False)
+    from gearjax.plot import headless
+    headless()
     import matplotlib.pyplot as plt
 
     if ax is None:
@@ -83,8 +83,8 @@ def _draw_flank(grid, blank, ax, label, color):
 
 def save_flank_plot(path, grid, blank=None, title: str | None = None, label: str = "flank") -> Path:
     """Save the axial-plane figure to ``path`` (format from the extension), atomically."""
-    import matplotlib
-    matplotlib.use("Agg", force=False)
+    from gearjax.plot import headless
+    headless()
     import matplotlib.pyplot as plt
 
     from gearjax.io import atomic_write

@@ -14,9 +14,9 @@ from __future__ import annotations
 
 import io as _io
 
-import matplotlib
+from gearjax.plot import headless
 
-matplotlib.use("Agg")
+headless()
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 

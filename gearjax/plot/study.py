@@ -96,8 +96,8 @@ def study_figure(report: dict, start: tuple, end: tuple, mask=None):
     ``(Q, res, eff)`` of :func:`gearjax.studies.study_run.run_study` (scenario 1 is
     drawn); ``mask``: the start design's on-flank points of scenario 1 (for |SRR|)."""
     import jax
-    import matplotlib
-    matplotlib.use("Agg", force=False)
+    from gearjax.plot import headless
+    headless()
     import matplotlib.pyplot as plt
 
     first = lambda tree: jax.tree_util.tree_map(lambda a: np.asarray(a)[0], tree)  # noqa: E731

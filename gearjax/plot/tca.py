@@ -154,8 +154,8 @@ def plot_tca(results, limits=None, title="TCA", pitch_rad=None):
     heel-tip, toe-tip, mm; bevel gears).  ``pitch_rad``: angular pitch of the pinion
     (2 pi/z1, rad) for the relative noise floor.  Returns the matplotlib Figure.
     """
-    import matplotlib
-    matplotlib.use("Agg", force=False)
+    from gearjax.plot import headless
+    headless()
     import matplotlib.pyplot as plt
 
     k = len(results)
