@@ -5,6 +5,7 @@ formulas, the ratio condition at the pitch point, Euler/Bertrand closed forms fo
 the cutter cone, the conjugate pinion flank built explicitly (K_II = k_gear - k_pinion),
 the paper's Table 1 and central differences."""
 
+import re
 from collections import namedtuple
 
 import jax
@@ -15,6 +16,7 @@ import pytest
 from gearjax.errors import ConvergenceError
 from gearjax.studies import cutter_radius as hk
 from gearjax.gears.hypoid.blank import blank_geometry
+from notebook_run import images, run_notebook
 
 SHAPE = (7, 5)
 
@@ -230,3 +232,22 @@ def test_contact_line_is_level_set_of_the_roll_angle(base):
     cr, dp = jax.jit(jax.vmap(check))(uv)
     assert np.max(np.asarray(cr)) < 1e-9
     assert np.max(np.asarray(dp)) < 1e-9 * float(np.max(np.linalg.norm(np.asarray(base[3].p), axis=-1)))
+
+
+# -- the notebook of this subject (tests/notebook_run.py: after this file's tests,
+# whose compiled programs it reuses)
+
+
+def test_cutter_radius_notebook_table_fields_and_derivatives(tmp_path):
+    """The cutter-radius notebook (7 x 5: the programs of test_cutter_radius_study.py):
+    the seed's Table 1 trends, the curvature-interference case found, the sweep's
+    derivatives against central differences, and the field maps displayed (a plot
+    module that forced the Agg backend on import hid them)."""
+    nb, text = run_notebook("06_cutter_radius_study", tmp_path)
+    rows = re.findall(r"^(\S+in)\s+[0-9.]+\s+([0-9.]+)\s+[0-9.]+\s+([0-9.]+)", text, re.M)
+    d1 = [float(r[1]) for r in rows]
+    assert len(rows) == 3 and d1[0] > d1[1] > d1[2], rows
+    assert "curvature interference inside: True" in text
+    worst = float(re.search(r"central difference ([0-9.e+-]+)$", text, re.M).group(1))
+    assert worst < 1e-6
+    assert images(nb) == 2

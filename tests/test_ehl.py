@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 
 import jax
 import jax.numpy as jnp
@@ -27,6 +28,7 @@ from gearjax.tribology.ehl import ehl_fields, ehl_gradients, ehl_traced, make_gr
 from gearjax.tribology.ehl.grid import deformation, influence_kernel
 from gearjax.tribology.ehl.model import make_case, scales
 from gearjax.tribology.film import hamrock_dowson
+from notebook_run import run_notebook
 
 N = 48
 BASE = dict(F=100.0, u_e=1000.0, u_s=200.0, Rx=10.0, Ry=10.0, eta0=0.088, alpha_per_GPa=22.0)
@@ -392,3 +394,21 @@ def test_bad_inputs_raise_value_error_naming_the_parameter(kw, word):
     with pytest.raises(ValueError, match=word):
         solve_ehl(args.pop("F"), args.pop("u_e"), args.pop("u_s"), args.pop("Rx"),
                   args.pop("Ry"), args.pop("eta0"), args.pop("alpha_per_GPa"), n=n, **args)
+
+
+# -- the notebook of this subject (tests/notebook_run.py: after this file's tests,
+# whose compiled programs it reuses)
+
+
+def test_ehl_check_notebook_meets_its_references(tmp_path):
+    """The EHL notebook (48²: the programs of test_ehl.py): the smooth film against
+    Hamrock-Dowson, the fast model against the numerical rough contact, and the adjoint
+    gradients against central differences (what the notebook prints, read back)."""
+    _, text = run_notebook("03_ehl_check", tmp_path)
+    assert "converged True" in text and "numerical solve converged True" in text, text[-2000:]
+    ratio = float(re.search(r"h_c  numerical .* ratio ([0-9.]+)", text).group(1))
+    assert 0.9 <= ratio <= 1.1
+    mu = re.search(r"^mu\s+([0-9.]+)\s+([0-9.]+)\s+([0-9.]+)$", text, re.M)
+    assert 0.7 <= float(mu.group(3)) <= 1.3, mu.group(0)
+    worst = float(re.search(r"largest relative difference ([0-9.e+-]+)", text).group(1))
+    assert worst < 1e-5

@@ -8,6 +8,7 @@ the involute loader."""
 
 import json
 import math
+import re
 
 import jax.numpy as jnp
 import numpy as np
@@ -18,6 +19,7 @@ from gearjax.cli import main
 from gearjax.studies import study_run as sr
 from gearjax.studies.quantities import smooth_max, smooth_min, te_ptp_continuous
 from gearjax.studies.study_file import read_study
+from notebook_run import images, run_notebook
 
 
 @pytest.fixture(scope="module")
@@ -59,6 +61,9 @@ def test_slsqp_finds_the_same_optimum(sliding_run):
                                          max_iterations=60))
     r = sr.run_study(prob)
     assert r.accepted and r.report["optimizer"]["converged"]
+    # the start and the end evaluation ran one traced program (the scales set between
+    # them keep their shapes: a retrace costs seconds of tracing per study)
+    assert prob.evaluate_program._cache_size() == 1
     end_al = {d["field"]: d["end"] for d in rep["variables"]}
     for d in r.report["variables"]:
         assert d["end"] == pytest.approx(end_al[d["field"]], abs=1e-6)
@@ -244,3 +249,15 @@ def test_bad_command_lines_are_refused(capsys, args, match):
     assert main(args) == 2
     err = capsys.readouterr().err
     assert match in err and err.count("\n") == 1
+
+
+# -- the notebook of this subject (tests/notebook_run.py: after this file's tests,
+# whose compiled programs it reuses)
+
+
+def test_design_study_notebook_runs_and_converges(tmp_path):
+    nb, text = run_notebook("02_design_study", tmp_path)
+    assert images(nb) == 1         # the study figure, in the kernel's inline backend
+    assert "converged:" in text and "accepted: True []" in text, text[-2000:]
+    kkt = re.search(r"stationarity ([0-9.e+-]+), feasibility ([0-9.e+-]+)", text)
+    assert float(kkt.group(1)) <= 1e-4 and float(kkt.group(2)) <= 1e-4

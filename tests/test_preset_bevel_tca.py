@@ -22,6 +22,7 @@ from gearjax.gears.preset_bevel import geometry as G
 from gearjax.gears.preset_bevel.pair import preset_assembly, side_flanks
 from gearjax.tca.assembly import gear_mount
 from gearjax.tca.result import strong_float64
+from notebook_run import run_notebook
 
 OPTS = dict(steps_per_pitch=16, half_pitches=1.0, n_pairs=3, kinematics=False)
 EX = "example:preset_te_bevel_10x30"
@@ -330,3 +331,24 @@ def test_cli_surface_refuses_points_beyond_the_flank(tmp_path, capsys):
         assert re.search(r"gearjax: error: .*: \d+ of \d+ grid points are not converged "
                          r"solves .*nothing written", err[0]), err
         assert not (tmp_path / out).exists()
+
+
+# -- the notebook of this subject (tests/notebook_run.py: after this file's tests,
+# whose compiled programs it reuses)
+
+
+def test_preset_te_bevel_notebook_preset_sweep_and_derivatives(tmp_path):
+    """The preset-TE bevel notebook (the TCA programs of test_preset_bevel_tca.py): the
+    preset parabola followed (docs/preset_te_bevel.md: 0.21 arcsec), smooth transfers
+    aligned, the jump under dG shrinking as kappa grows, and the forward-mode
+    derivatives by kappa and rho1 against central differences."""
+    _, text = run_notebook("05_preset_te_bevel", tmp_path)
+    dev = float(re.search(r"preset parabola ([0-9.]+) arcsec", text).group(1))
+    assert dev < 0.5, text[-2000:]
+    gaps = re.search(r"preset .* transfer gaps ([-+0-9.]+) / ([-+0-9.]+) arcsec", text)
+    assert float(gaps.group(1)) < 0 and float(gaps.group(2)) < 0
+    rows = re.findall(r"^\s+([0-9.]+)\s+[0-9.]+\s+[0-9.]+\s+([-0-9.]+)\s+(?:\[|none)", text, re.M)
+    jumps = [float(g) for _, g in rows]
+    assert len(jumps) == 4 and all(a > b for a, b in zip(jumps, jumps[1:])), rows
+    worst = float(re.search(r"largest relative error ([0-9.e+-]+)", text).group(1))
+    assert worst < 1e-5

@@ -24,6 +24,7 @@ loaded chain") lists which slip each test catches.
 """
 
 import math
+import re
 
 import jax.numpy as jnp
 import numpy as np
@@ -37,6 +38,7 @@ from gearjax.loading.loaded_contact import (MeshTeeth, contact_stress, hertz_coe
 from gearjax.tca.path import pair_arrays
 from gearjax.loading.pair_stiffness import (iso6336_mesh_stiffness, iso6336_single_stiffness,
                                             pair_compliance as path_pair_compliance)
+from notebook_run import run_notebook
 
 E_STEEL, NU = 206000.0, 0.3
 E_PRIME = 2.0 / (2.0 * (1.0 - NU ** 2) / E_STEEL)       # Hamrock's E' = 2 E*, steel/steel
@@ -814,3 +816,20 @@ def test_vh_catt_friction_radii_along_the_entrainment_by_hand(vh_run):
     # where the entrainment runs along t the radii are the principal ones
     zero = np.abs(th) < 1e-9
     np.testing.assert_allclose(Rx[zero], rx[zero], rtol=1e-12)
+
+
+# -- the notebook of this subject (tests/notebook_run.py: after this file's tests,
+# whose compiled programs it reuses)
+
+
+def test_vh_catt_notebook_efficiency_and_its_gradient(tmp_path):
+    """The VH-CATT notebook: the efficiency at the operating point of docs/vh_catt.md
+    (0.987854, the table there), every sweep point valid, and the jitted gradient of the
+    efficiency by the cutter radii against central differences."""
+    _, text = run_notebook("04_vh_catt_efficiency", tmp_path)
+    eta = float(re.search(r"mean mesh efficiency ([0-9.]+)", text).group(1))
+    assert abs(eta - 0.987854) <= 2e-6, text[-2000:]
+    rows = re.findall(r"^\s+[0-9.]+\s+([0-9.]+)\s+[0-9.]+\s+[0-9.]+\s+(\d+)$", text, re.M)
+    assert len(rows) == 15 and all(int(n) == 24 for _, n in rows), rows
+    worst = float(re.search(r"largest relative error ([0-9.e+-]+)", text).group(1))
+    assert worst < 5e-5

@@ -124,12 +124,14 @@ def test_duplicate_variable_and_unknown_field(tmp_path):
 
 def test_packaged_studies_read():
     names = list_studies()
-    assert {"spur_efficiency", "hypoid_efficiency_te", "preset_bevel_robust_kappa"} <= set(names)
+    assert {"spur_efficiency", "hypoid_efficiency_te", "preset_bevel_robust_kappa",
+            "vh_catt_cutter_radius"} <= set(names)
+    scenarios = {"preset_bevel_robust_kappa": 4, "vh_catt_cutter_radius": 2}
     for n in names:
         st = read_study(f"example:{n}")
         assert st.name == n and st.variables and st.objective
         prob = set_up(st)          # fields, bounds and scenarios checked (no compilation)
-        assert len(prob.scenarios) == (4 if n == "preset_bevel_robust_kappa" else 1)
+        assert len(prob.scenarios) == scenarios.get(n, 1)
 
 
 @pytest.mark.parametrize("example, field, delta, key", [
