@@ -139,6 +139,26 @@ def test_soft_active_set_removes_the_hand_over_jump(efficiency_problem):
     assert np.max(np.abs(np.diff(slope_s))) < 0.01 * np.max(np.abs(slope_h))
 
 
+def test_worst_case_over_scenarios_is_not_finite_when_a_scenario_is_not():
+    """The objective's worst case over scenarios (``over = "max"``) must not leave out a
+    scenario whose value is not finite: a VH-CATT study lowered its worst-case power
+    loss from 1.00 to 0.18 (scaled) by a step that left one scenario with no valid
+    position (power loss NaN), which the smooth maximum had dropped.  Planted bug
+    caught: the smooth maximum over scenarios without the finiteness test."""
+    from types import SimpleNamespace
+    st = read_study("example:preset_bevel_robust_kappa")
+    qi = st.quantities.index("te_ptp_arcsec")
+    Q = np.ones((4, len(st.quantities)))
+    Q[:, qi] = [9.0, 8.0, 7.0, 6.0]
+    data = SimpleNamespace(term_scale=jnp.ones(len(st.objective)),
+                           con_scale=jnp.ones(len(st.constraints)))
+    J, g = sr._combine(st, jnp.asarray(Q), data)
+    assert 9.0 <= float(J) <= 9.0 + sr.SCENARIO_TEMPERATURE * math.log(4)
+    Q[1, qi] = np.nan
+    J, g = sr._combine(st, jnp.asarray(Q), data)
+    assert np.isnan(float(J))
+
+
 def test_smooth_extrema_bounds():
     q = jnp.array([1.0, 3.0, 2.0, jnp.nan, 2.9])
     m = jnp.array([True, True, True, True, False])

@@ -223,8 +223,13 @@ def _combine(study: Study, Q, data):
     for t, term in enumerate(study.objective):
         sign = 1.0 if term.sense == "minimize" else -1.0
         q = sign * Q[:, qi[term.quantity]] / data.term_scale[t]
-        r = jnp.mean(q) if term.over == "mean" else smooth_max(
-            q, jnp.ones(q.shape, bool), SCENARIO_TEMPERATURE)
+        # the worst case over the scenarios: a scenario whose value is not finite (e.g. no
+        # valid position of the cycle) makes it NaN, so that the line search refuses the
+        # step -- smooth_max alone leaves non-finite entries out, and the optimiser then
+        # lowered the worst case by emptying a scenario (docs/optimize.md)
+        r = jnp.mean(q) if term.over == "mean" else jnp.where(
+            jnp.all(jnp.isfinite(q)),
+            smooth_max(q, jnp.ones(q.shape, bool), SCENARIO_TEMPERATURE), jnp.nan)
         J = J + term.weight * r
     g = []
     for c, con in enumerate(study.constraints):
