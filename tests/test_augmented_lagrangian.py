@@ -273,10 +273,18 @@ def test_a_given_constraint_count_saves_the_shape_probe():
     ref = minimize_constrained(hs43, jnp.zeros(4), max_outer=6, max_inner=13)
     np.testing.assert_array_equal(np.asarray(r.x), np.asarray(ref.x))
     assert int(r.evaluations) == int(ref.evaluations)
-    with pytest.raises(ValueError, match="fun returned 3 constraint values; n_constraints = 2"):
-        minimize_constrained(hs43, jnp.zeros(4), max_outer=6, n_constraints=2)
-    with pytest.raises(ValueError, match="n_constraints = -1 must be an integer >= 0"):
-        minimize_constrained(hs43, jnp.zeros(4), n_constraints=-1)
+    for wrong in (2, 4):        # too few and too many: the ValueError, not a reshape error
+        with pytest.raises(ValueError, match=f"fun returned 3 constraint values; "
+                                             f"n_constraints = {wrong}"):
+            minimize_constrained(hs43, jnp.zeros(4), max_outer=6, n_constraints=wrong)
+    for bad in (-1, 2.5):
+        with pytest.raises(ValueError, match=f"n_constraints = {bad} must be an integer >= 0"):
+            minimize_constrained(hs43, jnp.zeros(4), n_constraints=bad)
+    # a bound-only problem: n_constraints = 0 is valid and gives the same run
+    r0 = minimize_constrained(lambda x: (jnp.sum((x - 2.0) ** 2), jnp.zeros(0)), jnp.zeros(2),
+                              upper=1.0, n_constraints=0)
+    np.testing.assert_allclose(np.asarray(r0.x), [1.0, 1.0], atol=1e-8)
+    assert r0.converged
 
 
 #: evaluations of the model per problem, recorded at 47800e8 (deterministic for the code;

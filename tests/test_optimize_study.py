@@ -154,9 +154,23 @@ def test_worst_case_over_scenarios_is_not_finite_when_a_scenario_is_not():
                            con_scale=jnp.ones(len(st.constraints)))
     J, g = sr._combine(st, jnp.asarray(Q), data)
     assert 9.0 <= float(J) <= 9.0 + sr.SCENARIO_TEMPERATURE * math.log(4)
+    # one constraint row per bound and scenario: the count the optimiser is given
+    assert g.shape == (sr.n_constraint_rows(sr.set_up(st)),) == (8,)
     Q[1, qi] = np.nan
     J, g = sr._combine(st, jnp.asarray(Q), data)
     assert np.isnan(float(J))
+
+
+def test_forward_mode_for_few_variables_or_several_scenarios():
+    """study_run.derivatives: forward mode up to FORWARD_MAX_VARIABLES variables or with
+    several scenarios (where reverse mode through the scenarios' vmap gave NaN), reverse
+    mode otherwise (the 13-variable hypoid study)."""
+    from types import SimpleNamespace
+    n = sr.FORWARD_MAX_VARIABLES
+    mode = lambda nv, ns: sr.derivatives(SimpleNamespace(fields=["f"] * nv,  # noqa: E731
+                                                         scenarios=[{}] * ns))
+    assert mode(n, 1) == "forward" and mode(n + 1, 1) == "reverse"
+    assert mode(n + 9, 4) == "forward" and mode(1, 1) == "forward"
 
 
 def test_smooth_extrema_bounds():
