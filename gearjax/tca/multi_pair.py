@@ -146,13 +146,6 @@ def flank_crossings(path, margin):
     quadratic interpolant of the margin: error O(h^3); NaN if none).  Traceable."""
     phi = path.phi1
     m = jnp.where(path.converged, margin, -1.0)
-
-    def first_up(p, f):
-        hit = (f[:-1] < 0.0) & (f[1:] >= 0.0)
-        i = jnp.argmax(hit)
-        w = f[i] / (f[i] - f[i + 1])
-        return jnp.where(jnp.any(hit), p[i] + w * (p[i + 1] - p[i]), jnp.nan)
-
     h = phi[1] - phi[0]
 
     def refine(x):
@@ -162,7 +155,7 @@ def flank_crossings(path, margin):
             x = x - mx / dm
         return x
 
-    return refine(first_up(phi, m)), refine(first_up(phi[::-1], m[::-1]))
+    return refine(_crossing(phi, m)), refine(_crossing(phi[::-1], m[::-1]))
 
 
 def transfer_gaps(path, margin, multi: MultiPair):
