@@ -127,6 +127,15 @@ def test_preset_absorbs_part_of_a_misalignment(runs):
         g = max(float(v) for v in A.transfer_gaps(res, 10, 16)) / gj.ARCSEC
         q = float(QUANTITIES["transfer_gap_arcsec"].fn(res, None, None, None))
         assert g <= q <= g + GAP_TEMPERATURE * math.log(2), case
+    # pair 0 never leaving the flanks on the grid (every margin positive): no transfer is
+    # found, and the quantity is NaN -- not the other gap alone, nor -inf, either of which
+    # a constraint "transfer_gap <= 0" would read as satisfied
+    res = runs["mod"]
+    m = np.asarray(res.margin)
+    for margin in (np.where(np.arange(m.size) > m.size // 2, 1.0, m), np.ones_like(m)):
+        cut = dataclasses.replace(res, margin=jnp.asarray(margin))
+        assert not np.all(np.isfinite([float(v) for v in A.transfer_gaps(cut, 10, 16)]))
+        assert np.isnan(float(QUANTITIES["transfer_gap_arcsec"].fn(cut, None, None, None)))
 
 
 def test_summary_is_the_result_at_the_reference(runs):

@@ -140,9 +140,14 @@ GAP_TEMPERATURE = 0.01
 def _transfer_gap(res, eff, mask, pair):
     """Smooth maximum (:data:`GAP_TEMPERATURE`) of the TE gaps where tooth pair 0 enters
     and leaves the flanks (arcsec; :func:`gearjax.tca.multi_pair.transfer_gaps`): > 0
-    the envelope jumps there, < 0 the curves cross inside the overlap."""
+    the envelope jumps there, < 0 the curves cross inside the overlap.  NaN when either
+    transfer is not found on the grid (pair 0 does not enter or leave the flanks there):
+    ``smooth_max`` alone would leave that gap out (and give -inf without both), so that a
+    constraint ``transfer_gap <= 0`` would read "no transfer" as satisfied; a NaN makes
+    the start refuse the study and the line search refuse the step."""
     gaps = jnp.stack(transfer_gaps(res.path, res.margin, res.multi)) / ARCSEC
-    return smooth_max(gaps, jnp.ones(2, bool), GAP_TEMPERATURE)
+    return jnp.where(jnp.all(jnp.isfinite(gaps)),
+                     smooth_max(gaps, jnp.ones(2, bool), GAP_TEMPERATURE), jnp.nan)
 
 
 def _srr(res, mask):
