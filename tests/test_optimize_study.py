@@ -161,6 +161,15 @@ def test_worst_case_over_scenarios_is_not_finite_when_a_scenario_is_not():
     assert np.isnan(float(J))
 
 
+def test_valid_share_is_the_share_of_valid_positions():
+    """``valid_share``: valid positions over all positions of the cycle (not over the
+    loaded ones, not the count)."""
+    from types import SimpleNamespace
+    from gearjax.studies.quantities import QUANTITIES
+    eff = SimpleNamespace(valid=jnp.array([True, False, True, True, False, True, True, True]))
+    assert float(QUANTITIES["valid_share"].fn(None, eff, None, None)) == 0.75
+
+
 def test_forward_mode_for_few_variables_or_several_scenarios():
     """study_run.derivatives: forward mode up to FORWARD_MAX_VARIABLES variables or with
     several scenarios (where reverse mode through the scenarios' vmap gave NaN), reverse

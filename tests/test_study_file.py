@@ -124,8 +124,9 @@ def test_duplicate_variable_and_unknown_field(tmp_path):
 
 def test_packaged_studies_read():
     names = list_studies()
-    assert {"spur_efficiency", "hypoid_efficiency_te", "preset_bevel_robust_kappa"} <= set(names)
-    scenarios = {"preset_bevel_robust_kappa": 4}
+    assert {"spur_efficiency", "hypoid_efficiency_te", "preset_bevel_robust_kappa",
+            "vh_catt_cutter_radius"} <= set(names)
+    scenarios = {"preset_bevel_robust_kappa": 4, "vh_catt_cutter_radius": 2}
     for n in names:
         st = read_study(f"example:{n}")
         assert st.name == n and st.variables and st.objective
@@ -246,6 +247,14 @@ def test_acceptance_reasons_each_check():
     # an edge contact present at the start is not a new one; no hard model: not checked
     assert acceptance_reasons(**{**good, "flags0": [dict(ok, edge_contact=True)],
                                  "flags1": [dict(ok, edge_contact=True)], "hard": None}) == []
+    # an infeasible start may cost objective: the hard model may rise as much as the
+    # softened one (plus tol), not more
+    assert acceptance_reasons(**{**good, "hard": (1.07, 1.08), "soft": (1.0, 1.01)}) == []
+    assert acceptance_reasons(**{**good, "hard": (1.07, 1.08), "soft": (1.0, 1.00995)}) == []
+    r = acceptance_reasons(**{**good, "hard": (1.07, 1.08), "soft": (1.0, 1.0098)})
+    assert len(r) == 1 and "(softened: 1 -> 1.0098)" in r[0]
+    r = acceptance_reasons(**{**good, "hard": (1.07, 1.08), "soft": (1.0, 0.99)})
+    assert len(r) == 1 and "hard model" in r[0]
 
 
 def test_soften_edges():

@@ -310,6 +310,29 @@ def test_misaligned_contact_moves_off_the_middle(tca_runs):
     assert float(r.ptp) / gj.ARCSEC > 0.05
 
 
+def test_bearing_reach_is_the_ellipse_end_on_the_face_axis(tca_runs):
+    """The study quantity ``bearing_reach_mm`` (|z| + semi-major at the reference) is
+    how far the ellipse's farther end lies from the face middle: the contact point's
+    axial coordinate (fixed frame z, the pinion axis of the aligned pair) moved by the
+    semi-major along the major axis, which lies along the face (0.02 deg of tilt changes
+    the projection by less than 1e-7 relative).  Under the 0.02 deg shaft-angle error
+    the packaged pair's bearing reaches past the face end b/2 = 14 mm (17.78 mm,
+    docs/vh_catt.md section 6); aligned it stays inside."""
+    from gearjax.studies.quantities import QUANTITIES
+    reach = {}
+    for case in ("drive", "tilt"):
+        r = tca_runs[case]
+        mid = r.phi1.shape[0] // 2
+        a = float(r.path.semi_major[mid])
+        z = float(np.asarray(r.path.point)[mid, 2])
+        dz = a * float(np.asarray(r.path.major_dir)[mid, 2])
+        ends = max(abs(z + dz), abs(z - dz))
+        reach[case] = float(QUANTITIES["bearing_reach_mm"].fn(r, None, None, None))
+        assert reach[case] == pytest.approx(ends, abs=1e-3), case
+    assert reach["tilt"] == pytest.approx(17.78, abs=0.01)
+    assert reach["drive"] < 0.5 * B < reach["tilt"]
+
+
 def test_bearing_pushed_past_either_face_end_leaves_the_flank(pair, tca_runs):
     """The pair is symmetric about its middle section: a misalignment (dSigma, dP)
     and its mirror (-dSigma, -dP) put the contact at mirror-image axial positions (to

@@ -22,6 +22,9 @@ design moves a grid point on or off the flank.  So
   same mask) is then the constraint that keeps those points on the flank -- a study
   that uses a path quantity gets ``min_margin_mm >= 0`` added (``gearjax.studies.
   study_file``), so the fixed mask never describes points off the flank at its end;
+* the loaded cycle summaries are means over the *valid* positions, so a design whose
+  contact runs off the flank under load (positions lost) can look better; the
+  piecewise constant ``valid_share`` constrains that;
 * ``te_ptp_arcsec`` and the loaded cycle summaries (mean loss, efficiency, loaded TE)
   are those of the chain: piecewise smooth in the design, with kinks where the TE
   envelope hands over between pairs or a position changes validity.  The end design is
@@ -227,6 +230,12 @@ QUANTITIES: dict = {
         "set takes away (contacts within edge_softening_mm of a flank boundary; 0 without)",
         lambda res, eff, mask, pair: jnp.sum(jnp.where(eff.valid, eff.edge_share, 0.0))
         / jnp.maximum(jnp.sum(eff.valid), 1)),
+    "valid_share": Quantity(
+        "", True, False, None,
+        "share of the cycle's positions whose loaded result is valid (piecewise constant: "
+        "a constraint >= its start value makes a step that loses positions rise the merit "
+        "function, and the line search refuses it)",
+        lambda res, eff, mask, pair: jnp.sum(eff.valid) / eff.valid.shape[0]),
     "loaded_te_ptp_arcsec": Quantity(
         "arcsec", True, False, None, "peak-to-peak of the loaded TE over the valid positions",
         lambda res, eff, mask, pair: eff.te_loaded_ptp / ARCSEC),
@@ -256,6 +265,15 @@ QUANTITIES["tip_thickness_mm"] = Quantity(
     "involute pairs: smaller transverse tip thickness of pinion and wheel (smooth min)",
     lambda res, eff, mask, pair: _form(pair, ("tip_thickness1", "tip_thickness2")),
     ("involute",))
+
+
+QUANTITIES["bearing_reach_mm"] = Quantity(
+    "mm", False, False, None,
+    "VH-CATT pairs: how far the contact ellipse reaches from the face middle at the "
+    "reference, |z| + semi-major (unloaded ellipse at the TCA's approach); <= b/2 keeps "
+    "the bearing on the face (docs/vh_catt.md, section 6)",
+    lambda res, eff, mask, pair: jnp.abs(res.path.axial1[_mid(res)])
+    + res.path.semi_major[_mid(res)], ("vh_catt",))
 
 
 def needs_loaded(names) -> bool:

@@ -28,7 +28,9 @@ GearFamily.design_data`) and read again through the family's loader, which valid
 (tooth form, ranges), and its fields are compared with the optimiser's.  It is
 *accepted* only when the optimiser met its stopping test, the constraints hold, the
 file round-trips, and at every scenario the TCA converged without edge contact and (a
-loaded study) no fewer positions of the cycle are valid than at the start.
+loaded study) no fewer positions of the cycle are valid than at the start; with edge
+softening, the hard model's objective may not rise by more than the softened one's
+(:func:`acceptance_reasons`).
 """
 
 from __future__ import annotations
@@ -474,13 +476,16 @@ def _run_al(prob: Problem, callback):
 
 
 def acceptance_reasons(opt: dict, feasibility: float, tol: float, file_error, difference,
-                       x, flags0: list, flags1: list, hard=None) -> list:
+                       x, flags0: list, flags1: list, hard=None, soft=None) -> list:
     """Why an end design is not accepted (empty: accepted; module docstring): the
     optimiser's stopping test (``opt["converged"]``), the scaled constraint violation
     against ``tol``, the design file (``file_error`` of the loader; ``difference`` of its
     fields from the optimiser's ``x``, relative 1e-9), per scenario the TCA flags and
     valid positions (``flags0``/``flags1`` at start/end), and ``hard = (J0, J1)``, the
-    objective with the hard model when the study softens the edges."""
+    objective with the hard model when the study softens the edges: it may not rise by
+    more than ``tol`` beyond the rise of the softened objective ``soft = (J0, J1)`` (none
+    given: beyond 0).  A start that violates a constraint may cost objective to reach
+    feasibility; the hard model must then agree with that cost, not exceed it."""
     reasons = []
     if not opt["converged"]:
         reasons.append(f"the optimiser did not meet its stopping test ({opt['message']})")
@@ -491,9 +496,12 @@ def acceptance_reasons(opt: dict, feasibility: float, tol: float, file_error, di
     elif difference > 1e-9 * (1.0 + float(np.max(np.abs(x)))):
         reasons.append(f"the design file does not reproduce the end design (field difference "
                        f"{difference:.3g})")
-    if hard is not None and hard[1] > hard[0] + tol:
+    allowed = 0.0 if soft is None else max(0.0, soft[1] - soft[0])
+    if hard is not None and hard[1] > hard[0] + allowed + tol:
         reasons.append(f"with the hard model (no edge softening, as gearjax efficiency) the "
-                       f"objective rose {hard[0]:.6g} -> {hard[1]:.6g}")
+                       f"objective rose {hard[0]:.6g} -> {hard[1]:.6g}"
+                       + ("" if soft is None else
+                          f" (softened: {soft[0]:.6g} -> {soft[1]:.6g})"))
     for k, (a, b) in enumerate(zip(flags0, flags1)):
         where = f"scenario {k + 1}"
         if not b["converged"]:
@@ -571,7 +579,8 @@ def run_study(prob: Problem, callback=None, phase=None) -> StudyResult:
         flags0, flags1 = _flags(prob, res0, eff0), _flags(prob, res1, eff1)
     feas = float(np.max(np.asarray(g1), initial=0.0))
     reasons = acceptance_reasons(opt, feas, st.tolerance, err, diff, x, flags0, flags1,
-                                 (Jh0, Jh1) if prob.soft > 0.0 else None)
+                                 (Jh0, Jh1) if prob.soft > 0.0 else None,
+                                 (float(J0), float(J1)))
     scale = np.asarray(prob.data.scale)
     variables = [{"field": v.field, "unit": v.unit or "field",
                   "lower": (prob.x0[i] + scale[i] * prob.lower[i]) / v.factor,
