@@ -28,6 +28,7 @@ COMMANDS = [
     "gearjax.commands.efficiency",
     "gearjax.commands.optimize",
     "gearjax.commands.sensitivity",
+    "gearjax.commands.sweep",
 ]
 
 

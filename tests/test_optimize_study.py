@@ -152,12 +152,12 @@ def test_worst_case_over_scenarios_is_not_finite_when_a_scenario_is_not():
     Q[:, qi] = [9.0, 8.0, 7.0, 6.0]
     data = SimpleNamespace(term_scale=jnp.ones(len(st.objective)),
                            con_scale=jnp.ones(len(st.constraints)))
-    J, g = sr._combine(st, jnp.asarray(Q), data)
+    J, g = sr.combine(st, jnp.asarray(Q), data)
     assert 9.0 <= float(J) <= 9.0 + sr.SCENARIO_TEMPERATURE * math.log(4)
     # one constraint row per bound and scenario: the count the optimiser is given
     assert g.shape == (sr.n_constraint_rows(sr.set_up(st)),) == (8,)
     Q[1, qi] = np.nan
-    J, g = sr._combine(st, jnp.asarray(Q), data)
+    J, g = sr.combine(st, jnp.asarray(Q), data)
     assert np.isnan(float(J))
 
 
@@ -304,3 +304,78 @@ def test_design_study_notebook_runs_and_converges(tmp_path):
     assert "converged:" in text and "accepted: True []" in text, text[-2000:]
     kkt = re.search(r"stationarity ([0-9.e+-]+), feasibility ([0-9.e+-]+)", text)
     assert float(kkt.group(1)) <= 1e-4 and float(kkt.group(2)) <= 1e-4
+
+
+@pytest.fixture(scope="module")
+def sweep_one(tmp_path_factory):
+    """``gearjax sweep`` of the sliding study on this process's one device: 3 Latin-
+    hypercube designs and the design itself in chunks of 3 (the second chunk padded)."""
+    out = tmp_path_factory.mktemp("sweep1")
+    rc = main(["sweep", "example:spur_sliding", "--samples", "3", "--chunk", "3", "--seed", "1",
+               "--out", str(out)])
+    return rc, out, dict(np.load(out / "spur_sliding_sweep.npz"))
+
+
+def test_sweep_rows_are_each_designs_own_tca(sweep_one):
+    """Every row against a second route: the TCA of the row's design by
+    ``gj.tca_function`` (the program of the sensitivity test above), its quantities
+    over its own on-flank points, its flags; ``feasible`` and ``J`` against the study's
+    constraints and objective written out by hand."""
+    from gearjax.studies.quantities import QUANTITIES
+    from gearjax.studies.sweep import FLAG_KEYS
+    rc, out, d = sweep_one
+    assert rc == 0 and (out / "spur_sliding_sweep.png").stat().st_size > 10_000
+    names = list(d["quantities"])
+    assert names == ["max_abs_srr", "contact_ratio", "min_margin_mm", "tooth_form_margin_mm"]
+    x = d["x"]
+    assert x.shape == (4, 2) and np.allclose(x[0], [0.6, 0.36])
+    assert np.array_equal(d["x:pair.x2"], x[:, 1])
+    assert np.all((x[1:, 0] >= 0.3) & (x[1:, 0] <= 0.9) & (x[1:, 1] >= -0.2) & (x[1:, 1] <= 0.6))
+    f = gj.tca_function(gj.load_design("example:khk_spur_12x24"))
+    for k in range(4):
+        p = gj.with_fields(f.pair, {"pair.x1": jnp.asarray(x[k, 0]),
+                                    "pair.x2": jnp.asarray(x[k, 1])})
+        r = f(p)
+        want = [float(QUANTITIES[q].fn(r, None, r.on_flank, p)) for q in names]
+        np.testing.assert_allclose(d["values"][k, 0], want, rtol=1e-9, atol=1e-12)
+        np.testing.assert_array_equal(d[f"q:{names[1]}"][k], d["values"][k, :, 1])
+        fl = r.flags()
+        for key in FLAG_KEYS:
+            assert bool(d[f"flag:{key}"][k, 0]) == fl[key], (k, key)
+    v = d["values"][:, 0]
+    ok = np.isfinite(v).all(axis=1) & d["flag:converged"][:, 0] & ~d["flag:edge_contact"][:, 0]
+    assert np.array_equal(d["ok"], ok)
+    # the study's constraints: contact ratio >= 1.25 and the tooth form (the fixed mask's
+    # margin, which the study adds, is left out of a sweep)
+    assert np.array_equal(d["feasible"], ok & (v[:, 1] >= 1.25) & (v[:, 3] >= 0.0))
+    np.testing.assert_allclose(d["J"], v[:, 0] / v[0, 0], rtol=1e-12)
+    meta = json.loads(str(d["meta"]))
+    assert (meta["devices"], meta["chunk"], meta["designs"], meta["samples"]) == (1, 3, 4, 3)
+
+
+def test_sweep_on_four_host_devices_gives_the_same_numbers(sweep_one, tmp_path):
+    """The same sweep in a process whose CPU is split into 4 devices: the rows sharded
+    across them (one chunk of 4), the same numbers as on one device in chunks of 3."""
+    import os
+    import subprocess
+    import sys
+    env = dict(os.environ)
+    env["XLA_FLAGS"] = env.get("XLA_FLAGS", "") + " --xla_force_host_platform_device_count=4"
+    code = ("import sys; from gearjax.cli import main, _fast_compile_flags; "
+            "_fast_compile_flags(); sys.exit(main(sys.argv[1:]))")
+    run = subprocess.run([sys.executable, "-c", code, "sweep", "example:spur_sliding",
+                          "--samples", "3", "--chunk", "3", "--seed", "1", "--no-plot",
+                          "--out", str(tmp_path)], env=env, capture_output=True, text=True,
+                         timeout=900)
+    assert run.returncode == 0, run.stderr[-3000:]
+    assert "4 device(s)" in run.stdout
+    d4, d1 = np.load(tmp_path / "spur_sliding_sweep.npz"), sweep_one[2]
+    meta = json.loads(str(d4["meta"]))
+    assert (meta["devices"], meta["chunk"]) == (4, 4)
+    for k in d1:
+        if k == "meta":
+            continue
+        if d1[k].dtype.kind == "f":
+            np.testing.assert_allclose(d4[k], d1[k], rtol=1e-11, atol=1e-13, err_msg=k)
+        else:
+            assert np.array_equal(d4[k], d1[k]), k

@@ -94,6 +94,12 @@ def test_path_quantity_adds_the_mask_margin_constraint(tmp_path):
     ('torque_Nm = 60.0', 'torque_Nm = "60"', r"\[operating\] torque_Nm = '60' must be a number"),
     ('sigma_um = 0.4', 'sigma_um = 0.4\nedge_softening_mm = -1',
      r"\[operating\] edge_softening_mm = -1"),
+    ('sigma_um = 0.4\n', 'sigma_um = 0.4\n[sweep]\nmethod = "lhs"\n',
+     r"\[sweep\] method = 'lhs' must be one of"),
+    ('sigma_um = 0.4\n', 'sigma_um = 0.4\n[sweep]\npoints = 1\n',
+     r"\[sweep\] points = 1 is outside the allowed range \[2, inf\)"),
+    ('sigma_um = 0.4\n', 'sigma_um = 0.4\n[sweep]\nchunk = 0\n', r"\[sweep\] chunk = 0"),
+    ('sigma_um = 0.4\n', 'sigma_um = 0.4\n[sweep]\nsize = 3\n', r"unknown key 'sweep.size'"),
 ])
 def test_bad_entries_are_refused_with_one_line(tmp_path, old, new, match):
     assert old in GOOD
@@ -270,3 +276,35 @@ def test_soften_edges():
     np.testing.assert_allclose(np.asarray(c2), np.asarray(c) / np.asarray(s), rtol=1e-14)
     q3, c3, s3 = soften_edges(q, c, m, 0.0)
     assert q3 is q and c3 is c and np.all(np.asarray(s3) == 1.0)
+
+
+def test_sweep_table_defaults(tmp_path):
+    from gearjax.studies.study_file import SWEEP_DEFAULTS
+    assert read_study(_write(tmp_path, GOOD)).sweep == SWEEP_DEFAULTS
+    st = read_study(_write(tmp_path, GOOD + '\n[sweep]\nmethod = "grid"\npoints = 3\n'))
+    assert st.sweep == dict(SWEEP_DEFAULTS, method="grid", points=3)
+
+
+def test_sweep_points_grid_and_latin_hypercube():
+    """Row 0 the design's own point; a grid: every combination, the bounds included, the
+    last variable fastest; a Latin hypercube: one point in each of the n equal strata of
+    every variable's range, seeded (same seed, same points)."""
+    from gearjax.studies.sweep import MAX_DESIGNS, sample_points
+    lo, hi = np.array([-1.0, -0.5, 0.0]), np.array([2.0, 0.5, 3.0])
+    g = sample_points(lo, hi, "grid", points=3)
+    assert g.shape == (1 + 27, 3) and np.all(g[0] == 0.0)
+    assert {tuple(r) for r in g[1:]} == {(a, b, c) for a in (-1.0, 0.5, 2.0)
+                                         for b in (-0.5, 0.0, 0.5) for c in (0.0, 1.5, 3.0)}
+    assert list(g[1:4, 2]) == [0.0, 1.5, 3.0] and g[1, 0] == g[9, 0] == -1.0
+    n = 40
+    r = sample_points(lo, hi, "random", samples=n, seed=3)
+    assert r.shape == (n + 1, 3) and np.all(r[0] == 0.0)
+    strata = np.floor((r[1:] - lo) / (hi - lo) * n).astype(int)
+    for i in range(3):
+        assert sorted(strata[:, i]) == list(range(n)), i
+    assert np.array_equal(r, sample_points(lo, hi, "random", samples=n, seed=3))
+    assert not np.array_equal(r, sample_points(lo, hi, "random", samples=n, seed=4))
+    with pytest.raises(ValueError, match=r"\[sweep\] points = 101: 1030301 designs"):
+        sample_points(lo, hi, "grid", points=101)
+    with pytest.raises(ValueError, match=rf"samples = {MAX_DESIGNS + 1} is more"):
+        sample_points(lo, hi, "random", samples=MAX_DESIGNS + 1)

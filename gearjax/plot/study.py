@@ -1,6 +1,8 @@
 """The figure of a design study (``gearjax optimize``): the optimiser's history, the TE
 before and after, the loss per position (loaded studies) or the |SRR| along the path,
-and the change of every variable.  Agg backend; saved atomically by the caller."""
+and the change of every variable; the figure of a design sweep (``gearjax sweep``): the
+objective of every design against each variable.  Agg backend; saved atomically by the
+caller."""
 
 from __future__ import annotations
 
@@ -9,7 +11,7 @@ import numpy as np
 from gearjax.plot.style import MIN_WIDTH_IN, report_style, te_axis_limits
 from gearjax.tca.path import ARCSEC
 
-__all__ = ["study_figure"]
+__all__ = ["study_figure", "sweep_figure"]
 
 
 def _history(ax, hist, title):
@@ -115,5 +117,43 @@ def study_figure(report: dict, start: tuple, end: tuple, mask=None):
             m = np.ones(np.shape(res0.path.phi1), bool) if mask is None else np.asarray(mask)
             _srr(ax[1, 0], res0, res1, m)
         _variables(ax[1, 1], report["variables"])
+        fig.tight_layout()
+    return fig
+
+
+def sweep_figure(names: list, x, J, ok, feasible, title: str):
+    """The objective of every swept design against each variable (one panel per
+    variable; row 0, the design's own point, as a star): feasible designs filled,
+    designs that are ``ok`` but violate a constraint hollow, the others (TCA not
+    converged, edge contact, a quantity not finite) as crosses.  ``x`` (n, nv) in the
+    study file's units, ``J`` (n,) the study's scaled objective."""
+    from gearjax.plot import headless
+    headless()
+    import matplotlib.pyplot as plt
+
+    x, J = np.asarray(x), np.asarray(J)
+    ok, feasible = np.asarray(ok, bool), np.asarray(feasible, bool)
+    nv = x.shape[1]
+    cols = min(nv, 3)
+    rows = -(-nv // cols)
+    bad = ~ok & np.isfinite(J)
+    with report_style():
+        fig, axes = plt.subplots(rows, cols, figsize=(max(MIN_WIDTH_IN, 4.2 * cols),
+                                                      3.6 * rows), squeeze=False)
+        for i in range(rows * cols):
+            ax = axes.flat[i]
+            if i >= nv:
+                ax.set_visible(False)
+                continue
+            ax.plot(x[feasible, i], J[feasible], "o", ms=4, color="C0", label="feasible")
+            ax.plot(x[ok & ~feasible, i], J[ok & ~feasible], "o", ms=4, mfc="none",
+                    color="C1", label="constraint violated")
+            ax.plot(x[bad, i], J[bad], "x", ms=4, color="C3", label="flagged")
+            ax.plot(x[:1, i], J[:1], "*", ms=12, color="k", label="the design")
+            ax.set_xlabel(names[i])
+            ax.set_ylabel("objective J (scaled)")
+            ax.grid(True, alpha=0.3)
+        axes.flat[0].legend(fontsize=8)
+        fig.suptitle(title)
         fig.tight_layout()
     return fig

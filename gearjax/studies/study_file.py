@@ -23,6 +23,8 @@ full text with examples)::
                    |bound|, 1 for a bound 0)
     [optimizer]    method ("augmented_lagrangian" | "slsqp"), max_iterations,
                    tolerance (on the scaled KKT measures), starts (multi-start), seed
+    [sweep]        optional, for ``gearjax sweep``: method ("random": Latin hypercube |
+                   "grid"), samples (random), points (grid, per variable), seed, chunk
 
 Every entry is checked before any work; a bad one is a one-line ``ValueError`` naming
 it (``[[variables]] 2: field 'pair.x3' is not a field of ...``).  Fields are checked
@@ -49,6 +51,9 @@ __all__ = ["Variable", "Term", "Constraint", "Study", "read_study", "list_studie
 SCENARIO_KEYS = {"torque_Nm": "N m", "pinion_rpm": "rpm", "dE_mm": "mm", "dP_mm": "mm",
                  "dG_mm": "mm", "dSigma_deg": "deg"}
 METHODS = ("augmented_lagrangian", "slsqp")
+SWEEP_METHODS = ("random", "grid")
+#: the ``[sweep]`` table's keys and defaults (``gearjax sweep``)
+SWEEP_DEFAULTS = {"method": "random", "points": 5, "samples": 64, "seed": 0, "chunk": 16}
 _OPERATING = {"torque_Nm", "pinion_rpm", "oil", "sigma_um", "compliance", "edge_softening_mm"}
 _TCA = {"steps_per_pitch", "half_pitches", "n_pairs"}
 
@@ -117,6 +122,8 @@ class Study:
     source: str = ""
     #: quantities evaluated and reported but in neither the objective nor a constraint
     reported: tuple = ()
+    #: the ``[sweep]`` table (``gearjax sweep``): method, points, samples, seed, chunk
+    sweep: dict = field(default_factory=dict)
 
     @property
     def quantities(self) -> list:
@@ -307,7 +314,7 @@ def read_study(source) -> Study:
     except ValueError as exc:      # the reader speaks of design files
         raise ValueError(str(exc).replace("design file", "study file")) from None
     check_keys("", data, {"study", "operating", "scenarios", "tca", "variables", "objective",
-                          "constraints", "optimizer"})
+                          "constraints", "optimizer", "sweep"})
     st = require_key("", data, "study")
     check_keys("study", st, {"name", "description", "design", "side"})
     name = check_string("study", "name", require_key("study", st, "name"))
@@ -355,4 +362,18 @@ def read_study(source) -> Study:
                  tca={k: check_number("tca", k, v) for k, v in tca.items()}, method=method,
                  max_iterations=max_it, tolerance=tol, starts=starts,
                  seed=check_integer("optimizer", "seed", opt.get("seed", 0), 0),
-                 source=str(source))
+                 source=str(source), sweep=_sweep(data.get("sweep", {})))
+
+
+def _sweep(sw) -> dict:
+    """The ``[sweep]`` table: ``method`` ("random": a Latin hypercube of ``samples``
+    designs, or "grid": ``points`` values per variable), ``seed``, ``chunk`` (designs
+    per batch; rounded up to a multiple of the device count)."""
+    check_keys("sweep", sw, set(SWEEP_DEFAULTS))
+    out = dict(SWEEP_DEFAULTS)
+    out["method"] = check_string("sweep", "method", sw.get("method", "random"), SWEEP_METHODS)
+    out["points"] = check_integer("sweep", "points", sw.get("points", out["points"]), 2)
+    out["samples"] = check_integer("sweep", "samples", sw.get("samples", out["samples"]), 1)
+    out["seed"] = check_integer("sweep", "seed", sw.get("seed", out["seed"]), 0)
+    out["chunk"] = check_integer("sweep", "chunk", sw.get("chunk", out["chunk"]), 1)
+    return out

@@ -52,7 +52,8 @@ from gearjax.studies.study_file import Constraint, Study
 from gearjax.tca.assembly import Misalignment
 
 __all__ = ["Problem", "StudyResult", "set_up", "evaluate", "evaluator", "grid_size", "start_point",
-           "run_study", "acceptance_reasons"]
+           "run_study", "acceptance_reasons", "combine", "set_scales", "scenario_of",
+           "scenario_flags"]
 
 #: smooth maximum over scenarios: temperature in units of the term's scale
 SCENARIO_TEMPERATURE = 0.01
@@ -189,11 +190,12 @@ def set_up(study: Study) -> Problem:
     return prob
 
 
-def evaluator(prob: Problem, hard: bool = False):
+def evaluator(prob: Problem, hard: bool = False, own_mask: bool = False):
     """``(u, data) -> (Q (S, nq), res, eff, Q_hard)``: the quantities at every scenario;
     with ``hard`` (a loaded study) ``Q_hard`` are the loaded quantities again with the
     hard model (no edge softening: that of ``gearjax efficiency``) on the same TCA, else
-    ``Q``."""
+    ``Q``.  ``own_mask``: the path quantities over the evaluated design's own on-flank
+    points instead of ``data.mask`` (a sweep, where no optimiser moves the points)."""
     chain, names, loaded = prob.chain, list(prob.fields), prob.loaded
     qnames = prob.study.quantities
 
@@ -206,6 +208,8 @@ def evaluator(prob: Problem, hard: bool = False):
                 eff, res = chain(pair, T, n, data.oil, data.surface, mis)
             else:
                 eff, res = None, chain(pair, mis)
+            if own_mask:
+                mask = res.on_flank
             q = quantity_values(qnames, res, eff, mask, pair)
             if not (hard and loaded):
                 return q, res, eff, q
@@ -217,7 +221,7 @@ def evaluator(prob: Problem, hard: bool = False):
     return ev
 
 
-def _combine(study: Study, Q, data):
+def combine(study: Study, Q, data):
     """``(J, g)`` of the module docstring from the quantities ``Q`` (S, nq) (traceable;
     also run eagerly on concrete values for the start and end points)."""
     qi = {q: i for i, q in enumerate(study.quantities)}
@@ -244,7 +248,7 @@ def _combine(study: Study, Q, data):
 
 
 def n_constraint_rows(prob: Problem) -> int:
-    """Length of ``g`` of :func:`_combine`: one row per bound of each constraint and
+    """Length of ``g`` of :func:`combine`: one row per bound of each constraint and
     scenario (given to the optimiser, which would otherwise trace the chain once more
     to find it)."""
     bounds = sum((c.upper is not None) + (c.lower is not None) for c in prob.study.constraints)
@@ -256,7 +260,7 @@ def _objective(prob: Problem):
     ev, study = evaluator(prob), prob.study
 
     def fun(u, data):
-        return _combine(study, ev(u, data)[0], data)
+        return combine(study, ev(u, data)[0], data)
 
     return fun
 
@@ -267,7 +271,7 @@ def evaluate(prob: Problem, u):
     return prob.evaluate_program(jnp.asarray(u, float), prob.data)
 
 
-def _scales(prob: Problem, Q0) -> None:
+def set_scales(prob: Problem, Q0) -> None:
     """The terms' and constraints' default scales from the start values ``Q0``."""
     st = prob.study
     qi = {q: i for i, q in enumerate(st.quantities)}
@@ -322,19 +326,19 @@ def start_point(prob: Problem):
     if any(QUANTITIES[q].path for q in prob.study.quantities):
         prob.data = prob.data._replace(mask=jnp.asarray(np.asarray(out[1].on_flank)))
         out = evaluate(prob, u0)
-    _scales(prob, np.asarray(out[0]))
+    set_scales(prob, np.asarray(out[0]))
     return out
 
 
-def _scenario(tree, k):
+def scenario_of(tree, k):
     return jax.tree_util.tree_map(lambda a: a[k], tree)
 
 
-def _flags(prob: Problem, res, eff) -> list:
+def scenario_flags(prob: Problem, res, eff) -> list:
     """Per scenario: the TCA's quality flags and (loaded) the number of valid positions."""
     out = []
     for k in range(len(prob.scenarios)):
-        fl = _scenario(res, k).flags()
+        fl = scenario_of(res, k).flags()
         if eff is not None:
             fl["n_valid"] = int(np.asarray(eff.n_valid)[k])
         out.append(fl)
@@ -380,13 +384,13 @@ def quantity_jacobian(prob: Problem):
 def _run_slsqp(prob: Problem, callback):
     """SciPy's SLSQP on the same scaled problem with exact Jacobians: those of the
     quantities (:func:`quantity_jacobian`) carried through ``[J, g]`` of
-    :func:`_combine` by the chain rule (a small program of its own)."""
+    :func:`combine` by the chain rule (a small program of its own)."""
     from scipy.optimize import minimize
 
     study, prog = prob.study, quantity_jacobian(prob)
 
     def stacked(Q, data):
-        J, g = _combine(study, Q, data)
+        J, g = combine(study, Q, data)
         return jnp.concatenate([jnp.reshape(J, (1,)), g])
 
     def chain_rule(dQ, Q, data):        # d[J, g]/du = d[J, g]/dQ . dQ/du
@@ -394,11 +398,11 @@ def _run_slsqp(prob: Problem, callback):
                       in_axes=-1, out_axes=-1)
         return stacked(Q, data), jv(dQ)
 
-    combine = jax.jit(chain_rule)
+    chained = jax.jit(chain_rule)
 
     def vj(u, data):
         dQ, Q = prog(u, data)
-        return combine(dQ, Q, data)
+        return chained(dQ, Q, data)
 
     cache = {}
     hist_v, hist_f, count = [], [], [0]
@@ -471,7 +475,7 @@ def _run_al(prob: Problem, callback):
     per = [{"start": X0[i].tolist(), "value": float(vals[i]),
             "feasibility": float(np.asarray(rs.feasibility)[i]),
             "status": int(np.asarray(rs.status)[i])} for i in range(st.starts)]
-    return _scenario(rs, best), {"starts": st.starts, "best_start": best, "per_start": per,
+    return scenario_of(rs, best), {"starts": st.starts, "best_start": best, "per_start": per,
                                  "derivatives": kw["derivatives"]}
 
 
@@ -544,7 +548,7 @@ def run_study(prob: Problem, callback=None, phase=None) -> StudyResult:
     st, t0 = prob.study, time.time()
     with phase("start design"):
         Q0, res0, eff0, H0 = start_point(prob)
-    J0, g0 = _combine(st, jnp.asarray(Q0), prob.data)
+    J0, g0 = combine(st, jnp.asarray(Q0), prob.data)
     with phase(f"optimising ({st.method})"):
         t1 = time.time()
         if st.method == "slsqp":
@@ -570,13 +574,13 @@ def run_study(prob: Problem, callback=None, phase=None) -> StudyResult:
         opt.update(method=st.method, tolerance=st.tolerance, seconds=time.time() - t1, **extra)
     with phase("checking the end design"):
         Q1, res1, eff1, H1 = evaluate(prob, u)
-        J1, g1 = _combine(st, jnp.asarray(Q1), prob.data)
-        Jh0, Jh1 = (float(_combine(st, jnp.asarray(H), prob.data)[0]) for H in (H0, H1))
+        J1, g1 = combine(st, jnp.asarray(Q1), prob.data)
+        Jh0, Jh1 = (float(combine(st, jnp.asarray(H), prob.data)[0]) for H in (H0, H1))
         x = prob.x0 + np.asarray(prob.data.scale) * u
         end_pair = with_fields(prob.data.pair0, {n: jnp.asarray(x[i])
                                                  for i, n in enumerate(prob.fields)})
         data, err, diff = _round_trip(prob, end_pair)
-        flags0, flags1 = _flags(prob, res0, eff0), _flags(prob, res1, eff1)
+        flags0, flags1 = scenario_flags(prob, res0, eff0), scenario_flags(prob, res1, eff1)
     feas = float(np.max(np.asarray(g1), initial=0.0))
     reasons = acceptance_reasons(opt, feas, st.tolerance, err, diff, x, flags0, flags1,
                                  (Jh0, Jh1) if prob.soft > 0.0 else None,
