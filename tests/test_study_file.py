@@ -308,3 +308,14 @@ def test_sweep_points_grid_and_latin_hypercube():
         sample_points(lo, hi, "grid", points=101)
     with pytest.raises(ValueError, match=rf"samples = {MAX_DESIGNS + 1} is more"):
         sample_points(lo, hi, "random", samples=MAX_DESIGNS + 1)
+
+
+def test_a_sweep_uses_the_hard_loaded_model():
+    """``gearjax sweep`` reports the loaded quantities of ``gearjax efficiency`` (no edge
+    softening); the study itself keeps its soft active set (set up, no compilation)."""
+    from gearjax.studies.sweep import set_up_sweep
+    st = read_study("example:spur_efficiency")
+    assert set_up(st).soft == 0.2
+    prob = set_up_sweep(st)
+    assert prob.soft == 0.0 and prob.chain.options["edge_softening_mm"] == 0.0
+    assert "edge_load_share" not in prob.study.quantities

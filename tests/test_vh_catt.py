@@ -8,6 +8,7 @@ aligned pair), the transverse contact ratio, Hertz's ellipse by Timoshenko's
 coefficients m_a, m_b from SciPy's complete elliptic integrals.
 """
 
+import dataclasses
 import math
 
 import jax
@@ -331,6 +332,10 @@ def test_bearing_reach_is_the_ellipse_end_on_the_face_axis(tca_runs):
         assert reach[case] == pytest.approx(ends, abs=1e-3), case
     assert reach["tilt"] == pytest.approx(17.78, abs=0.01)
     assert reach["drive"] < 0.5 * B < reach["tilt"]
+    # a bearing pushed the other way (toward the other face end) reaches as far
+    r = tca_runs["tilt"]
+    mirrored = dataclasses.replace(r, path=r.path._replace(axial1=-r.path.axial1))
+    assert float(QUANTITIES["bearing_reach_mm"].fn(mirrored, None, None, None)) == reach["tilt"]
 
 
 def test_bearing_pushed_past_either_face_end_leaves_the_flank(pair, tca_runs):

@@ -98,12 +98,11 @@ def _run(study, sw, out, args) -> int:
 
     from gearjax.io import atomic_write, atomic_write_figure
     from gearjax.progress import Progress
-    from gearjax.studies.study_run import set_up
-    from gearjax.studies.sweep import npz_columns, run_sweep, sample_points
+    from gearjax.studies.sweep import npz_columns, run_sweep, sample_points, set_up_sweep
 
     with Progress(1, f"sweep {study.name}") as bar:
         with bar.phase("setting up the design"):
-            prob = set_up(study)
+            prob = set_up_sweep(study)
             U = sample_points(prob.lower, prob.upper, sw["method"], samples=sw["samples"],
                               points=sw["points"], seed=sw["seed"])
     n = U.shape[0]

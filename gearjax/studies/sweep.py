@@ -25,7 +25,8 @@ devices at a time, so memory does not grow with the number of designs.  On a CPU
 (each runs on its own thread); several GPUs are used as they are.  Several hosts: start
 one process per host with ``jax.distributed.initialize()`` (docs/optimize.md, "Sweeps").
 
-**Quantities and flags.**  The path quantities (|SRR|, R_x, margins) of a row are taken
+**Quantities and flags.**  Loaded quantities use the hard model (no edge softening,
+:func:`set_up_sweep`).  The path quantities (|SRR|, R_x, margins) of a row are taken
 over its own on-flank points (no optimiser moves them; contrast the fixed mask of a
 study).  Every row carries per scenario the TCA's quality flags
 (:meth:`gearjax.tca.result.TCAResult.flags`) and, for a loaded study, the number of
@@ -51,7 +52,7 @@ from gearjax.compile_ahead import FAST_COMPILE_OPTIONS
 from gearjax.studies.study_run import (Problem, combine, evaluator, scenario_flags,
                                        scenario_of, set_scales)
 
-__all__ = ["SweepResult", "sample_points", "sweep_program", "run_sweep", "npz_columns",
+__all__ = ["SweepResult", "set_up_sweep", "sample_points", "sweep_program", "run_sweep", "npz_columns",
            "MAX_DESIGNS", "FLAG_KEYS"]
 
 #: most designs one sweep may ask for (a grid's points ** n_variables included)
@@ -59,6 +60,15 @@ MAX_DESIGNS = 1_000_000
 #: the TCA flags a sweep records per row and scenario
 FLAG_KEYS = ("converged", "edge_contact", "tip_contact", "face_end_contact",
              "low_contact_ratio", "large_te")
+
+
+def set_up_sweep(study) -> Problem:
+    """:func:`gearjax.studies.study_run.set_up` for a sweep: the loaded quantities with
+    the hard model (``edge_softening_mm = 0``, that of ``gearjax efficiency``) -- the
+    soft active set exists for an optimiser's gradients, which a sweep does not take."""
+    from gearjax.studies.study_run import set_up
+    return set_up(dataclasses.replace(study, operating={**study.operating,
+                                                        "edge_softening_mm": 0.0}))
 
 
 def sample_points(lower, upper, method: str, *, samples: int = 64, points: int = 5,
