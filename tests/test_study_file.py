@@ -261,6 +261,9 @@ def test_acceptance_reasons_each_check():
     assert len(r) == 1 and "(softened: 1 -> 1.0098)" in r[0]
     r = acceptance_reasons(**{**good, "hard": (1.07, 1.08), "soft": (1.0, 0.99)})
     assert len(r) == 1 and "hard model" in r[0]
+    # a softened objective that fell asks only that the hard one did not rise, not that
+    # it fell as much
+    assert acceptance_reasons(**{**good, "hard": (1.0, 0.95), "soft": (1.0, 0.8)}) == []
 
 
 def test_soften_edges():

@@ -47,7 +47,7 @@ def register(sub):
         "sweep", help="evaluate a study's quantities over a sample or grid of designs",
         description="Evaluate the quantities of a study file at a Latin-hypercube sample or a "
                     "grid of designs inside its variables' bounds, in batches (vmap) sharded "
-                    "across every local device.",
+                    "across every device.",
         epilog=NPZ_KEYS_DOC, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("study", help="study file (.toml) or example:NAME")
     p.add_argument("--method", choices=["random", "grid"], default=None,

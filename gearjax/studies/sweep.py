@@ -14,7 +14,8 @@ Row 0 is always the design's own point (the reference the rows are compared with
 
 **Batches, devices, memory.**  The designs go through one compiled program in chunks of
 ``chunk`` rows: ``jax.vmap`` of the study's evaluator (every scenario of a row in the
-same call) over the rows of a chunk, the rows laid out across every local device
+same call) over the rows of a chunk, the rows laid out across every device (those of
+this process; with ``jax.distributed``, those of every process)
 (``jax.sharding``: a one-axis mesh ``designs``, the rows sharded, the design data
 replicated), so that XLA runs each device's share of the rows on that device; the
 rows come back to the host (from every process of a ``jax.distributed`` run).  The
