@@ -117,6 +117,36 @@ def test_hard_model_recheck_is_gearjax_efficiency(efficiency_problem):
     assert float(H0[0, i]) == pytest.approx(247.300, abs=5e-3)
 
 
+def test_run_study_hands_the_softened_objective_to_the_acceptance(efficiency_problem,
+                                                                   monkeypatch):
+    """run_study gives ``acceptance_reasons`` the hard model's objective and the softened
+    one's, start and end (an infeasible start may cost objective: the hard model may rise
+    as far as the softened one).  The optimiser is replaced by a fixed step (the wiring
+    is under test, not the optimiser); the programs are those compiled above."""
+    from types import SimpleNamespace
+    seen = {}
+    real = sr.acceptance_reasons
+
+    def spy(*args, **kw):
+        seen["args"] = args
+        return real(*args, **kw)
+
+    u1 = np.array([-0.2, 0.1])
+    fake = SimpleNamespace(x=u1, outer_iterations=1, message="converged", converged=True,
+                           evaluations=1, stationarity=0.0, feasibility=0.0,
+                           complementarity=0.0, multipliers=np.zeros(4),
+                           history_value=[1.0], history_feasibility=[0.0],
+                           history_stationarity=[0.0])
+    monkeypatch.setattr(sr, "acceptance_reasons", spy)
+    monkeypatch.setattr(sr, "_run_al", lambda prob, callback: (fake, {}))
+    rep = sr.run_study(efficiency_problem).report
+    hard, soft = seen["args"][-2:]
+    obj = rep["objective"]
+    assert soft == pytest.approx((obj["start"], obj["end"]), rel=1e-12)
+    assert hard == pytest.approx((obj["start_hard_model"], obj["end_hard_model"]), rel=1e-12)
+    assert soft[1] != soft[0] and hard[1] != hard[0]
+
+
 def test_soft_active_set_removes_the_hand_over_jump(efficiency_problem):
     """Across x1 = 0.700 .. 0.7025 a second tooth pair leaves contact at the first
     position of the cycle: with the hard model the cycle-mean loss jumps by about 3 W
