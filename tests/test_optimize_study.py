@@ -311,6 +311,12 @@ def test_sensitivity_command_against_central_differences(capsys):
     (["optimize"], "STUDY is required"),
     (["optimize", "example:nope"], "unknown example study 'nope'"),
     (["optimize", "example:spur_efficiency", "--max-iterations", "0"], "--max-iterations"),
+    (["sweep", "example:spur_sliding", "--points", "1"],
+     "--points = 1 is outside the allowed range [2, inf)"),
+    (["sweep", "example:spur_sliding", "--samples", "0"], "--samples = 0"),
+    (["sweep", "example:spur_sliding", "--chunk", "0"], "--chunk = 0"),
+    (["sweep", "example:spur_sliding", "--seed", "-1"], "--seed = -1"),
+    (["sweep", "example:nope"], "unknown example study 'nope'"),
     (["sensitivity", "example:khk_spur_12x24", "--outputs", "power_loss_W", "--params",
       "pair.x1"], "'power_loss_W' needs the operating point: torque_Nm"),
     (["sensitivity", "example:khk_spur_12x24", "--outputs", "contact_ratio", "--params",
@@ -322,18 +328,6 @@ def test_bad_command_lines_are_refused(capsys, args, match):
     assert main(args) == 2
     err = capsys.readouterr().err
     assert match in err and err.count("\n") == 1
-
-
-# -- the notebook of this subject (tests/notebook_run.py: after this file's tests,
-# whose compiled programs it reuses)
-
-
-def test_design_study_notebook_runs_and_converges(tmp_path):
-    nb, text = run_notebook("02_design_study", tmp_path)
-    assert images(nb) == 1         # the study figure, in the kernel's inline backend
-    assert "converged:" in text and "accepted: True []" in text, text[-2000:]
-    kkt = re.search(r"stationarity ([0-9.e+-]+), feasibility ([0-9.e+-]+)", text)
-    assert float(kkt.group(1)) <= 1e-4 and float(kkt.group(2)) <= 1e-4
 
 
 @pytest.fixture(scope="module")
@@ -394,3 +388,19 @@ def test_sweep_on_four_devices_is_each_designs_own_tca_on_one(sweep_four):
     np.testing.assert_allclose(d["J"], v[:, 0] / v[0, 0], rtol=1e-12)
     meta = json.loads(str(d["meta"]))
     assert (meta["devices"], meta["chunk"], meta["designs"], meta["samples"]) == (4, 4, 5, 4)
+    # the summary's best design is the feasible row of the smallest J
+    best = int(re.search(r"best feasible design: row (\d+)", run.stdout).group(1))
+    rows = np.flatnonzero(d["feasible"])
+    assert best == rows[np.argmin(d["J"][rows])] and d["feasible"][best]
+
+
+# -- the notebook of this subject (tests/notebook_run.py: after this file's tests,
+# whose compiled programs it reuses)
+
+
+def test_design_study_notebook_runs_and_converges(tmp_path):
+    nb, text = run_notebook("02_design_study", tmp_path)
+    assert images(nb) == 1         # the study figure, in the kernel's inline backend
+    assert "converged:" in text and "accepted: True []" in text, text[-2000:]
+    kkt = re.search(r"stationarity ([0-9.e+-]+), feasibility ([0-9.e+-]+)", text)
+    assert float(kkt.group(1)) <= 1e-4 and float(kkt.group(2)) <= 1e-4

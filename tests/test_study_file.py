@@ -2,6 +2,7 @@
 every bad entry refused with one line naming it, before any compilation; every family's
 design round-trips through its file with a changed field."""
 
+import dataclasses
 import math
 
 import numpy as np
@@ -305,6 +306,10 @@ def test_sweep_points_grid_and_latin_hypercube():
     strata = np.floor((r[1:] - lo) / (hi - lo) * n).astype(int)
     for i in range(3):
         assert sorted(strata[:, i]) == list(range(n)), i
+    # the strata of the variables are paired at random, not in the same order (a shared
+    # permutation would put every point on the box's diagonal)
+    for i, j in ((0, 1), (0, 2), (1, 2)):
+        assert abs(np.corrcoef(strata[:, i], strata[:, j])[0, 1]) < 0.6, (i, j)
     assert np.array_equal(r, sample_points(lo, hi, "random", samples=n, seed=3))
     assert not np.array_equal(r, sample_points(lo, hi, "random", samples=n, seed=4))
     with pytest.raises(ValueError, match=r"\[sweep\] points = 101: 1030301 designs"):
@@ -322,3 +327,38 @@ def test_a_sweep_uses_the_hard_loaded_model():
     prob = set_up_sweep(st)
     assert prob.soft == 0.0 and prob.chain.options["edge_softening_mm"] == 0.0
     assert "edge_load_share" not in prob.study.quantities
+    # also where the study file sets its own softening
+    own = dataclasses.replace(st, operating={**st.operating, "edge_softening_mm": 0.3})
+    assert set_up(own).soft == 0.3 and set_up_sweep(own).soft == 0.0
+
+
+def test_sweep_chunks_units_and_constraints(tmp_path):
+    """The pieces of a sweep that need no compilation: the chunk rounded up to a
+    multiple of the devices (and only then), the points in the file's units (degrees
+    for a ``unit = "deg"`` variable), the constraints checked (the study's own margin
+    constraint kept, the one it adds for its fixed mask left out)."""
+    import math
+    from gearjax.studies.sweep import chunk_size, file_units, steady_rate, sweep_constraints
+    assert [chunk_size(c, d) for c, d in ((3, 4), (4, 4), (5, 4), (1, 1), (16, 1), (0, 2))] \
+        == [4, 4, 8, 1, 16, 2]
+    # the rate after the first chunk (it carries the compilation); none with one chunk
+    assert steady_rate(10, 4, 5.0, 3.0) == 3.0 and steady_rate(4, 4, 5.0, 5.0) is None
+    assert steady_rate(3, 4, 2.0, 2.0) is None
+    # the best design: the feasible row of the smallest J, counted among all rows
+    from gearjax.studies.sweep import best_row
+    assert best_row([0.5, 0.9, 0.7, 0.8], [False, True, False, True]) == 3
+    assert best_row([1.0, 2.0], [False, False]) is None
+    st = read_study(_write(tmp_path, GOOD.replace(
+        'field = "pair.x1"\nlower = 0.3\nupper = 0.75',
+        'field = "pair.pressure_angle"\nunit = "deg"\nlower = 18.0\nupper = 22.0')))
+    prob = set_up(st)
+    x = file_units(prob, np.array([[0.0], [prob.lower[0]], [prob.upper[0]]]))
+    np.testing.assert_allclose(x[:, 0], [20.0, 18.0, 22.0], rtol=1e-12)
+    assert math.isclose(float(prob.x0[0]), math.radians(20.0), rel_tol=1e-12)
+    srr = GOOD.replace('quantity = "power_loss_W"', 'quantity = "max_abs_srr"')
+    added = read_study(_write(tmp_path, srr))
+    assert [c.quantity for c in sweep_constraints(added)] == [
+        c.quantity for c in added.constraints if not c.added]
+    own = read_study(_write(tmp_path, srr + '\n[[constraints]]\nquantity = "min_margin_mm"\n'
+                                              'lower = 0.1\n'))
+    assert [(c.quantity, c.lower) for c in sweep_constraints(own)][-1] == ("min_margin_mm", 0.1)

@@ -98,7 +98,8 @@ def _run(study, sw, out, args) -> int:
 
     from gearjax.io import atomic_write, atomic_write_figure
     from gearjax.progress import Progress
-    from gearjax.studies.sweep import npz_columns, run_sweep, sample_points, set_up_sweep
+    from gearjax.studies.sweep import (npz_columns, run_sweep, sample_points, set_up_sweep,
+                                       steady_rate)
 
     with Progress(1, f"sweep {study.name}") as bar:
         with bar.phase("setting up the design"):
@@ -115,8 +116,7 @@ def _run(study, sw, out, args) -> int:
 
         with bar.phase("evaluating"):
             r = run_sweep(prob, U, chunk=sw["chunk"], progress=progress)
-    later = n - min(r.chunk, n)          # designs after the first chunk (compiled by then)
-    rate = later / (r.seconds - r.first_chunk_seconds) if later else None
+    rate = steady_rate(n, r.chunk, r.seconds, r.first_chunk_seconds)
     meta = {"study": study.name, "design": study.design, "method": sw["method"],
             "seed": sw["seed"], "chunk": r.chunk, "devices": r.devices, "designs": n,
             "seconds": r.seconds, "first_chunk_seconds": r.first_chunk_seconds,
@@ -147,6 +147,8 @@ def _run(study, sw, out, args) -> int:
 
 def _summary(study, r, meta) -> str:
     import numpy as np
+
+    from gearjax.studies.sweep import best_row
     rate = meta["designs_per_s"]
     lines = [f"sweep {study.name}: {meta['designs']} designs ({meta['method']}), "
              f"{r.devices} device(s), chunk {r.chunk}, {r.seconds:.1f} s (first chunk, with "
@@ -160,8 +162,8 @@ def _summary(study, r, meta) -> str:
         v = mean[r.ok, j]
         stats = (np.min(v), np.median(v), np.max(v)) if v.size else (np.nan,) * 3
         lines.append(f"{q:34s} {mean[0, j]:12.6g} " + " ".join(f"{s:12.6g}" for s in stats))
-    if np.any(r.feasible):
-        b = int(np.flatnonzero(r.feasible)[np.argmin(r.J[r.feasible])])
+    b = best_row(r.J, r.feasible)
+    if b is not None:
         lines += ["", f"best feasible design: row {b}, J {r.J[b]:.6g} (the design: "
                   f"{r.J[0]:.6g})"]
         for i, v in enumerate(study.variables):

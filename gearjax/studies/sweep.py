@@ -53,8 +53,9 @@ from gearjax.compile_ahead import FAST_COMPILE_OPTIONS
 from gearjax.studies.study_run import (Problem, combine, evaluator, scenario_flags,
                                        scenario_of, set_scales)
 
-__all__ = ["SweepResult", "set_up_sweep", "sample_points", "sweep_program", "run_sweep", "npz_columns",
-           "MAX_DESIGNS", "FLAG_KEYS"]
+__all__ = ["SweepResult", "set_up_sweep", "sample_points", "sweep_program", "run_sweep",
+           "npz_columns", "chunk_size", "steady_rate", "best_row", "file_units", "sweep_constraints", "MAX_DESIGNS",
+           "FLAG_KEYS"]
 
 #: most designs one sweep may ask for (a grid's points ** n_variables included)
 MAX_DESIGNS = 1_000_000
@@ -123,6 +124,41 @@ def _to_host(tree):
     return multihost_utils.process_allgather(tree, tiled=True)
 
 
+def chunk_size(chunk: int, n_devices: int) -> int:
+    """Rows per batch: ``chunk`` (at least 1) rounded up to a multiple of the device count
+    (every device gets the same number of rows)."""
+    return -(-max(int(chunk), 1) // n_devices) * n_devices
+
+
+def steady_rate(n: int, chunk: int, seconds: float, first_chunk_seconds: float):
+    """Designs per second after the first chunk (which carries the compilation), the
+    rate a long sweep sees; None when there is only one chunk."""
+    later = n - min(chunk, n)
+    return later / max(seconds - first_chunk_seconds, 1e-9) if later > 0 else None
+
+
+def best_row(J, feasible):
+    """Index of the feasible row of the smallest ``J`` (None when no row is feasible)."""
+    rows = np.flatnonzero(np.asarray(feasible, bool))
+    return int(rows[np.argmin(np.asarray(J)[rows])]) if rows.size else None
+
+
+def file_units(prob: Problem, U) -> np.ndarray:
+    """``(n, nv)`` the scaled points ``U`` as the study file writes the variables (the
+    field's units, or degrees for ``unit = "deg"``)."""
+    U = np.asarray(U, float)
+    scale = np.asarray(prob.data.scale)
+    return np.stack([(prob.x0[i] + scale[i] * U[:, i]) / v.factor
+                     for i, v in enumerate(prob.study.variables)], axis=1)
+
+
+def sweep_constraints(study) -> tuple:
+    """The study's constraints a sweep checks: all but the one the study adds for its
+    fixed mask (``min_margin_mm >= 0``, ``added``); a file's own margin constraint stays."""
+    return tuple(c for c in study.constraints
+                 if not (c.added and c.quantity == "min_margin_mm"))
+
+
 class SweepResult(NamedTuple):
     """What :func:`run_sweep` found; arrays have one row per design (row 0: the design's
     own point), ``S`` scenarios, the study's ``quantities`` in order."""
@@ -145,12 +181,10 @@ def run_sweep(prob: Problem, U, chunk: int = 16, devices=None, progress=None) ->
     """Evaluate the study ``prob`` (:func:`gearjax.studies.study_run.set_up`) at the
     scaled points ``U`` (:func:`sample_points`) in chunks (module docstring).
     ``progress(done, total)`` after each chunk (or None)."""
-    st = prob.study
     U = np.asarray(U, float)
     n = U.shape[0]
     prog, sharding, nd = sweep_program(prob, devices)
-    c = -(-max(int(chunk), 1) // nd) * nd
-    S = len(prob.scenarios)
+    c = chunk_size(chunk, nd)
     data = prob.data
     vals, flags, nval = [], {k: [] for k in FLAG_KEYS}, []
     t0 = time.time()
@@ -163,9 +197,9 @@ def run_sweep(prob: Problem, U, chunk: int = 16, devices=None, progress=None) ->
         # every process holds U: each gives the rows of its own devices
         chunk_u = jax.make_array_from_callback(rows.shape, sharding, lambda idx: rows[idx])
         Q, res, eff, _ = prog(chunk_u, data)
-        Q, res, nv = _to_host((Q, res, None if eff is None else eff.n_valid))
-        Q, res = Q[:k], jax.tree_util.tree_map(lambda v: v[:k], res)
-        eff_nv = None if nv is None else nv[:k]
+        # the padding rows dropped from every output at once
+        Q, res, eff_nv = jax.tree_util.tree_map(
+            lambda v: v[:k], _to_host((Q, res, None if eff is None else eff.n_valid)))
         for i in range(k):
             one = scenario_flags(prob, scenario_of(res, i), None)
             for key in FLAG_KEYS:
@@ -179,13 +213,11 @@ def run_sweep(prob: Problem, U, chunk: int = 16, devices=None, progress=None) ->
             progress(min(a + c, n), n)
     seconds = time.time() - t0
     values = np.concatenate(vals)
-    flags = {k: np.asarray(v, bool).reshape(n, S) for k, v in flags.items()}
+    flags = {k: np.asarray(v, bool) for k, v in flags.items()}       # (n, S): row, scenario
     ok = (np.all(flags["converged"] & ~flags["edge_contact"], axis=1)
           & np.all(np.isfinite(values), axis=(1, 2)))
     J, feasible = _objective_and_feasibility(prob, values, ok)
-    x = np.stack([(prob.x0[i] + np.asarray(prob.data.scale)[i] * U[:, i]) / v.factor
-                  for i, v in enumerate(st.variables)], axis=1)
-    return SweepResult(U, x, values, flags, np.concatenate(nval) if nval else None, ok,
+    return SweepResult(U, file_units(prob, U), values, flags, np.concatenate(nval) if nval else None, ok,
                        feasible, J, seconds, first, nd, c)
 
 
@@ -196,8 +228,8 @@ def _objective_and_feasibility(prob: Problem, values, ok):
     sweep's own on-flank points are on the flank by definition, and the smooth minimum
     lies below the true one by up to its ``T log n``."""
     st = prob.study
-    kept = tuple(c for c in st.constraints if not (c.added and c.quantity == "min_margin_mm"))
-    prob = dataclasses.replace(prob, study=dataclasses.replace(st, constraints=kept))
+    prob = dataclasses.replace(prob, study=dataclasses.replace(
+        st, constraints=sweep_constraints(st)))
     # the reduced study's quantities in its own order (combine reads them by position)
     values = values[:, :, [st.quantities.index(q) for q in prob.study.quantities]]
     try:
