@@ -865,6 +865,35 @@ def build_cases() -> list[Case]:
     add("sensitivity.plot_dir_missing", [*sens, "--outputs", "contact_ratio", "--params",
                                          "pair.x1", "--plot", "{tmp}/no/dir/t.png"], "refuse",
         "--plot into a missing directory: refused before any work")
+
+    # ---------------------------------------------------------------- sweep
+    sw = ["sweep", "example:spur_sliding"]
+    add("sweep.ok.small", [*sw, "--samples", "3", "--chunk", "2", "--out", "{tmp}/s",
+                           "--no-plot"], "ok", "a small random sweep, padded last chunk",
+        heavy=True)
+    add("sweep.no_study", ["sweep"], "refuse", "STUDY missing")
+    add("sweep.unknown_example", ["sweep", "example:nope"], "refuse", "unknown packaged study")
+    add("sweep.missing_file", ["sweep", "{tmp}/no_such_study.toml"], "refuse",
+        "study file missing")
+    for cid, flag, value, why in (
+            ("samples=0", "--samples", "0", "no design to sample"),
+            ("samples=abc", "--samples", "abc", "not an integer"),
+            ("points=1", "--points", "1", "a grid needs two values per variable"),
+            ("chunk=0", "--chunk", "0", "an empty batch"),
+            ("seed=-1", "--seed", "-1", "a negative seed"),
+            ("method=lhs", "--method", "lhs", "unknown method")):
+        add(f"sweep.{cid}", [*sw, flag, value], "refuse", why)
+    add("sweep.grid_too_large", [*sw, "--method", "grid", "--points", "1001"], "refuse",
+        "a grid of more than 1e6 designs: refused before any compilation")
+    add("sweep.out_is_a_file", [*sw, "--out", "{file}"], "refuse", "--out names a file",
+        setup=plain_file())
+    for cid, old, new, why in (
+            ("unknown_method", "[optimizer]", "[sweep]\nmethod = \"lhs\"\n\n[optimizer]",
+             "[sweep] method unknown"),
+            ("unknown_key", "[optimizer]", "[sweep]\nsize = 3\n\n[optimizer]",
+             "[sweep] unknown key")):
+        add(f"sweep.study.{cid}", ["sweep", "{study}", "--out", "{tmp}/s"], "refuse", why,
+            setup=study_file((old, new)))
     return cs
 
 

@@ -53,7 +53,7 @@ from gearjax.compile_ahead import FAST_COMPILE_OPTIONS
 from gearjax.studies.study_run import (Problem, combine, evaluator, scenario_flags,
                                        scenario_of, set_scales)
 
-__all__ = ["SweepResult", "set_up_sweep", "sample_points", "sweep_program", "run_sweep",
+__all__ = ["SweepResult", "set_up_sweep", "check_design_count", "sample_points", "sweep_program", "run_sweep",
            "npz_columns", "chunk_size", "steady_rate", "best_row", "file_units", "sweep_constraints", "MAX_DESIGNS",
            "FLAG_KEYS"]
 
@@ -73,28 +73,36 @@ def set_up_sweep(study) -> Problem:
                                                         "edge_softening_mm": 0.0}))
 
 
+def check_design_count(method: str, samples: int, points: int, n_variables: int) -> None:
+    """One-line ``ValueError`` when a sweep would ask for more than :data:`MAX_DESIGNS`
+    designs (a grid's ``points ** n_variables`` included) or names an unknown method."""
+    if method == "grid":
+        n = points ** n_variables
+        if n > MAX_DESIGNS:
+            raise ValueError(f"[sweep] points = {points}: {n} designs for {n_variables} "
+                             f"variables is more than {MAX_DESIGNS}")
+    elif method == "random":
+        if samples > MAX_DESIGNS:
+            raise ValueError(f"[sweep] samples = {samples} is more than {MAX_DESIGNS}")
+    else:
+        raise ValueError(f"[sweep] method = {method!r} must be one of 'random', 'grid'")
+
+
 def sample_points(lower, upper, method: str, *, samples: int = 64, points: int = 5,
                   seed: int = 0) -> np.ndarray:
     """``(n, nv)`` points in the box ``[lower, upper]`` (module docstring); row 0 is the
     origin (the design's own point; ``lower <= 0 <= upper``), then the sample."""
     lower, upper = np.asarray(lower, float), np.asarray(upper, float)
     nv = lower.size
+    check_design_count(method, samples, points, nv)
     if method == "grid":
-        n = points ** nv
-        if n > MAX_DESIGNS:
-            raise ValueError(f"[sweep] points = {points}: {n} designs for {nv} variables is "
-                             f"more than {MAX_DESIGNS}")
         axes = [np.linspace(lower[i], upper[i], points) for i in range(nv)]
         pts = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, nv)
-    elif method == "random":
-        if samples > MAX_DESIGNS:
-            raise ValueError(f"[sweep] samples = {samples} is more than {MAX_DESIGNS}")
+    else:                                              # "random"
         rng = np.random.default_rng(seed)
         strata = np.stack([rng.permutation(samples) for _ in range(nv)], axis=1)
         frac = (strata + rng.uniform(size=(samples, nv))) / samples
         pts = lower + frac * (upper - lower)
-    else:
-        raise ValueError(f"[sweep] method = {method!r} must be one of 'random', 'grid'")
     return np.vstack([np.zeros((1, nv)), pts])
 
 
