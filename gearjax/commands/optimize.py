@@ -25,7 +25,7 @@ import argparse
 import os
 import sys
 
-from gearjax.commands import warn_nonfinite
+from gearjax.commands import output_dir, warn_nonfinite
 
 HISTORY_KEYS_DOC = """JSON keys of NAME_history.json:
   study, description, design, family, side   the study's [study] table (design as given)
@@ -107,17 +107,6 @@ def _fields(study) -> int:
     return 0
 
 
-def _out_dir(args, name):
-    from gearjax.io import check_output_path
-    out = args.out or f"{name}_results"
-    if os.path.exists(out) and not os.path.isdir(out):
-        raise ValueError(f"--out = {out!r} exists and is not a directory")
-    os.makedirs(out, exist_ok=True)
-    for suffix in ("_optimised.toml", "_history.json", ".png"):
-        check_output_path(os.path.join(out, name + suffix), "--out")
-    return out
-
-
 def _fmt(v):
     return "-" if v is None else f"{v:.6g}"
 
@@ -174,7 +163,8 @@ def run(args) -> int:
     study = dataclasses.replace(study, **over)
     if args.fields:
         return _fields(study)
-    out = _out_dir(args, study.name)
+    out = output_dir(args.out or f"{study.name}_results", study.name,
+                     ("_optimised.toml", "_history.json", ".png"))
     return _run(study, out, args)
 
 

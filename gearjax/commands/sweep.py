@@ -80,18 +80,14 @@ def _settings(study, args) -> dict:
 
 
 def run(args) -> int:
-    from gearjax.io import check_output_path
+    from gearjax.commands import output_dir
     from gearjax.studies.study_file import read_study
     from gearjax.studies.sweep import check_design_count
     study = read_study(args.study)
     sw = _settings(study, args)
     check_design_count(sw["method"], sw["samples"], sw["points"], len(study.variables))
-    out = args.out or f"{study.name}_sweep"
-    if os.path.exists(out) and not os.path.isdir(out):
-        raise ValueError(f"--out = {out!r} exists and is not a directory")
-    os.makedirs(out, exist_ok=True)
-    for suffix in ("_sweep.npz", "_sweep.png"):
-        check_output_path(os.path.join(out, study.name + suffix), "--out")
+    out = output_dir(args.out or f"{study.name}_sweep", study.name,
+                     ("_sweep.npz", "_sweep.png"))
     return _run(study, sw, out, args)
 
 
