@@ -35,6 +35,13 @@ minimum wall time is reported (process start to exit, output discarded)::
     python benchmarks/bench_startup.py --wall
     python benchmarks/bench_startup.py --wall --repeat 3 --json wall.json
 
+``--wall-cached`` runs each command ``--repeat`` times (at least 2) sharing a new,
+empty cache directory: the first run cold, the others warm (programs read back from
+the program store, executables from the compilation cache), as a user's first and
+later runs::
+
+    python benchmarks/bench_startup.py --wall-cached --repeat 3
+
 Results of past runs: ``benchmarks/results/startup_wall.md``.
 
 Benchmarks are never tests.  Not for CI.
@@ -213,15 +220,20 @@ def child(job, cache_dir, tmp, count_binds):
 
 # ------------------------------------------------------------------------ parent side
 
-def wall(names, repeat):
+def wall(names, repeat, cached=False):
     """Minimum over ``repeat`` fresh processes of the wall time of each ``WALL`` job
-    (``GEARJAX_CACHE_DIR=off``); returns ``{name: [seconds of each run]}``."""
+    (``GEARJAX_CACHE_DIR=off``); returns ``{name: [seconds of each run]}``.  With
+    ``cached``: the processes of a job share a new, empty cache directory (compilation
+    cache and program store), the first run is the cold one, the rest are warm; the
+    line shows the first and the minimum of the rest."""
     env = dict(os.environ, GEARJAX_CACHE_DIR="off")
     # run outside any checkout: ``python -c`` puts the working directory first on
     # sys.path, so the package imported is the one the environment (PYTHONPATH) names
     cwd = tempfile.mkdtemp(prefix="gearjax-bench-wall-")
     out = {}
     for name in names:
+        if cached:
+            env["GEARJAX_CACHE_DIR"] = tempfile.mkdtemp(prefix="cache-", dir=cwd)
         argv = WALL[name]
         code = ("import gearjax" if argv is None else
                 "import sys; from gearjax.cli import main; sys.argv[0] = 'gearjax'; "
@@ -236,7 +248,12 @@ def wall(names, repeat):
                 raise RuntimeError(f"{name}: exit {p.returncode}: {p.stderr[-2000:]}")
         out[name] = times
         shown = " ".join(f"{x:.2f}" for x in times)
-        print(f"{name:16s} {min(times):7.2f}   (runs: {shown})", flush=True)
+        if cached:
+            warm = min(times[1:]) if len(times) > 1 else float("nan")
+            print(f"{name:16s} cold {times[0]:7.2f}  warm {warm:7.2f}   (runs: {shown})",
+                  flush=True)
+        else:
+            print(f"{name:16s} {min(times):7.2f}   (runs: {shown})", flush=True)
     shutil.rmtree(cwd, ignore_errors=True)
     import gearjax
     print(f"package: {os.path.dirname(gearjax.__file__)}")
@@ -263,6 +280,8 @@ def main(argv=None):
     ap.add_argument("--list", action="store_true")
     ap.add_argument("--wall", action="store_true",
                     help="whole-process wall times of the WALL commands, no compilation cache")
+    ap.add_argument("--wall-cached", action="store_true",
+                    help="as --wall, the runs of a command sharing a new cache: cold, then warm")
     ap.add_argument("--repeat", type=int, default=2, help="runs per --wall command (min shown)")
     ap.add_argument("--child", default=None, help=argparse.SUPPRESS)
     ap.add_argument("--cache", default=None, help=argparse.SUPPRESS)
@@ -277,14 +296,18 @@ def main(argv=None):
             cmd = 'python -c "import gearjax"' if a is None else "gearjax " + " ".join(a)
             print(f"{k:14s} --wall: {cmd}")
         return 0
-    if args.wall:
+    if args.wall or args.wall_cached:
         names = list(WALL) if args.jobs == ",".join(DEFAULT) else [
             j.strip() for j in args.jobs.split(",")]
         unknown = [j for j in names if j not in WALL]
         if unknown:
             ap.error(f"unknown --wall job(s) {unknown}; --list shows them")
-        print(f"seconds, min of {args.repeat} fresh processes, GEARJAX_CACHE_DIR=off")
-        res = wall(names, args.repeat)
+        if args.wall_cached:
+            print(f"seconds, {max(2, args.repeat)} fresh processes sharing a new cache")
+        else:
+            print(f"seconds, min of {args.repeat} fresh processes, GEARJAX_CACHE_DIR=off")
+        res = wall(names, max(2, args.repeat) if args.wall_cached else args.repeat,
+                   cached=args.wall_cached)
         if args.json:
             with open(args.json, "w") as fh:
                 json.dump(res, fh, indent=1)

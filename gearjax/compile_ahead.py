@@ -40,7 +40,9 @@ import threading
 
 import jax
 
-__all__ = ["CompileAhead", "prefetch", "first_time", "FAST_COMPILE_OPTIONS"]
+from gearjax import program_store
+
+__all__ = ["CompileAhead", "call", "prefetch", "first_time", "FAST_COMPILE_OPTIONS"]
 
 #: XLA options that trade run time for compile time on the CPU, for a program compiled
 #: once and run a few times (``jax.jit(f, compiler_options=FAST_COMPILE_OPTIONS)``; the
@@ -60,6 +62,10 @@ _POOL_LOCK = threading.Lock()
 _DONE: dict = {}
 #: the same key -> (abstract outputs, future) of a compilation not yet waited for
 _RUNNING: dict = {}
+#: (store directory, the same key) -> the program store's program (None: not stored)
+_STORED: dict = {}
+#: (store directory, the same key) -> (stored program, its executable compiled ahead)
+_COMPILED: dict = {}
 #: keys of the early starts made in this process (:func:`first_time`)
 _STARTED: set = set()
 
@@ -101,25 +107,62 @@ class CompileAhead:
         if key in _DONE:
             return _DONE[key]
         if key not in _RUNNING:             # (else: submitted by :func:`prefetch`)
-            traced = fun.trace(*args, **static)
-            _RUNNING[key] = traced.out_info, _pool().submit(traced.lower().compile)
-        out, future = _RUNNING[key]
-        self._pending.append((key, out, future))
+            prog = _stored(key, fun, args, static)
+            if prog is not None:            # the program store's: not traced again
+                traced, out = prog.trace(*args), prog.out_info
+            else:
+                traced = fun.trace(*args, **static)
+                out = traced.out_info
+            _RUNNING[key] = out, _pool().submit(traced.lower().compile), prog
+        out, future, prog = _RUNNING[key]
+        self._pending.append((key, out, future, prog))
         return out
 
     def __enter__(self):
         return self
 
     def __exit__(self, *exc):
-        for key, out, future in self._pending:
+        for key, out, future, prog in self._pending:
             _RUNNING.pop(key, None)
             try:
-                future.result()
+                compiled = future.result()
             except Exception:   # the concrete call compiles again and raises it
                 continue
             _DONE[key] = out
+            if prog is not None:
+                # the concrete call runs this executable: the stored program's results
+                # are placed on the device (committed), and a jitted call on them would
+                # compile once more for that placement
+                _COMPILED[(program_store.directory(), key)] = prog, compiled
         self._pending = []
         return False
+
+
+def _stored(key, fun, args, static):
+    """The stored program of ``key`` (:mod:`gearjax.program_store`; read or exported
+    once per process), or None when the store is off or the program not storable."""
+    k = (program_store.directory(), key)
+    if k not in _STORED:
+        _STORED[k] = program_store.stored_program(fun, args, static)
+    return _STORED[k]
+
+
+def call(fun, *args, **static):
+    """``fun(*args, **static)`` for a concrete run: by the program store's program
+    when the store is on (:mod:`gearjax.program_store`: not traced again), else the
+    jitted ``fun`` itself.  Inside a trace (an argument is a tracer): ``fun``."""
+    if program_store.directory() is None:
+        return fun(*args, **static)
+    sig = _signature(args, static)
+    if sig is None:
+        return fun(*args, **static)
+    key = (fun, sig)
+    done = _COMPILED.get((program_store.directory(), key))
+    if done is not None:
+        prog, compiled = done
+        return jax.tree.unflatten(prog.out_tree, compiled(*jax.tree.leaves(args)))
+    prog = _stored(key, fun, args, static)
+    return prog(*args) if prog is not None else fun(*args, **static)
 
 
 def prefetch(fun, *args, **static):

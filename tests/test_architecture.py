@@ -12,7 +12,7 @@ import gearjax
 PKG = Path(gearjax.__file__).resolve().parent
 BACKBONE = {"frames", "newton", "surfaces", "kinematics", "tca", "contact", "loading",
             "optimize", "augmented_lagrangian", "io", "errors", "progress", "fields",
-            "compile_ahead"}
+            "compile_ahead", "program_store"}
 #: the loaded chain (loading/) stands on tribology/; the rest of the backbone below it
 ABOVE_TRIBOLOGY = {"loading"}
 
@@ -103,7 +103,8 @@ def test_commands_use_the_public_api_and_boundary_helpers():
     import importlib
 
     allowed = ("gearjax.errors", "gearjax.io", "gearjax.progress", "gearjax.plot",
-               "gearjax.tribology", "gearjax.studies", "gearjax.commands")
+               "gearjax.tribology", "gearjax.studies", "gearjax.commands",
+               "gearjax.program_store")
     # namespaces: only the names they list
     namespaces = ("gearjax", "gearjax.hypoid", "gearjax.involute", "gearjax.vh_catt",
                   "gearjax.preset_bevel", "gearjax.loading", "gearjax.tca")

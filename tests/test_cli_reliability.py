@@ -395,6 +395,33 @@ def test_cache_switched_off(tmp_path, monkeypatch):
     assert cli._cache_dir() == str(tmp_path)
 
 
+@pytest.mark.parametrize("switch", [None, "0", "off"])
+def test_program_store_beside_the_cache(tmp_path, monkeypatch, switch):
+    """The command line keeps its traced programs in ``programs/`` of its cache
+    directory (gearjax/program_store.py) unless ``GEARJAX_PROGRAM_STORE`` is off; no
+    store without the cache."""
+    import jax
+    from gearjax import cli, program_store
+
+    monkeypatch.setattr(jax.config, "update", lambda *a: None)   # not this process's cache
+    monkeypatch.setattr(cli, "_install_cache_repair", lambda path: None)
+    monkeypatch.setattr(program_store, "_DIR", None)
+    if switch is None:
+        monkeypatch.delenv("GEARJAX_PROGRAM_STORE", raising=False)
+    else:
+        monkeypatch.setenv("GEARJAX_PROGRAM_STORE", switch)
+    monkeypatch.setenv("GEARJAX_CACHE_DIR", str(tmp_path / "c"))
+    cli._enable_compilation_cache()
+    want = None if switch else tmp_path / "c" / "programs"
+    assert program_store.directory() == want
+    if want is not None:
+        assert want.is_dir()
+    monkeypatch.setattr(program_store, "_DIR", None)
+    monkeypatch.setenv("GEARJAX_CACHE_DIR", "off")
+    cli._enable_compilation_cache()
+    assert program_store.directory() is None
+
+
 # ------------------------------------------------------------ failed TCA side
 
 

@@ -65,6 +65,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from gearjax.compile_ahead import call
 from gearjax.errors import check_range
 from gearjax.loading.efficiency_inputs import (RPM_RANGE, TORQUE_RANGE_NM, check_models,
                                                check_efficiency_inputs, check_operating_point)
@@ -502,7 +503,7 @@ def mesh_efficiency(design, torque_Nm, pinion_rpm, oil: Oil, surface: Surface, *
     # the loads' program compiles beside the TCA's (gearjax/compile_ahead.py)
     res = ad.run(run_design, misalignment, **kw, **opts, kinematics=True, throw=throw,
                  also=lambda ahead, r: ahead.submit(_post_jit, r, *args, **static))
-    eff = _post_jit(res, *args, **static)
+    eff = call(_post_jit, res, *args, **static)
     return eff, res
 
 

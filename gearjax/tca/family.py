@@ -42,7 +42,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax.compile_ahead import CompileAhead, first_time, prefetch
+from gearjax.compile_ahead import CompileAhead, call, first_time, prefetch
 from gearjax.tca.edge_contact import face_end_contact
 from gearjax.tca.multi_pair import multi_pair
 from gearjax.tca.path import (DEFAULT_APPROACH, check_on_flank_converged, check_tca_options,
@@ -78,6 +78,12 @@ class GearFamily:
     #: one-line refusal of the other mode
     line_contact_modes: tuple = (False,)
     contact_mode_reason: str = ""
+
+    @property
+    def program_key(self) -> str:
+        """The family's key in the program store (gearjax/program_store.py): its class
+        (a family object is stateless: the class is all that shapes its programs)."""
+        return f"{type(self).__module__}.{type(self).__qualname__}"
 
     # -- concrete set-up ------------------------------------------------------------
     def pair(self, design):
@@ -357,8 +363,8 @@ def _result(fam, pair, mis, x_ref, phi1_ref, approach, side, static, also=None) 
         surface = tca_surface(fam, pair, mis, x_ref, phi1_ref, drive, approach, **s1)
         parts = tca_finish(fam, pair, mis, drive, surface, **s2)
         return TCAResult(*parts, side, fam.name)
-    surface = _surface_program(*a1, fam=fam, **s1)
-    parts = _finish_program(blank, extra, mis, drive, surface, fam=fam, **s2)
+    surface = call(_surface_program, *a1, fam=fam, **s1)
+    parts = call(_finish_program, blank, extra, mis, drive, surface, fam=fam, **s2)
     return TCAResult(*parts, side, fam.name)
 
 

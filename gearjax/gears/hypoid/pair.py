@@ -61,7 +61,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax.compile_ahead import CompileAhead, first_time, prefetch
+from gearjax.compile_ahead import CompileAhead, call, first_time, prefetch
 from gearjax.fields import float64_array, floats_for_ints
 from gearjax.frames import matrix_x
 from gearjax.gears.hypoid.cutter import FaceMillCutter
@@ -270,7 +270,7 @@ def mean_point(fl: FlankSpec, crossing):
     """Mean point of a flank (concrete): ``uv = (theta, s)`` at mid face, half-way along
     the blade to the tip, its body-frame point (origin at the crossing point) and the
     outward normal (out of the tooth material; one envelope solve for both)."""
-    uv, r, n = _mean_point(fl, jnp.asarray(crossing, float))
+    uv, r, n = call(_mean_point, fl, jnp.asarray(crossing, float))
     q = np.asarray(r) - np.array([0.0, 0.0, float(crossing)])
     return np.asarray(uv), q, np.asarray(n)
 
