@@ -5,8 +5,10 @@ kinematics at the contact points, load sharing at every position, friction at ev
 (position, pair) and the losses.  The gradient = ``jax.grad`` of the mean efficiency
 with respect to every pinion and gear machine setting and cutter parameter, the four
 misalignments, torque, speed, viscosity and roughness (reverse mode, one backward
-pass).  Prints a table: compile and run time of each, and the ratio gradient /
-forward measured in the same process.
+pass).  Prints a table: compile time (trace, lower and compile) and run time of
+each, XLA's memory account of each compiled program (peak = arguments + outputs +
+temporaries, benchmarks/program_memory.py), and the ratio gradient / forward measured
+in the same process.
 
     python benchmarks/bench_efficiency.py [--design hypoid_iso_10x41_synthesised] [--repeats 5]
                                           [--fast-compile]
@@ -31,6 +33,7 @@ import numpy as np
 
 import gearjax as gj
 from gearjax.loading.mesh_efficiency import efficiency_function
+from program_memory import memory_cell, peak_rss_mb, program_memory
 
 
 def main():
@@ -67,23 +70,25 @@ def main():
     for label, fn in routes:
         jax.clear_caches()
         t = time.perf_counter()
-        jax.block_until_ready(fn(*a))
+        compiled = fn.trace(*a).lower().compile()      # trace, lower, compile
         tc = time.perf_counter() - t
+        jax.block_until_ready(compiled(*a))
         ts = []
         for _ in range(args.repeats):
             t = time.perf_counter()
-            jax.block_until_ready(fn(*a))
+            jax.block_until_ready(compiled(*a))
             ts.append(time.perf_counter() - t)
-        rows.append((label, tc, min(ts)))
+        rows.append((label, tc, min(ts), program_memory(compiled)))
     eff, res = f(f.pair, *a[2:4], oil, surf)
     K, M = eff.loaded.load.shape
     n_loaded = int(np.sum(np.asarray(eff.loaded.load) > 0))
     print(f"gearjax mesh-efficiency benchmark ({jax.default_backend()}, {args.design}: "
           f"{res.path.phi1.shape[0]} TCA grid points, {M} positions x {K} pairs, "
           f"{n_loaded} loaded contacts)")
-    print(f"{'route':40s} {'compile (s)':>12s} {'call (s)':>10s}")
-    for label, tc, t in rows:
-        print(f"{label:40s} {tc:12.1f} {t:10.4f}")
+    print(f"{'route':40s} {'compile (s)':>12s} {'call (s)':>10s} {'peak MB (temp)':>16s}")
+    for label, tc, t, mem in rows:
+        print(f"{label:40s} {tc:12.1f} {t:10.4f} {memory_cell(mem):>16s}")
+    print(f"process peak RSS {peak_rss_mb():.0f} MB (compilers included)")
     print(f"gradient / forward cost: {rows[1][2] / rows[0][2]:.2f}")
     if args.fast_compile:
         print(f"with FAST_COMPILE_OPTIONS: gradient compile {rows[1][1] / rows[3][1]:.2f}x "

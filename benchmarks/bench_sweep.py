@@ -17,6 +17,7 @@ Usage::
     python benchmarks/bench_sweep.py --devices 1,2 --samples 127 --chunk 32
     python benchmarks/bench_sweep.py --study example:spur_efficiency  # the loaded chain
     python benchmarks/bench_sweep.py --gpu                             # the GPUs as they are
+    python benchmarks/bench_sweep.py --memory 8,16,64     # the program's memory by chunk
 
 Results of past runs: ``benchmarks/results/sweep.md``.  Benchmarks are never tests.
 """
@@ -59,6 +60,27 @@ def one(study, samples, chunk, devices, gpu) -> dict:
         return dict(meta, wall_s=wall, values=d["values"])
 
 
+def memory_by_chunk(study, chunks) -> list:
+    """``[(chunk, program_memory)]``: XLA's memory account of the sweep's program
+    (one device, this process) at each chunk size -- what a sweep holds at once, which
+    must not depend on how many designs it evaluates."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import jax
+    from program_memory import program_memory
+
+    from gearjax.studies.study_file import read_study
+    from gearjax.studies.sweep import set_up_sweep, sweep_program
+
+    prob = set_up_sweep(read_study(study))
+    prog, _, _ = sweep_program(prob, jax.devices()[:1])
+    n = len(prob.x0)
+    out = []
+    for c in chunks:
+        U = jax.ShapeDtypeStruct((c, n), np.float64)
+        out.append((c, program_memory(prog.trace(U, prob.data).lower().compile())))
+    return out
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--study", default="example:spur_sliding")
@@ -66,7 +88,17 @@ def main(argv=None):
     ap.add_argument("--samples", type=int, default=63)
     ap.add_argument("--chunk", type=int, default=16)
     ap.add_argument("--gpu", action="store_true", help="use the GPUs as they are")
+    ap.add_argument("--memory", default=None,
+                    help="chunk sizes (e.g. 8,16,64): XLA's memory account of the sweep "
+                         "program at each, instead of the timings")
     args = ap.parse_args(argv)
+    if args.memory:
+        print(f"{args.study}: the sweep program's memory (MB) by chunk, one device")
+        print("| chunk | arguments | outputs | temporaries | peak |")
+        print("|---:|---:|---:|---:|---:|")
+        for c, m in memory_by_chunk(args.study, [int(c) for c in args.memory.split(",")]):
+            print(f"| {c} | {m['args']:.3f} | {m['out']:.3f} | {m['temp']:.2f} | {m['peak']:.2f} |")
+        return
     counts = [0] if args.gpu else [int(c) for c in args.devices.split(",")]
     rows, ref = [], None
     for d in counts:

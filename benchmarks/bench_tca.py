@@ -1,7 +1,8 @@
 """Benchmark: 61-position, 3-pair TCA (gearjax, jitted scan of implicit Newton solves)
 against SciPy ``fsolve`` loops over the same contact equations, and the cost of one
 full TCA gradient (jacfwd of the TCA summary with respect to the four misalignments
-and all design fields) against the forward run.
+and all design fields) against the forward run; XLA's memory account of the traced
+TCA and of its gradient (benchmarks/program_memory.py).
 
 Pair: 25/41 spur, m 2, 20 deg, pinion with profile crown 0.002/mm and lead crown
 0.001/mm (point contact, 5x5 system).  Three comparisons, each of the same work:
@@ -33,6 +34,7 @@ import numpy as np
 from scipy.optimize import fsolve
 
 import gearjax as gj
+from program_memory import memory_cell, peak_rss_mb, program_memory
 from gearjax.gears.involute.geometry import InvolutePair, generated_flank
 from gearjax.tca.corners import CORNER_GIVE_UP, corner_end
 from gearjax.tca.edge_contact import EDGE_NAMES, edge_contact_system, face_end_contact
@@ -228,6 +230,9 @@ def main():
     t0 = time.perf_counter()
     jax.block_until_ready(grad(des, mis))
     t_grad_first = time.perf_counter() - t0
+    # XLA's memory account of the traced TCA and of its gradient (one program each)
+    mem_fwd = program_memory(jax.jit(summary).trace(des, mis).lower().compile())
+    mem_grad = program_memory(grad.trace(des, mis).lower().compile())
     t_grad = _best(lambda: grad(des, mis), repeat=10)
 
     print(f"{'task':58s} {'time':>10s}")
@@ -248,6 +253,8 @@ def main():
           f"TE p-t-p {float(multi.ptp) / ARCSEC:.4f} arcsec")
     print(f"edge candidates: {n_valid} valid edge contacts in gearjax, max |TE(SciPy) - "
           f"TE(gearjax)| over {int(both.sum())} solved by both: {dte_edges / ARCSEC:.2e} arcsec")
+    print(f"memory, MB peak (temporaries): traced TCA {memory_cell(mem_fwd)}, its gradient "
+          f"{memory_cell(mem_grad)}; process peak RSS {peak_rss_mb():.0f} MB")
 
 
 if __name__ == "__main__":

@@ -95,18 +95,24 @@ def directory() -> Path | None:
 
 
 def source_digest() -> str:
-    """SHA-256 of gearjax's source files (their paths relative to the package and their
-    bytes), computed once per process."""
+    """SHA-256 of gearjax's source files (:func:`tree_digest` of the package), computed
+    once per process."""
     global _DIGEST
     if _DIGEST is None:
-        root = Path(__file__).resolve().parent
-        h = hashlib.sha256()
-        for f in sorted(root.rglob("*.py")):
-            h.update(f.relative_to(root).as_posix().encode())
-            h.update(b"\0")
-            h.update(f.read_bytes())
-        _DIGEST = h.hexdigest()
+        _DIGEST = tree_digest(Path(__file__).resolve().parent)
     return _DIGEST
+
+
+def tree_digest(root: Path) -> str:
+    """SHA-256 of the ``*.py`` files under ``root``: their paths relative to it and their
+    bytes."""
+    h = hashlib.sha256()
+    for f in sorted(root.rglob("*.py")):
+        h.update(f.relative_to(root).as_posix().encode())
+        h.update(b"\0")
+        h.update(f.read_bytes())
+        h.update(b"\0")
+    return h.hexdigest()
 
 
 def static_key(v) -> str:

@@ -183,3 +183,91 @@ def test_submit_then_call_compiles_once(store, compile_log):
     np.testing.assert_array_equal(np.asarray(got.y), 5.0 * np.arange(4.0))
     assert ps.STATS["written"] == 1 and ps.STATS["loaded"] == 0
     assert len(ca._STORED) == 1
+
+
+@jax.jit
+def _mixed(x, y):
+    return x * y
+
+
+def test_weak_and_strong_arguments_are_two_programs(store, monkeypatch):
+    """A Python float and a float64 array promote differently against float32: one
+    program for each (a key without the weak type would run the first for both and
+    return float32 where float64 is due)."""
+    y = jnp.ones(3, jnp.float32)
+    weak = call(_mixed, 2.0, y)
+    _new_process(monkeypatch)
+    strong = call(_mixed, jnp.float64(2.0), y)
+    assert weak.dtype == jnp.float32 and strong.dtype == jnp.float64
+    assert ps.STATS["written"] == 2 and len(list(store.glob("*.prog"))) == 2
+
+
+def test_source_digest_reads_the_contents(tmp_path):
+    """An edit that keeps every file name changes the digest (a stored program made by
+    the old code is never read by the new); so does a new file."""
+    root = tmp_path / "pkg"
+    (root / "sub").mkdir(parents=True)
+    (root / "a.py").write_text("X = 1\n")
+    (root / "sub" / "b.py").write_text("Y = 2\n")
+    d0 = ps.tree_digest(root)
+    assert ps.tree_digest(root) == d0
+    (root / "a.py").write_text("X = 2\n")
+    d1 = ps.tree_digest(root)
+    (root / "c.py").write_text("")
+    assert len({d0, d1, ps.tree_digest(root)}) == 3
+    assert len(ps.source_digest()) == 64
+
+
+def test_failed_write_leaves_the_old_file(store, monkeypatch):
+    """A write that fails part-way (disk full) leaves the file that was there whole and
+    readable, and no temporary file behind."""
+    x = jnp.arange(3.0)
+    call(_scaled, x, 2.0)
+    (f,) = store.glob("*.prog")
+    good = f.read_bytes()
+    real_fdopen = ps.os.fdopen
+
+    class Half:
+        def __init__(self, fh):
+            self.fh = fh
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            self.fh.close()
+            return False
+
+        def write(self, data):
+            self.fh.write(data[:len(data) // 2])
+            raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(ps.os, "fdopen", lambda fd, mode: Half(real_fdopen(fd, mode)))
+    ps._write(f, b"another program", None)
+    assert f.read_bytes() == good and not list(store.glob(".tmp-*"))
+
+
+def test_unreadable_file_deleted_on_read(store):
+    f = store / "scaled-0.prog"
+    f.write_bytes(ps._MAGIC + b"\x80\x04 truncated")
+    assert ps._read(f) is None
+    assert not f.exists() and ps.STATS["dropped"] == 1
+    assert ps._read(store / "missing.prog") is None and ps.STATS["dropped"] == 1
+
+
+def test_pruning_keeps_the_newest(store, monkeypatch):
+    """Full store: the oldest files go, the one just written stays and is read."""
+    import os
+    monkeypatch.setattr(ps, "MAX_FILES", 2)
+    for n in (1, 2):
+        call(_scaled, jnp.ones(n), 1.0)
+    for age, f in enumerate(sorted(store.glob("*.prog"))):
+        os.utime(f, (1e9 + age, 1e9 + age))          # long ago, the second a bit later
+    older = {f.name: f.stat().st_mtime for f in store.glob("*.prog")}
+    oldest = min(older, key=older.get)
+    call(_scaled, jnp.ones(3), 1.0)
+    names = {f.name for f in store.glob("*.prog")}
+    assert len(names) == 2 and oldest not in names
+    _new_process(monkeypatch)
+    call(_scaled, jnp.ones(3), 1.0)
+    assert ps.STATS["loaded"] == 1
