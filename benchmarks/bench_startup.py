@@ -62,6 +62,7 @@ import time
 
 HYPOID = "example:hft_8x43"
 HYPOID_TCA = "example:hft_8x43_synthesised"   # localised bearing (the raw 8/43 set is not)
+EFF_DESIGN = "example:hypoid_iso_10x41_synthesised"   # the packaged hypoid study's design
 
 # name -> (description, kind, argument): kind "cli" runs gearjax.cli.main(argv)
 JOBS = {
@@ -85,6 +86,8 @@ JOBS = {
     "tca-coast": ("run_tca hypoid drive, then coast (2nd side)", "py", "tca_coast"),
     "tca-grad": ("grad of TE p-t-p wrt pinion radial distance", "py", "tca_grad"),
     "synthesis": ("local synthesis (spiral bevel 10/30)", "py", "synthesis"),
+    "eff": ("efficiency program, hypoid 10/41 (jit of efficiency_function)", "py", "eff"),
+    "eff-grad": ("its gradient wrt every pair field (jit of grad)", "py", "eff_grad"),
 }
 DEFAULT = ["surface", "tca-hypoid", "tca-involute", "kinematics", "blank", "friction", "efficiency",
            "tca"]
@@ -139,6 +142,23 @@ def _py_job(name):
                 ms = replace(pair.pinion.machine, radial_distance=sr)
                 return f(replace(pair, pinion=replace(pair.pinion, machine=ms))).multi.ptp
             return float(jax.jit(jax.grad(ptp))(f.pair.pinion.machine.radial_distance))
+        return run
+    if name in ("eff", "eff_grad"):
+        from gearjax.loading.mesh_efficiency import efficiency_function
+
+        # the loaded chain of the packaged hypoid study (200 N m, 1000 rpm), with the
+        # command line's XLA options (one program each, as a study compiles them)
+        f = efficiency_function(load_design(EFF_DESIGN))
+        oil = gj.tribology.get_oil(gj.tribology.OILS[0])
+        surf = gj.tribology.make_surface(0.4)
+
+        def eta(pair):
+            return f(pair, 200.0, 1000.0, oil, surf)[0].mean_efficiency
+        fn = jax.jit(eta if name == "eff" else jax.grad(eta),
+                     compiler_options=gj.FAST_COMPILE_OPTIONS)
+
+        def run():
+            return float(jax.tree.leaves(fn(f.pair))[0])
         return run
     if name == "synthesis":
         from gearjax.gears.hypoid import synthesis as sy

@@ -117,8 +117,15 @@ def value_and_grad(fun: Callable, mode: str = "rev") -> Callable:
     if mode == "rev":
         return jax.value_and_grad(fun)
     if mode == "fwd":
+        def twice(x):
+            y = fun(x)
+            return y, y
+
         def vg(x):
-            return fun(x), jax.jacfwd(fun)(x)
+            # the value as the primal of the same forward-mode pass (one evaluation of
+            # ``fun``, not two)
+            g, y = jax.jacfwd(twice, has_aux=True)(x)
+            return y, g
         return vg
     raise ValueError(f"mode = {mode!r} must be 'rev' or 'fwd'")
 

@@ -71,7 +71,7 @@ from gearjax.errors import check_range, require_converged
 from gearjax.gears.hypoid import pitch_cones
 from gearjax.gears.hypoid.blank import BlankInput, blank_core
 from gearjax.kinematics import Mesh, eigen_kinematics
-from gearjax.newton import newton_solve
+from gearjax.newton import newton_solve, with_value
 from gearjax.surfaces import curvature_in_direction, local_geometry
 
 __all__ = ["STUDY_BLANK", "STUDY_CUTTERS", "study_blank_input", "StudySettings",
@@ -534,10 +534,9 @@ def statistics_gradient(inp: BlankInput, settings: StudySettings, flank: str = "
 
 def _sweep(inp, r0s, flank, shape):
     def one(r0):
-        st = StudySettings(r0, 0.0 * r0, 0.0 * r0)
-        val = study_statistics(inp, st, flank, shape)
-        der = jax.jacfwd(lambda x: study_statistics(inp, StudySettings(x, 0.0 * x, 0.0 * x),
-                                             flank, shape))(r0)
+        # the statistics and their derivatives from one forward-mode pass
+        der, val = jax.jacfwd(with_value(lambda x: study_statistics(
+            inp, StudySettings(x, 0.0 * x, 0.0 * x), flank, shape)), has_aux=True)(r0)
         return val, der
     return jax.vmap(one)(r0s)
 
