@@ -29,6 +29,7 @@ COMMANDS = [
     "gearjax.commands.optimize",
     "gearjax.commands.sensitivity",
     "gearjax.commands.sweep",
+    "gearjax.commands.warmup",
 ]
 
 

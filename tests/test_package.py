@@ -21,11 +21,13 @@ def test_pyproject_metadata():
     assert proj["name"] == "gearjax"
     assert proj["requires-python"] == ">=3.11"
     runtime = {re.split(r"[<>=!~ ;\[]", d, maxsplit=1)[0].lower() for d in proj["dependencies"]}
-    assert runtime == {"jax", "jaxopt", "optax", "numpy", "matplotlib"}
+    # flatbuffers: JAX's export format (gearjax/program_store.py)
+    assert runtime == {"jax", "jaxopt", "optax", "numpy", "matplotlib", "flatbuffers"}
     test = {re.split(r"[<>=!~ ;\[]", d, maxsplit=1)[0].lower()
             for d in proj["optional-dependencies"]["test"]}
     assert {"pytest", "pytest-xdist", "hypothesis", "scipy"} <= test
     assert proj["scripts"]["gearjax"] == "gearjax.cli:main"
+    assert proj["optional-dependencies"]["gpu"] == ["jax[cuda12]"]
 
 
 def test_console_script_is_installed():

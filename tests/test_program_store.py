@@ -271,3 +271,30 @@ def test_pruning_keeps_the_newest(store, monkeypatch):
     _new_process(monkeypatch)
     call(_scaled, jnp.ones(3), 1.0)
     assert ps.STATS["loaded"] == 1
+
+
+# ------------------------------------------------------------ gearjax warmup
+
+def test_warmup_runs_its_jobs_and_refuses_without_the_store(store, monkeypatch, capsys):
+    """``gearjax warmup`` runs each job's command in the process (its output kept back),
+    reports the programs stored and fails (exit 1, one warning a job) when a job fails;
+    without the store it is refused in one line; an unknown job is named."""
+    import gearjax.commands.warmup as wu
+    from gearjax.cli import main
+
+    monkeypatch.setattr(wu, "JOBS", {"list": ("examples", ["example", "list"]),
+                                     "bad": ("a missing design", ["tca", "example:nothing"])})
+    assert main(["warmup", "--jobs", "list"]) == 0
+    out, err = capsys.readouterr()
+    assert "warmed 1 of 1 jobs" in out and f"in {store}" in out
+    assert "hft_8x43" not in out                  # the job's own output is kept back
+    assert "[1/1] list" in err
+    assert main(["warmup"]) == 1
+    out, err = capsys.readouterr()
+    assert "warmed 1 of 2 jobs" in out
+    assert "gearjax: warning: warmup job failed: bad:" in err and "nothing" in err
+    assert main(["warmup", "--jobs", "list,tca"]) == 2
+    assert "unknown job 'tca'" in capsys.readouterr().err
+    ps.disable()
+    assert main(["warmup", "--jobs", "list"]) == 2
+    assert "needs the program store" in capsys.readouterr().err

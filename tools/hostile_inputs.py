@@ -894,6 +894,13 @@ def build_cases() -> list[Case]:
              "[sweep] unknown key")):
         add(f"sweep.study.{cid}", ["sweep", "{study}", "--out", "{tmp}/s"], "refuse", why,
             setup=study_file((old, new)))
+
+    # ---------------------------------------------------------------- warmup
+    add("warmup.ok.list", ["warmup", "--list"], "ok", "the jobs listed, nothing run")
+    add("warmup.unknown_job", ["warmup", "--jobs", "tca"], "refuse", "unknown job name")
+    add("warmup.empty_jobs", ["warmup", "--jobs", ""], "refuse", "no job named")
+    add("warmup.ok.one_job", ["warmup", "--jobs", "tca-involute"], "ok",
+        "one job: a spur TCA run in the process, its output kept back", heavy=True)
     return cs
 
 
