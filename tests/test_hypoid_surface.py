@@ -19,6 +19,7 @@ from gearjax.gears.hypoid.flank import (axial_coords, face_cone_gap, flank_point
                                   root_cone_gap, solve_point, solve_tip, spiral_angle_at,
                                   work_point, xi_of)
 from gearjax.gears.hypoid.design_file import load_design
+from gearjax.gears.hypoid.flank import program_pair
 
 FLANKS = [("pinion", "convex"), ("pinion", "concave"), ("gear", "convex"), ("gear", "concave")]
 NX, NS = 5, 4
@@ -446,3 +447,77 @@ def test_closed_form_tool_normal_equals_the_autodiff_normal():
                 np.testing.assert_allclose(g.r, with_n(uv), atol=1e-12)
                 n_checked += 1
     assert n_checked >= 12            # both generated flanks of three members, 2 points each
+
+
+# ------------------------------------------------------------ the grid's solves
+
+def _steps(fl, n_xi=21, n_s=11):
+    """Newton iterations of the tip scans and of the row solves of a grid."""
+    import gearjax.gears.hypoid.flank as F
+
+    xis = np.linspace(-1.0, 1.0, n_xi)
+    ts = jnp.asarray(np.linspace(1.0, 0.0, n_s))
+
+    @jax.jit
+    def go(fl):
+        tips, _ = F._tips(fl, xis)
+        s_min = F.fillet_start(fl.cutter)
+        rows = jax.vmap(lambda x, xi: F._row(fl, s_min, ts, x, xi))(tips.x, jnp.asarray(xis))
+        return tips.steps, rows[5], rows[4]
+    return [np.asarray(a) for a in go(program_pair(fl))]
+
+
+def test_grid_solves_take_three_newton_iterations(design):
+    """Each solve of the grid starts from the secant prediction of the last two points
+    of its scan, and the confirming iteration of a converged point takes no line
+    search: one correction, one to round-off, the confirmation -- 3 iterations a
+    point, 4 at most (docs/hypoid.md, "2026-11-29").  A predictor with a wrong sign or
+    a carry that is not shifted costs 3.5-4.5 on average; the points would not change,
+    only the time the grid takes (and every TCA on it)."""
+    tip_steps, row_steps, conv = _steps(design.flank("pinion", "convex"))
+    assert conv.all()
+    assert tip_steps.max() <= 4 and tip_steps.mean() <= 3.2, tip_steps
+    assert row_steps[:, 1:].max() <= 4 and row_steps.mean() <= 3.1, row_steps.mean()
+
+
+def test_solves_skip_the_line_search_on_the_confirming_step(design, monkeypatch):
+    import gearjax.gears.hypoid.flank as F
+
+    seen = []
+    real = F.newton_solve
+
+    def spy(*a, **kw):
+        seen.append(kw.get("noise_floor", False))
+        return real(*a, **kw)
+    monkeypatch.setattr(F, "newton_solve", spy)
+    fl = program_pair(design.flank("pinion", "convex"))
+    jax.eval_shape(lambda fl: F.solve_tip(fl, 0.0, F.mid_estimate(fl)), fl)
+    jax.eval_shape(lambda fl: F.solve_point(fl, 1.0, 0.0, jnp.zeros(2)), fl)
+    assert seen == [True, True]
+
+
+def test_a_failed_point_does_not_derail_its_row(design, monkeypatch):
+    """A solve that fails (NaN) in the middle of a row: the next solve starts from the
+    last converged point, and the rest of the row converges to the same points as
+    without the failure."""
+    import gearjax.gears.hypoid.flank as F
+
+    fl = program_pair(design.flank("pinion", "convex"))
+    ts = jnp.asarray(np.linspace(1.0, 0.0, 11))
+    tips, _ = F._tips(fl, np.array([0.0]))
+    s_min = F.fillet_start(fl.cutter)
+    x_tip = tips.x[0]
+    good = jax.jit(lambda fl: F._row(fl, s_min, ts, x_tip, 0.0))(fl)
+    s_bad = float(s_min + (x_tip[0] - s_min) * ts[4])
+    real = F.solve_point
+
+    def failing(fl, s, xi0, x0):
+        res = real(fl, s, xi0, x0)
+        bad = jnp.abs(s - s_bad) < 1e-9
+        return res._replace(x=jnp.where(bad, jnp.nan, res.x), converged=res.converged & ~bad)
+    monkeypatch.setattr(F, "solve_point", failing)
+    got = jax.jit(lambda fl: F._row(fl, s_min, ts, x_tip, 0.0))(fl)
+    conv = np.asarray(got[4])
+    assert not conv[4] and conv[:4].all() and conv[5:].all(), conv
+    np.testing.assert_allclose(np.asarray(got[0])[5:], np.asarray(good[0])[5:], rtol=0,
+                               atol=1e-9)

@@ -15,6 +15,7 @@ lost (a named tuple comes back as a list); the store used while it is off; the T
 through the store not bit-identical to the plain run.
 """
 
+from argparse import Namespace
 from typing import NamedTuple
 
 import jax
@@ -298,3 +299,35 @@ def test_warmup_runs_its_jobs_and_refuses_without_the_store(store, monkeypatch, 
     ps.disable()
     assert main(["warmup", "--jobs", "list"]) == 2
     assert "needs the program store" in capsys.readouterr().err
+
+
+def test_warmup_counts_new_programs_and_lists_without_running(store, monkeypatch, capsys):
+    """The report's "new" is what the run added (a second warmup that stores nothing
+    says 0 new); ``--list`` names every job and runs none."""
+    import gearjax.commands.warmup as wu
+    from gearjax import cli
+
+    for i in range(3):
+        (store / f"old-{i}.prog").write_bytes(b"")
+    made = []
+
+    def fake_main(argv):                      # a job that stores one program, once
+        if not made:
+            (store / "new-0.prog").write_bytes(b"")
+            made.append(argv)
+        return 0
+    monkeypatch.setattr(wu, "JOBS", {"one": ("a job", ["tca", "example:x"])})
+    monkeypatch.setattr(cli, "main", fake_main)
+    assert wu.run(Namespace(jobs="one", list=False)) == 0
+    assert "programs stored: 4 (1 new)" in capsys.readouterr().out
+    assert wu.run(Namespace(jobs="one", list=False)) == 0
+    assert "programs stored: 4 (0 new)" in capsys.readouterr().out
+
+    def no_run(argv):
+        raise AssertionError(f"--list ran {argv}")
+    monkeypatch.setattr(cli, "main", no_run)
+    monkeypatch.setattr(wu, "JOBS", {"a": ("first", ["tca", "x"]),
+                                     "b": ("second", ["efficiency", "y"])})
+    assert wu.run(Namespace(jobs="all", list=True)) == 0
+    out = capsys.readouterr().out
+    assert "a " in out and "first: gearjax tca x" in out and "second: gearjax efficiency y" in out

@@ -394,6 +394,41 @@ def _tip_scan(fl, xs, x_start):
     return out
 
 
+def _tips(fl: FlankSpec, xis):
+    """Tip points at the face-width positions ``xis`` (ascending; NumPy), by two scans
+    from mid face outwards: ``(NewtonResult batched over xis, converged with the mid
+    point)``."""
+    mid = solve_tip(fl, 0.0, mid_estimate(fl))
+    up = xis[xis >= 0.0]
+    down = xis[xis < 0.0][::-1]
+    tips = _tip_scan(fl, jnp.asarray(up), mid.x)
+    if down.size:
+        tips_dn = _tip_scan(fl, jnp.asarray(down), mid.x)
+        tips = jax.tree_util.tree_map(lambda a, b: jnp.concatenate([a[::-1], b]), tips_dn, tips)
+    return tips, tips.converged & mid.converged
+
+
+def _row(fl: FlankSpec, s_min, ts, tip_x, xi0):
+    """One row of the grid at ``xi0``, from its tip solution ``tip_x = (s_max, theta,
+    psi)`` down to ``s_min`` at the fractions ``ts`` (1 -> 0): ``(points, normals,
+    params, residual, converged, Newton steps)``, one entry per fraction."""
+    k = machine_chain(fl)
+    s_max = tip_x[0]
+
+    def step(carry, t):
+        x1, x2 = carry                # the last two solutions (equal at the tip)
+        s = s_min + (s_max - s_min) * t
+        # secant predictor along the row (equal steps in s): fewer Newton steps
+        res = solve_point(fl, s, xi0, 2.0 * x1 - x2)
+        nxt = jnp.where(res.converged, res.x, x1)
+        uv = jnp.stack([res.x[0], s])
+        r, n = chain_point(k, uv, res.x[1]), chain_normal(k, uv, res.x[1])
+        return (nxt, x1), (r, n, jnp.stack([s, res.x[0], res.x[1]]), res.residual,
+                           res.converged, res.steps)
+
+    return jax.lax.scan(step, (tip_x[1:], tip_x[1:]), ts)[1]
+
+
 def flank_points(fl: FlankSpec, n_xi: int = 21, n_s: int = 11) -> FlankGrid:
     """Flank grid by the algorithm of [HFT-hypoid] (pure and jit-friendly; no validation).
 
@@ -410,38 +445,11 @@ def flank_points(fl: FlankSpec, n_xi: int = 21, n_s: int = 11) -> FlankGrid:
     tip solve both converged).
     """
     xis = np.linspace(-1.0, 1.0, int(n_xi))
-    ts = np.linspace(1.0, 0.0, int(n_s))          # tip -> root
-    mid = solve_tip(fl, 0.0, mid_estimate(fl))
-    up = xis[xis >= 0.0]
-    down = xis[xis < 0.0][::-1]
-    tips_up = _tip_scan(fl, jnp.asarray(up), mid.x)
-    if down.size:
-        tips_dn = _tip_scan(fl, jnp.asarray(down), mid.x)
-        tips = jax.tree_util.tree_map(lambda a, b: jnp.concatenate([a[::-1], b]), tips_dn, tips_up)
-    else:
-        tips = tips_up
-    tip_ok = tips.converged & mid.converged
+    ts = jnp.asarray(np.linspace(1.0, 0.0, int(n_s)))          # tip -> root
+    tips, tip_ok = _tips(fl, xis)
     s_min = fillet_start(fl.cutter)
-    k = machine_chain(fl)
-
-    def row(tip_x, xi0):
-        s_max = tip_x[0]
-
-        def step(carry, t):
-            x1, x2 = carry                # the last two solutions (equal at the tip)
-            s = s_min + (s_max - s_min) * t
-            # secant predictor along the row (equal steps in s): fewer Newton steps
-            res = solve_point(fl, s, xi0, 2.0 * x1 - x2)
-            nxt = jnp.where(res.converged, res.x, x1)
-            uv = jnp.stack([res.x[0], s])
-            r, n = chain_point(k, uv, res.x[1]), chain_normal(k, uv, res.x[1])
-            return (nxt, x1), (r, n, jnp.stack([s, res.x[0], res.x[1]]), res.residual,
-                               res.converged)
-
-        _, out = jax.lax.scan(step, (tip_x[1:], tip_x[1:]), jnp.asarray(ts))
-        return out
-
-    r, n, prm, res, conv = jax.vmap(row)(tips.x, jnp.asarray(xis))
+    r, n, prm, res, conv, _ = jax.vmap(lambda x, xi: _row(fl, s_min, ts, x, xi))(
+        tips.x, jnp.asarray(xis))
     flip = lambda a: a[:, ::-1]
     res = jnp.maximum(flip(res), tips.residual[:, None])
     conv = flip(conv) & tip_ok[:, None]
