@@ -21,6 +21,11 @@ Nothing changes in what is computed: the same jitted functions run on the same
 arguments (the TCA as two programs: bit-identical on 54 TCAs of every family, their
 sensitivity tables and two efficiencies).
 
+With the program store on (:mod:`gearjax.program_store`, the command line), a program
+is traced once per installation instead of once per process: :meth:`CompileAhead.submit`
+reads (or writes) the stored program and compiles that, and :func:`call` runs it with
+the executable compiled ahead.
+
 :func:`prefetch` starts a compilation without waiting (abstract arguments allowed),
 for a program a run needs only after other work; :data:`FAST_COMPILE_OPTIONS` are the
 command line's XLA options, for one program.

@@ -547,7 +547,7 @@ def _sensitivity_program(blank, extra, mis, x_ref, phi1_ref, approach, drive, *,
         parts = tca_parts(fam, pair, m, x_ref, phi1_ref, drive, approach, **static)
         return fam.summary(pair, TCAResult(*parts, "", fam.name))
     # the values as the primal of the same forward-mode pass: the TCA runs once, not
-    # twice (f(mis) beside jacfwd(f) was a second TCA in the program: 1.5x instead of
-    # 2.6x the forward run, benchmarks/bench_tca.py)
+    # twice (f(mis) beside jacfwd(f) was a second TCA in the program; the 10/30 spiral
+    # bevel's table 446 -> 251 ms, docs/tca.md)
     jac, vals = jax.jacfwd(with_value(f), has_aux=True)(mis)
     return vals, jac
