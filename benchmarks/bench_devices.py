@@ -35,10 +35,11 @@ import os
 import sys
 import time
 
-import numpy as np
 
-# benchmark the checkout this file belongs to, not an installed gearjax
+# benchmark the checkout this file belongs to, not an installed gearjax; the
+# benchmarks' own helpers (bench_friction's points)
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 
 def _best(fn, args, repeats):
@@ -99,12 +100,9 @@ def friction_kernel(n):
     from gearjax.tribology import get_oil, make_surface
     from gearjax.tribology.friction import friction_traced
 
-    rng = np.random.default_rng(0)
-    F = rng.uniform(200, 3000, n)
-    ue = rng.uniform(500, 20000, n)
-    us = ue * rng.uniform(0.0, 0.5, n)
-    Rx = rng.uniform(5, 30, n)
-    Ry = Rx * rng.uniform(2, 200, n)
+    from bench_friction import random_contacts
+
+    F, ue, us, Rx, Ry = random_contacts(n)
     oil, surf = get_oil("mineral_vg100"), make_surface(0.5)
     fn = jax.jit(lambda F, ue, us, Rx, Ry: friction_traced(F, ue, us, Rx, Ry, oil, surf,
                                                            226374.0).mu)

@@ -90,6 +90,18 @@ def numpy_mu(F, ue, us, Rx, Ry, Ep, eta0, z, tau0, sigma, dens, beta, fc, vslip)
     return fc * phi * math.tanh(us / vslip) + Ft / F
 
 
+def random_contacts(n: int, seed: int = 0):
+    """``(F, u_e, u_s, R_x, R_y)`` of ``n`` random contacts (N, mm/s, mm/s, mm, mm): the
+    benchmark's points (also benchmarks/bench_devices.py)."""
+    rng = np.random.default_rng(seed)
+    F = rng.uniform(200, 3000, n)
+    ue = rng.uniform(500, 20000, n)
+    us = ue * rng.uniform(0.0, 0.5, n)
+    Rx = rng.uniform(5, 30, n)
+    Ry = Rx * rng.uniform(2, 200, n)
+    return F, ue, us, Rx, Ry
+
+
 def _stage_times(timeit, cpu_times, args_j, oil, surf, Ep):
     """Each stage of the kernel jitted alone on the same points (its inputs precomputed)."""
     import jax
@@ -145,12 +157,7 @@ def main():
     from gearjax.tribology.friction import friction_traced
 
     n = args.points
-    rng = np.random.default_rng(0)
-    F = rng.uniform(200, 3000, n)
-    ue = rng.uniform(500, 20000, n)
-    us = ue * rng.uniform(0.0, 0.5, n)
-    Rx = rng.uniform(5, 30, n)
-    Ry = Rx * rng.uniform(2, 200, n)
+    F, ue, us, Rx, Ry = random_contacts(n)
     oil = get_oil("mineral_vg100")
     surf = make_surface(0.5)
     Ep = 226374.0
