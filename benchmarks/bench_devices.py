@@ -56,7 +56,7 @@ def _best(fn, args, repeats):
     return first, best
 
 
-def flank_kernel(n):
+def flank_kernel(n, device):
     """``(fn, args, units)``: n hypoid flank grids of 861 points."""
     import jax
     import jax.numpy as jnp
@@ -73,7 +73,7 @@ def flank_kernel(n):
     return jax.jit(jax.vmap(one)), (sr,), n * 41 * 21
 
 
-def tca_kernel(n):
+def tca_kernel(n, device):
     """``(fn, args, units)``: n TCAs of the crowned 25/41 spur pair."""
     import jax
     import jax.numpy as jnp
@@ -92,7 +92,7 @@ def tca_kernel(n):
     return jax.jit(jax.vmap(one)), (crowns,), n
 
 
-def friction_kernel(n):
+def friction_kernel(n, device):
     """``(fn, args, units)``: friction at n random contacts."""
     import jax
     import jax.numpy as jnp
@@ -122,6 +122,8 @@ def sweep_kernel(n, device):
     return (lambda U, data: prog(U, data)[0]), (U, prob.data), n
 
 
+#: name -> ``kernel(batch, device) -> (fn, args, units)`` (the sweep's program is laid
+#: out on the device itself; the others run where their arguments are)
 KERNELS = {"flank points/s": flank_kernel, "TCAs/s": tca_kernel,
            "friction points/s": friction_kernel, "sweep designs/s": sweep_kernel}
 
@@ -131,9 +133,7 @@ def measure(name, size, device, repeats):
     import jax
 
     with jax.default_device(device):
-        made = (sweep_kernel(size, device) if name == "sweep designs/s"
-                else KERNELS[name](size))
-        fn, args, units = made
+        fn, args, units = KERNELS[name](size, device)
         args = jax.device_put(args, device)
         first, best = _best(fn, args, repeats)
     return first, units / best

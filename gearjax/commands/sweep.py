@@ -21,7 +21,8 @@ import io
 import os
 import sys
 
-NPZ_KEYS_DOC = """Arrays of NAME_sweep.npz (numpy.load; one row per design, row 0 the design itself):
+NPZ_KEYS_DOC = """Arrays of NAME_sweep.npz (numpy.load; one row per design, row 0 the design
+itself):
   x                 (n, nv) the variables in the study file's units (order: variables)
   u                 (n, nv) the same, scaled as the optimiser sees them
   x:FIELD           (n,) one variable's column

@@ -53,9 +53,9 @@ from gearjax.compile_ahead import FAST_COMPILE_OPTIONS
 from gearjax.studies.study_run import (Problem, combine, evaluator, scenario_flags,
                                        scenario_of, set_scales)
 
-__all__ = ["SweepResult", "set_up_sweep", "check_design_count", "sample_points", "sweep_program", "run_sweep",
-           "npz_columns", "chunk_size", "steady_rate", "best_row", "file_units", "sweep_constraints", "MAX_DESIGNS",
-           "FLAG_KEYS"]
+__all__ = ["SweepResult", "set_up_sweep", "check_design_count", "sample_points",
+           "sweep_program", "run_sweep", "npz_columns", "chunk_size", "steady_rate", "best_row",
+           "file_units", "sweep_constraints", "MAX_DESIGNS", "FLAG_KEYS"]
 
 #: most designs one sweep may ask for (a grid's points ** n_variables included)
 MAX_DESIGNS = 1_000_000
@@ -225,8 +225,9 @@ def run_sweep(prob: Problem, U, chunk: int = 16, devices=None, progress=None) ->
     ok = (np.all(flags["converged"] & ~flags["edge_contact"], axis=1)
           & np.all(np.isfinite(values), axis=(1, 2)))
     J, feasible = _objective_and_feasibility(prob, values, ok)
-    return SweepResult(U, file_units(prob, U), values, flags, np.concatenate(nval) if nval else None, ok,
-                       feasible, J, seconds, first, nd, c)
+    n_valid = np.concatenate(nval) if nval else None
+    return SweepResult(U, file_units(prob, U), values, flags, n_valid, ok, feasible, J, seconds,
+                       first, nd, c)
 
 
 def _objective_and_feasibility(prob: Problem, values, ok):
