@@ -38,7 +38,8 @@ eps-active set ``A`` (variables within ``min(1e-3, |P(x - grad) - x|)`` of a bou
 gradient pushes outwards) takes a steepest-descent step; the free variables a Newton step
 ``B_FF d_F = -grad_F`` with a dense Powell-damped BFGS matrix ``B`` (Nocedal & Wright,
 Procedure 18.2; initial scaling ``y^T y / s^T y``; carried from one outer iteration to the
-next, which about halved the evaluations on the test problems).  The step follows the projection arc
+next, which about halved the evaluations on the test problems; reset to the scaled identity
+when a line search fails).  The step follows the projection arc
 ``x(a) = P(x + a d)``, ``a = 1`` first, backtracking by safeguarded quadratic interpolation
 until the Armijo condition ``L(x(a)) <= L(x) + 1e-4 grad^T (x(a) - x)`` holds.  Each
 inner evaluation is one ``jax.value_and_grad`` (forward + reverse) of ``L_rho`` (or, with
@@ -206,9 +207,11 @@ def _run(fun, max_outer, max_inner, callback, x0, lo, hi, tol, rho0, args,
         sel = lambda a, b: jax.tree_util.tree_map(lambda u, v: jnp.where(ok, u, v), a, b)  # noqa
         x, L, grad, f, g = sel((st["xe"], Le, gre, fe, ge),
                                (st["x"], st["L"], st["grad"], st["f"], st["g"]))
-        # the quasi-Newton matrix is kept from one outer iteration to the next
-        B = jnp.where(acc, Bn, st["B"])
-        fresh = jnp.where(acc, fresh_n, st["fresh"])
+        # the quasi-Newton matrix is kept from one outer iteration to the next, unless
+        # its direction failed the line search: then the next starts from a scaled
+        # steepest descent (else every later outer iteration repeats the failed step)
+        B = jnp.where(give_up, jnp.eye(n, dtype=dt), jnp.where(acc, Bn, st["B"]))
+        fresh = give_up | jnp.where(acc, fresh_n, st["fresh"])
         it = jnp.where(reset, 0, st["it"] + acc.astype(int))
         # -- the inner solve ends: converged to eps, out of steps or stuck -------------
         inner_done = ok & ((_pg(x, grad, lo, hi) <= st["eps"]) | (it >= max_inner)) | give_up

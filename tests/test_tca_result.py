@@ -95,6 +95,53 @@ def test_no_edge_contact_where_the_te_curves_coincide():
     assert _result(margin, te, inside, np.array([0.15, 0.5]), cr).flags()["edge_contact"]
 
 
+def _parabolic_pair(delta, offset, m=8, z1=10, w_pitches=0.55, a=4.9e-4):
+    """Pair 0 of a parabolic-TE design on a uniform grid of ``m`` steps a pitch shifted
+    by ``offset`` steps: TE_0 = -a (phi - delta)^2 (rad), on the flanks for
+    abs(phi) <= w (margin w - abs(phi)); pairs +-1 are pair 0 shifted by a pitch p."""
+    from gearjax.tca.path import multi_pair
+    p = 2 * np.pi / z1
+    n = 4 * m + 1
+    phi = (np.arange(n) - n // 2 + offset) * (p / m)
+    te = -a * (phi - delta) ** 2
+    margin = w_pitches * p - np.abs(phi)
+    base = _result(np.ones(N), np.zeros((3, N)), np.ones((3, N), bool), [0.0, 0.0], 1.0).path
+    z, z3 = jnp.zeros(n), jnp.zeros((n, 3))
+    path = ContactPath(jnp.asarray(phi), z, jnp.asarray(te), jnp.zeros((n, 2)),
+                       jnp.zeros((n, 2)), z3, z3, z3, z3, z, z, z, z, z + 1.0, z + 0.5, z3, z,
+                       jnp.ones(n, bool))
+    assert type(path) is type(base)
+    multi = multi_pair(path, jnp.asarray(margin), m, z1)
+    return TCAResult(path, jnp.asarray(margin), multi, {}, None, "drive", "test"), phi, p
+
+
+def test_edge_flag_does_not_depend_on_where_the_grid_falls():
+    """A parabolic TE design whose curves cross just inside the flank boundary (delta
+    0.03 p: crossing at 0.53 p, exit at 0.55 p) hands over smoothly; one whose crossing
+    lies beyond it (delta 0.08 p) runs off its flank while still ahead (edge contact).
+    The grid check alone cannot tell the first from the second wherever no grid point
+    lies between the crossing and the boundary; the flag must give the closed-form
+    verdict at every offset of the grid, and the continuous gap at the exit is the
+    closed form TE_0(w) - TE_0(w - p) = -a p (2 (w - delta) - p)."""
+    from gearjax.tca.multi_pair import transfer_gaps
+    a, w = 4.9e-4, 0.55
+    uncovered = 0
+    for frac, edge in ((0.03, False), (0.08, True)):
+        for offset in np.linspace(0.0, 1.0, 8, endpoint=False):
+            res, phi, p = _parabolic_pair(frac * 2 * np.pi / 10, offset)
+            delta = frac * p
+            gap_out = float(transfer_gaps(res.path, res.margin, res.multi)[1])
+            closed = -a * p * (2 * (w * p - delta) - p)
+            assert gap_out == pytest.approx(closed, rel=1e-9, abs=1e-15), (frac, offset)
+            assert float(res.multi.contact_ratio) == pytest.approx(2 * w, rel=1e-9)
+            f = res.flags()
+            assert f["edge_contact"] is edge, (frac, offset, gap_out / gj.ARCSEC)
+            assert not (f["face_end_contact"] or f["tip_contact"] or f["low_contact_ratio"])
+            cross = delta + p / 2
+            uncovered += (not edge) and not np.any((phi > cross) & (phi <= w * p))
+    assert uncovered >= 4        # the offsets where the grid alone would flag an edge
+
+
 def test_edge_contact_when_no_transfer_point_is_found():
     margin, te, inside, _, cr = _crossing_case()
     assert _result(margin, te, inside, np.array([np.nan, 0.5]), cr).flags()["edge_contact"]

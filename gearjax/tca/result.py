@@ -75,6 +75,7 @@ from gearjax.surfaces import local_geometry
 from gearjax.tca.path import (ARCSEC, ContactPath, MultiPair, contact_equations, contact_system,
                               relative_curvature)
 from gearjax.tca.assembly import Assembly, Misalignment, gear_mount
+from gearjax.tca.multi_pair import transfer_gaps
 
 __all__ = ["SIDES", "check_side", "check_design",
            "TCAResult", "ContactKinematics", "contact_kinematics",
@@ -98,6 +99,9 @@ def check_side(side) -> str:
 
 
 _SAME_TE = 1e-9   # rad (2e-4 arc-seconds): TE curves that coincide
+#: rad (0.01 arc-seconds): a transfer gap below minus this is a smooth hand-over
+#: (the TE curves cross inside the flanks; :func:`gearjax.tca.multi_pair.transfer_gaps`)
+_GAP_SMOOTH = 0.01 * ARCSEC
 
 #: arc-seconds: a TE peak-to-peak above this raises the ``large_te`` flag
 LARGE_TE_ARCSEC = 60.0
@@ -406,8 +410,14 @@ class TCAResult:
             two pairs cross -- the load is then carried at the edge of a tooth.  Pairs
             whose TE curves coincide (conjugate pairs) touch simultaneously and are
             not flagged, also where their overlap is shorter than a grid step
-            (contact ratio just above 1: the curves meet between grid points).
-            Also raised with ``face_end_contact``.
+            (contact ratio just above 1: the curves meet between grid points).  Where
+            the grid shows the leaving (entering) pair off its flank at the step after
+            (before) the transfer, the curves may still cross between its last grid
+            point on the flank and the boundary: then the continuous transfer gap
+            (:func:`~gearjax.tca.multi_pair.transfer_gaps`, the TE difference at the
+            boundary crossing, interpolated) decides, a gap below -0.01 arc-seconds
+            with a contact ratio >= 1 being a smooth hand-over, so the flag does not
+            depend on where the grid falls.  Also raised with ``face_end_contact``.
         face_end_contact : pair 0 carries the load (it is the active pair of the
             envelope) at a face end of a flank -- toe or heel of pinion or gear
             (``path.edge_kind``, :mod:`gearjax.tca.edge_contact`): the bearing has run
@@ -436,7 +446,9 @@ class TCAResult:
         phi = np.asarray(self.path.phi1)
         edge = False
         cr = float(self.multi.contact_ratio)
-        for t_phi, (a, b) in zip(np.asarray(self.multi.transfer_phi1), ((k0 - 1, k0), (k0, k0 + 1))):
+        gaps = None
+        for j, (t_phi, (a, b)) in enumerate(zip(np.asarray(self.multi.transfer_phi1),
+                                                ((k0 - 1, k0), (k0, k0 + 1)))):
             if not np.isfinite(t_phi):
                 edge = True
                 continue
@@ -455,7 +467,14 @@ class TCAResult:
                 handed = cr >= 1.0 and any(
                     inside[p, i] and inside[q, i + 1] and abs(te[p, i] - te[q, i + 1]) < _SAME_TE
                     for p, q in ((a, b), (b, a)))
-            edge = edge or not (crossing or bool(same.any()) or handed)
+            if not (crossing or bool(same.any()) or handed):
+                # on the grid one pair leaves its flank at the transfer: the curves may
+                # still cross between the last grid point on the flank and the boundary
+                # (a grid artefact); the continuous gap at the boundary decides
+                if gaps is None:
+                    gaps = np.asarray(jnp.stack(transfer_gaps(self.path, self.margin,
+                                                              self.multi)))
+                edge = edge or not (cr >= 1.0 and gaps[j] < -_GAP_SMOOTH)
         face_end = bool(self.face_ends_loaded())
         tip = bool(self.tips_loaded())
         cr = float(self.multi.contact_ratio)
