@@ -411,3 +411,49 @@ def test_mean_points_at_mid_face_and_the_gear_at_mid_depth(example):
             assert abs(xi) < 0.1, (side, xi)
         assert abs(above_root - below_tip) < 0.02 * (above_root + below_tip), (
             side, above_root, below_tip)
+
+
+def _sheet(surf, uv):
+    """Independent route to the sheet of a generated flank point: the sign of
+    (E_u x E_v) . n, E(uv) = family(uv, psi(uv)) with psi_uv = -f_uv/f_psi from the
+    meshing function f (Litvin & Fuentes, 2nd ed., §6.3); it changes sign at the edge
+    of regression."""
+    from gearjax.surfaces import _tool_at, meshing_function
+    psi = surf.solve(uv).x
+    P_uv, P_psi = jax.jacfwd(surf.family, argnums=(0, 1))(uv, psi)
+    f_uv, f_psi = jax.jacfwd(lambda a, b: meshing_function(surf.family, a, b, surf.normal),
+                             argnums=(0, 1))(uv, psi)
+    E = P_uv - jnp.outer(P_psi, f_uv / f_psi)
+    return float(jnp.dot(jnp.cross(E[:, 0], E[:, 1]), _tool_at(surf.family, uv, psi,
+                                                                 surf.normal)[1]))
+
+
+def test_edge_points_beyond_the_blade_tip_are_off_the_flank():
+    """The far corner (docs/tca.md, "A far corner branch"): on the kept
+    end design of a hypoid study, the pinion's tip/heel corner candidate converged at
+    uv = (theta, s) = (-0.7442, -3.9319) -- 3.9 mm beyond the blade tip, on the second
+    sheet of the generated flank (the sheet sign opposite to that of the reference
+    contact, by the independent Jacobian route above), yet on the tip (tip margin ~0),
+    at the heel (face margin ~0) and 11.6 mm above the fillet: every height and
+    face-width boundary held, and the TCA took it (TE p-t-p 2852 arcsec on the default
+    grid instead of 8.4).  The blade's own extent bounds the root side of an edge point
+    (margin s); a real flank point keeps its margins."""
+    from gearjax.gears.hypoid.pair import flank_function, hypoid_face_ends
+    from pathlib import Path
+    d = load_design(str(Path(__file__).resolve().parents[1] / "experiments" / "results"
+                        / "hypoid_far_corner" / "hypoid_far_corner.toml"))
+    pair = th.pair_flanks(d, "drive")
+    surf = flank_function(pair.pinion, pair.pinion_crossing)
+    parts = hypoid_face_ends(pair)[0]
+    far, ref = jnp.array([-0.7442, -3.9319]), jnp.array([-0.5971, 5.4383])
+    assert _sheet(surf, far) * _sheet(surf, ref) < 0
+    for uv, s_bounds in ((far, True), (ref, False)):
+        q = surf(uv)[None]
+        face, tip, root = (float(a[0]) for a in parts(q, q, uv[None], uv[None])[:3])
+        face_h, tip_h, root_h = (float(a[0]) for a in parts(q, q)[:3])   # heights only
+        assert (face, tip) == (face_h, tip_h)
+        if s_bounds:
+            assert abs(face) < 0.01 and abs(tip) < 0.01 and root_h > 10.0
+            assert root == pytest.approx(float(uv[1]), abs=1e-12)
+        else:
+            assert min(face, tip, root) > 3.0 and root == root_h

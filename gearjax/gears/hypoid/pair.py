@@ -326,10 +326,23 @@ def _member_margins(fl: FlankSpec, crossing, p_body):
     width ``F (1 - |xi|)/2`` and of its other boundaries (below the face cone, above the
     fillet); also ``xi`` and the height above the root cone."""
     xi, above_root, tip_gap = flank_coordinates(fl, crossing, p_body)
+    return (0.5 * fl.blank.face_width * (1.0 - jnp.abs(xi)),
+            jnp.minimum(tip_gap, _root_margin(fl, above_root)), xi, above_root)
+
+
+def _root_margin(fl: FlankSpec, above_root, s=None):
+    """Margin (mm) of the root side of a flank point: its height above the fillet
+    (``h - rho_f (1 - sin alpha)``), and, where the blade position ``s`` of the point is
+    given (mm along the blade from its tip), ``s`` itself.  A point of the cutter
+    surface continued beyond the blade tip (``s < 0``) is cut by no blade: the generated
+    pinion flank continued there folds back past its edge of regression over the real
+    flank at the same radii (a second sheet), inside every other boundary, and a tip or
+    corner candidate of the edge search can converge there (docs/tca.md, "A far corner
+    branch").  Applied to the edge candidates; the surface path keeps the height test
+    alone (its contacts are continued from the reference on the real sheet)."""
     c = fl.cutter
     h_fillet = c.edge_radius * (1.0 - jnp.sin(c.blade_angle))
-    return (0.5 * fl.blank.face_width * (1.0 - jnp.abs(xi)),
-            jnp.minimum(tip_gap, above_root - h_fillet), xi, above_root)
+    return above_root - h_fillet if s is None else jnp.minimum(above_root - h_fillet, s)
 
 
 def hypoid_face_ends(pair: HypoidPair):
@@ -340,16 +353,16 @@ def hypoid_face_ends(pair: HypoidPair):
     functions ``t(q)`` = the gap below the face cone (mm, zero on the face cone)."""
     members = ((pair.pinion, pair.pinion_crossing), (pair.gear, pair.gear_crossing))
 
-    def parts(fl, t, q):
+    def parts(fl, t, q, s):
         xi, above_root, tip_gap = flank_coordinates(fl, t, q)
-        c = fl.cutter
-        h_fillet = c.edge_radius * (1.0 - jnp.sin(c.blade_angle))
         return (0.5 * fl.blank.face_width * (1.0 - jnp.abs(xi)), tip_gap,
-                above_root - h_fillet)
+                _root_margin(fl, above_root, s))
 
     def margin_parts(q1, q2, uv1=None, uv2=None):
-        return (jax.vmap(lambda q: parts(*members[0], q))(q1)
-                + jax.vmap(lambda q: parts(*members[1], q))(q2))
+        # uv = (theta, s): the blade position s bounds the root side (_root_margin)
+        s1, s2 = (None if uv is None else uv[:, 1] for uv in (uv1, uv2))
+        return (jax.vmap(lambda q, s: parts(*members[0], q, s))(q1, s1)
+                + jax.vmap(lambda q, s: parts(*members[1], q, s))(q2, s2))
 
     def end(fl, t):
         def g(q, e):
