@@ -8,8 +8,8 @@ deviations in um), checks it against the design's reference grid, fits the error
 chosen settings by Levenberg-Marquardt with exact Jacobians, prints the before/after
 deviations, the fitted errors and corrections, the condition number and the settings
 that cannot be told apart (or, with ``--json``, the report as JSON), and writes the
-corrected design (``--out``) and the deviation maps (``--plot``).  Exit status 0; 2 for bad input (one
-line, before any work); 3 when the fit did not converge (the report says
+corrected design (``--out``) and the deviation maps (``--plot``).  Exit status 0; 2 for
+bad input (one line, before any work); 3 when the fit did not converge (the report says
 ``converged: false``; no design is written)."""
 
 from __future__ import annotations

@@ -4,8 +4,8 @@ The blank (ISO 23509 methods 0 and 1 and the tangent-cone route), the face-mill 
 and the cradle-type machine, the generated flanks, a pair of members, the design
 file (``[design] kind`` = ``hypoid``, ``spiral_bevel``, ...), local synthesis of the
 machine settings, the reference contact, corrective machine settings from a measured
-flank (:mod:`~gearjax.gears.hypoid.flank_correction`).  Its TCA runs through :func:`gearjax.run_tca`
-like every family.  docs/architecture.md lists the modules.
+flank (:mod:`~gearjax.gears.hypoid.flank_correction`).  Its TCA runs through
+:func:`gearjax.run_tca` like every family.  docs/architecture.md lists the modules.
 """
 
 from gearjax.gears.hypoid.blank import BlankInput, blank_geometry, blank_sensitivity
