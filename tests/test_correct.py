@@ -355,3 +355,29 @@ def test_cli_writes_the_corrected_design(sb, tmp_path, capsys):
     assert rms(after) < 0.05 * rms(clean) and rms(after) < 1.0
     # the gear's tables and the blank are untouched
     assert new.data["gear"] == sb.data["gear"] and new.data["blank"] == sb.data["blank"]
+
+
+def test_ease_off_target_reached_where_one_exists(sb):
+    """Item 4 (target ease-off): the ease-off of the spiral-bevel pinion with known
+    setting changes is the target; fitted from the shipped pinion, the settings come back
+    and the written design's ease-off, evaluated anew from its file, is the target."""
+    from gearjax.gears.hypoid import ease_off as eo
+    change = {"modified_roll_2c": 0.01, "ratio_of_roll": 0.001, "blade_angle": 0.05}
+    bent = _perturbed(sb, "pinion", {f"concave.{k}": v for k, v in change.items()})
+    settings = ["blade_angle", "ratio_of_roll", "modified_roll_2c", "modified_roll_6d",
+                "axis_rotation"]
+    target = eo.ease_off(eo.ease_off_problem(bent, "drive", settings=settings))
+    p0 = eo.ease_off_problem(sb, "drive", target, settings=settings)
+    e0 = eo.ease_off(p0)
+    i, j = 4, 2
+    assert abs(e0[i, j]) < 0.05 and abs(target[i, j]) < 0.05      # aligned at the middle
+    assert np.nanmax(np.abs(e0 - target)) > 5.0                     # a real change to make
+    res = eo.fit_ease_off(p0)
+    assert res.converged and np.nanmax(np.abs(res.after_um)) < 0.05
+    for k, v in change.items():
+        assert abs(res.correction[k] - v) < 0.02 * abs(v), (k, res.correction[k], v)
+    assert abs(res.correction["modified_roll_6d"]) < 1e-3
+    new = eo.ease_off_design(res)
+    assert new.data["pinion"]["convex"] == sb.data["pinion"]["convex"]
+    again = eo.ease_off(eo.ease_off_problem(new, "drive", settings=settings))
+    assert np.nanmax(np.abs(again - target)) < 0.05

@@ -46,7 +46,7 @@ def save_correction_plot(path, flanks, xi, height, before_um, after_um,
                     ax = axes[k, c]
                     m = ax.pcolormesh(np.asarray(xi), np.asarray(height), v.T, norm=norm,
                                       cmap=cmap, shading="nearest")
-                    rms = float(np.sqrt(np.mean(v ** 2)))
+                    rms = float(np.sqrt(np.nanmean(v ** 2)))
                     ax.set_title(f"{f}: {what}\nrms {rms:.2f} um")
                     if k == n_f - 1:
                         ax.set_xlabel("face width xi (toe -1, heel +1)")

@@ -77,7 +77,7 @@ from gearjax.newton import newton_solve
 __all__ = ["SETTINGS", "ROTATION", "DEFAULT_GENERATED", "DEFAULT_FORMATE", "INDISTINCT",
            "DEFAULT_REGULARISATION", "CorrectionProblem", "CorrectionResult",
            "line_deviations", "correction_problem", "model_deviations", "correct_flanks",
-           "corrected_design", "apply_settings"]
+           "corrected_design", "apply_settings", "problem_on_lines"]
 
 #: correctable setting -> (design-file table, unit at the boundary); angles in degrees
 SETTINGS = {
@@ -167,9 +167,11 @@ def line_deviations(fl, points, normals, params, rotation=0.0):
     return res.x[:, 3].reshape(shape), res.converged.reshape(shape)
 
 
-def _residual(x, aux, specs, M, rot, P, N, prm, d_mm, reg):
-    """Scaled residuals of the fit: ``(d - t(u)) / 1 um`` over every grid point of every
-    flank, then ``reg * x``; ``u``: ``delta_f = M_f x``, ``omega = rot . x``."""
+def _residual(x, aux, specs, M, rot, P, N, prm, d_mm, w, reg):
+    """Scaled residuals of the fit: ``w (d - t(u)) / 1 um`` over every grid point of every
+    flank (``w`` 1, or 0 for a line left out: its solve is not required to converge and
+    its value does not enter), then ``reg * x``; ``u``: ``delta_f = M_f x``, ``omega =
+    rot . x``."""
     delta = jnp.einsum("fkj,j->fk", M, x)
     omega = jnp.dot(rot, x)
 
@@ -177,8 +179,9 @@ def _residual(x, aux, specs, M, rot, P, N, prm, d_mm, reg):
         return line_deviations(apply_settings(fl, dl), P1, N1, p1, omega)
 
     t, conv = jax.vmap(one)(specs, delta, P, N, prm)
-    r = ((d_mm - t) / UM).reshape(-1)
-    return jnp.concatenate([r, reg * x]), aux, jnp.all(conv)
+    keep = w > 0.0
+    r = jnp.where(keep, w * (d_mm - t) / UM, 0.0).reshape(-1)
+    return jnp.concatenate([r, reg * x]), aux, jnp.all(conv | ~keep)
 
 
 @dataclass(frozen=True)
@@ -191,7 +194,9 @@ class CorrectionProblem:
     ``convex.radial_distance`` for one flank's own, ``axis_rotation``); index : their
     columns in the full unknown vector; M_unit (n_f, 13, K), rot_unit (K,): the maps
     from the full vector (internal units) to each flank's setting increments and the
-    rotation; specs : the flanks' FlankSpecs stacked (program pytree).
+    rotation; specs : the flanks' FlankSpecs stacked (program pytree); generated : the
+    member's structure; sign : the correction written is ``sign * delta``; weight :
+    (n_f, n_xi, n_s) 1/0, the points that enter the fit (None: all).
     """
 
     design: object
@@ -205,9 +210,23 @@ class CorrectionProblem:
     rot_unit: np.ndarray
     specs: object
     generated: bool
+    sign: float = -1.0
+    weight: object = None
+
+    @property
+    def mask(self) -> np.ndarray:
+        """(n_f, n_xi, n_s) bool: the grid points that enter the fit (all for a
+        measurement)."""
+        shape = np.shape(self.measured.deviation_um)
+        return np.ones(shape, bool) if self.weight is None else np.asarray(self.weight) > 0
 
     @property
     def n_points(self) -> int:
+        """The number of grid points that enter the fit."""
+        return int(np.sum(self.mask))
+
+    @property
+    def n_rows(self) -> int:
         return int(np.asarray(self.measured.deviation_um).size)
 
     def args(self, scale, deviation_um, reg):
@@ -216,7 +235,8 @@ class CorrectionProblem:
         st = lambda a: jnp.asarray(np.stack([np.asarray(getattr(x, a), float) for x in g]))
         return (self.specs, jnp.asarray(self.M_unit * scale[None, None, :]),
                 jnp.asarray(self.rot_unit * scale), st("points"), st("normals"), st("params"),
-                jnp.asarray(np.asarray(deviation_um, float) * UM), jnp.asarray(float(reg)))
+                jnp.asarray(np.nan_to_num(np.asarray(deviation_um, float)) * UM),
+                jnp.asarray(self.mask.astype(float)), jnp.asarray(float(reg)))
 
 
 def _choices(generated: bool):
@@ -260,6 +280,19 @@ def correction_problem(design, measured, settings=None) -> CorrectionProblem:
              for f in flanks}
     check_on_reference(measured, np.stack([np.asarray(grids[f].points) for f in flanks]),
                        np.stack([np.asarray(grids[f].normals) for f in flanks]))
+    return problem_on_lines(design, measured, grids, names, specs, generated)
+
+
+def problem_on_lines(design, measured, lines: dict, names, specs, generated: bool,
+                     sign: float = -1.0, weight=None) -> CorrectionProblem:
+    """:class:`CorrectionProblem` of the flanks ``specs`` (FlankSpecs, in the order of
+    ``measured.flanks``) along given lines: ``lines`` flank -> a
+    :class:`gearjax.io.FlankGrid` whose ``points``/``normals`` are the lines' origins and
+    directions and whose ``params`` start each line solve on the flank (no checks;
+    :func:`correction_problem` and the ease-off fit build on it).  ``sign``: the
+    correction written to the design is ``sign * delta`` (-1: cancel measured errors;
+    +1: produce a target); ``weight`` (n_f, n_xi, n_s) 1/0: the lines that enter."""
+    member, flanks = measured.member, tuple(measured.flanks)
     n_f, nk = len(flanks), len(FIELDS)
     K = n_f * nk + 1
     M = np.zeros((n_f, nk, K))
@@ -286,8 +319,9 @@ def correction_problem(design, measured, settings=None) -> CorrectionProblem:
                 unknowns.append(f"{f}.{n}" if n_f == 2 else n)
                 index.append(col)
     stacked = jax.tree_util.tree_map(lambda *a: jnp.stack(a), *[program_pair(s) for s in specs])
-    return CorrectionProblem(design, member, flanks, measured, grids, tuple(unknowns),
-                             tuple(index), M, rot, stacked, generated)
+    return CorrectionProblem(design, member, flanks, measured, lines, tuple(unknowns),
+                             tuple(index), M, rot, stacked, generated, float(sign),
+                             None if weight is None else np.asarray(weight, float))
 
 
 def _lm(problem: CorrectionProblem, scale, deviation_um, reg, free_x0, fixed: bool,
@@ -326,8 +360,9 @@ def model_deviations(problem: CorrectionProblem, values: dict):
     out = _lm(problem, np.ones(K), zero, 0.0, u, True, 1)
     if int(out.status) == optimize.FAILED:
         raise ConvergenceError("model deviations: a line-flank intersection did not converge")
-    n = problem.n_points
+    n = problem.n_rows
     dev = -np.asarray(out.residual)[:n].reshape(zero.shape)
+    dev = np.where(problem.mask, dev, np.nan)
     J = -np.asarray(out.jacobian)[:n][:, list(problem.index)]
     return dev, J
 
@@ -338,7 +373,8 @@ class CorrectionResult:
 
     unknowns : names; units : name -> unit; fitted : name -> fitted setting error
     ``delta`` (what the machine cut, relative to the design) and the rotation;
-    correction : name -> ``-delta`` (settings only); uncertainty : name -> one standard
+    correction : name -> ``sign * delta`` (``-delta`` for a measurement; settings only);
+    uncertainty : name -> one standard
     deviation of ``delta`` from the residual noise (the regularised estimator's
     covariance ``s^2 (A + L)^-1 A (A + L)^-1``, ``A = J^T J``, ``L = (alpha sqrt N)^2 I``,
     ``s`` the residual rms); before_um, after_um : (n_f, n_xi, n_s) the measured
@@ -377,10 +413,10 @@ class CorrectionResult:
         out = {}
         for k, f in enumerate(self.problem.flanks):
             b, a = self.before_um[k], self.after_um[k]
-            out[f] = {"before_rms_um": float(np.sqrt(np.mean(b ** 2))),
-                      "before_max_um": float(np.max(np.abs(b))),
-                      "after_rms_um": float(np.sqrt(np.mean(a ** 2))),
-                      "after_max_um": float(np.max(np.abs(a)))}
+            out[f] = {"before_rms_um": float(np.sqrt(np.nanmean(b ** 2))),
+                      "before_max_um": float(np.nanmax(np.abs(b))),
+                      "after_rms_um": float(np.sqrt(np.nanmean(a ** 2))),
+                      "after_max_um": float(np.nanmax(np.abs(a)))}
         return out
 
 
@@ -407,7 +443,7 @@ def correct_flanks(problem: CorrectionProblem, *,
     alpha = check_range("regularisation", regularisation, 0.0, 1.0)
     max_iter = check_int("max_iter", max_iter, 1, _HISTORY - 1)
     d = np.asarray(problem.measured.deviation_um, float)
-    if not np.all(np.isfinite(d)):
+    if not np.all(np.isfinite(d[problem.mask])):
         raise ValueError(f"--measured {problem.measured.path!r}: deviations missing (a "
                          f"reference grid without measured deviations)")
     t0 = time.perf_counter()
@@ -416,7 +452,9 @@ def correct_flanks(problem: CorrectionProblem, *,
     names = problem.unknowns
     # column scales: the change of each unknown that moves the flanks by 1 um rms
     _, J0 = model_deviations(problem, {})
-    rms = np.sqrt(np.mean(J0 ** 2, axis=0))
+    N = problem.n_points
+    rows = problem.n_rows
+    rms = np.sqrt(np.sum(J0 ** 2, axis=0) / N)
     dead = [names[i] for i in range(len(names)) if not rms[i] > _ZERO_COLUMN]
     if dead:
         raise ValueError(f"--settings: {', '.join(dead)} does not change the measured "
@@ -424,7 +462,6 @@ def correct_flanks(problem: CorrectionProblem, *,
                          f"at zero tilt); leave it out")
     scale = np.ones(K)
     scale[idx] = 1.0 / rms
-    N = problem.n_points
     reg = alpha * math.sqrt(N)
     out = _lm(problem, scale, d, reg, np.zeros(len(idx)), False, max_iter)
     jax.block_until_ready(out.x)
@@ -432,9 +469,9 @@ def correct_flanks(problem: CorrectionProblem, *,
     status = int(out.status)
     x = np.asarray(out.x)[idx]
     delta = x * scale[idx]
-    r = np.asarray(out.residual)[:N]
-    after = r.reshape(d.shape)
-    Js = np.asarray(out.jacobian)[:N][:, idx]          # d r / d x  (= -d t / d x, um)
+    r = np.asarray(out.residual)[:rows]
+    after = np.where(problem.mask, r.reshape(d.shape), np.nan)
+    Js = np.asarray(out.jacobian)[:rows][:, idx]       # d r / d x  (= -d t / d x, um)
     sv, V = np.linalg.svd(Js, full_matrices=False)[1:]
     s_rel = sv / math.sqrt(N)
     cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else math.inf
@@ -451,18 +488,20 @@ def correct_flanks(problem: CorrectionProblem, *,
     sd = np.sqrt(np.maximum(np.diag(cov), 0.0)) * scale[idx]
     fitted = {n: _to_file(n.split(".")[-1], delta[i]) for i, n in enumerate(names)}
     units = {n: _unit(n.split(".")[-1]) for n in names}
-    correction = {n: -v for n, v in fitted.items() if n != ROTATION}
+    correction = {n: problem.sign * v for n, v in fitted.items() if n != ROTATION}
     unc = {n: abs(_to_file(n.split(".")[-1], sd[i])) for i, n in enumerate(names)}
     scales = {n: _to_file(n.split(".")[-1], scale[idx][i]) for i, n in enumerate(names)}
     converged = status == optimize.CONVERGED
-    return CorrectionResult(problem, names, units, fitted, correction, unc, d, after, s_rel,
+    before = np.where(problem.mask, d, np.nan)
+    return CorrectionResult(problem, names, units, fitted, correction, unc, before, after, s_rel,
                             cond, combos, noise, alpha, scales, converged, status,
                             optimize.status_message(status), int(out.iterations),
                             int(out.evaluations), seconds, delta)
 
 
 def corrected_design(result: CorrectionResult, *, description: str | None = None):
-    """The design with the corrections ``-delta`` applied to the measured flanks' cutter
+    """The design with the corrections ``sign * delta`` (``-delta`` for a measurement,
+    :attr:`CorrectionProblem.sign`) applied to the measured flanks' cutter
     and machine tables (file units; a flank's No. 116 dials become the geometric
     settings), validated by the family's loader.  Refused (``ValueError``) for a
     non-converged result."""
@@ -477,7 +516,7 @@ def corrected_design(result: CorrectionResult, *, description: str | None = None
         for i, col in enumerate(p.index):
             if col == len(p.rot_unit) - 1:
                 continue
-            inc -= p.M_unit[a, :, col] * result.delta[i]
+            inc += p.sign * p.M_unit[a, :, col] * result.delta[i]
         table = flank_settings_table(apply_settings(fl, jnp.asarray(inc)))
         data[p.member][f] = {"cutter": table["cutter"], "machine": table["machine"]}
     if description is not None:
