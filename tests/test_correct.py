@@ -6,7 +6,9 @@ tables is the "cut" part; its own flank grid, intersected with the nominal norma
 gives the measured deviations (a route independent of the fit's line-flank solve);
 seeded noise of 1 um is added.  One example (spiral_bevel_10x30_synthesised, both
 members generated) so that the compiled grid and fit programs are shared; the formate
-gear of hypoid_iso_10x41_synthesised in one recovery case."""
+gear of hypoid_iso_10x41_synthesised in one recovery case.  Also: the measurement's
+rotation about the axis, and a target ease-off (issue item 4) that a known change of
+settings produces."""
 
 import copy
 import json
@@ -381,3 +383,26 @@ def test_ease_off_target_reached_where_one_exists(sb):
     assert new.data["pinion"]["convex"] == sb.data["pinion"]["convex"]
     again = eo.ease_off(eo.ease_off_problem(new, "drive", settings=settings))
     assert np.nanmax(np.abs(again - target)) < 0.05
+
+
+def test_measurement_rotation_is_recovered_with_its_sign(sb, tmp_path):
+    """The measured flank turned by +0.05 deg about the member's axis (right-handed about
+    z, apex -> heel): the tangent-plane route on the turned grid (exact to 0.02 um here),
+    fitted with ``axis_rotation`` alone, gives +0.05 deg (a sign or axis error gives -0.05
+    or a residual of ~20 um)."""
+    w = math.radians(0.05)
+    R = np.array([[math.cos(w), -math.sin(w), 0.0], [math.sin(w), math.cos(w), 0.0],
+                  [0.0, 0.0, 1.0]])
+    dev = []
+    for f in ("convex", "concave"):
+        g = sb.reference_grid("pinion", f, *GRID, MARGIN, MARGIN)
+        P, n = np.asarray(g.points), np.asarray(g.normals)
+        Q, m = P @ R.T, n @ R.T
+        dev.append(np.sum(m * (Q - P), -1) / np.sum(m * n, -1) / 1e-3)
+    dev = np.stack(dev)
+    assert np.max(np.abs(dev)) > 15.0
+    m = read_measured_grid(_write(tmp_path / "r.csv", sb, "pinion", dev))
+    res = fc.correct_flanks(fc.correction_problem(sb, m, ["axis_rotation"]))
+    assert res.converged and res.unknowns == ("axis_rotation",)
+    assert abs(res.fitted["axis_rotation"] - 0.05) < 2e-4
+    assert res.correction == {} and np.max(np.abs(res.after_um)) < 0.05
