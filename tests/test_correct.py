@@ -406,3 +406,14 @@ def test_measurement_rotation_is_recovered_with_its_sign(sb, tmp_path):
     assert res.converged and res.unknowns == ("axis_rotation",)
     assert abs(res.fitted["axis_rotation"] - 0.05) < 2e-4
     assert res.correction == {} and np.max(np.abs(res.after_um)) < 0.05
+
+
+def test_a_windows_export_reads_the_same(ref_file, tmp_path):
+    """A byte-order mark and CRLF line ends (a measuring machine's export on Windows)."""
+    text = ref_file.read_text().replace("\n", "\r\n")
+    p = tmp_path / "win.csv"
+    p.write_bytes(b"\xef\xbb\xbf" + text.encode())
+    a = read_measured_grid(ref_file, require_deviations=False)
+    b = read_measured_grid(p, require_deviations=False)
+    assert (a.member, a.n_xi, a.n_s, a.flanks) == (b.member, b.n_xi, b.n_s, b.flanks)
+    np.testing.assert_array_equal(a.points, b.points)

@@ -188,7 +188,7 @@ def read_measured_grid(path, *, require_deviations: bool = True) -> MeasuredGrid
     read as NaN."""
     src = f"--measured {str(path)!r}"
     try:
-        text = Path(path).read_text(encoding="utf-8")
+        text = Path(path).read_text(encoding="utf-8-sig")   # a BOM is dropped
     except UnicodeDecodeError:
         raise ValueError(f"{src}: not a UTF-8 text file") from None
     except IsADirectoryError:
