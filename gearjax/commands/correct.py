@@ -196,7 +196,7 @@ def table(rep: dict) -> str:
     L.append(f"{'unknown':<28}{'fitted error':>14}{'correction':>14}{'+- 1 sigma':>13}  unit")
     for n in rep["unknowns"]:
         corr = rep["correction"].get(n)
-        c = f"{corr:>14.6g}" if corr is not None else f"{'(not corrected)':>14}"
+        c = f"{corr:>14.6g}" if corr is not None else f"{'(none)':>14}"
         L.append(f"{n:<28}{rep['fitted_error'][n]:>14.6g}{c}{rep['uncertainty'][n]:>13.3g}  "
                  f"{rep['units'][n]}")
     sv = rep["singular_values"]
