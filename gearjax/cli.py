@@ -22,6 +22,7 @@ COMMANDS = [
     "gearjax.commands.example",
     "gearjax.commands.blank",
     "gearjax.commands.surface",
+    "gearjax.commands.correct",
     "gearjax.commands.friction",
     "gearjax.commands.kinematics",
     "gearjax.commands.tca",

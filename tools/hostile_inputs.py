@@ -230,6 +230,52 @@ def plain_file(name: str = "afile"):
     return setup
 
 
+#: the packaged sample measurement of ``gearjax correct`` (docs/correct.md)
+SAMPLE_MEASUREMENT = (EXAMPLES_DIR / "measurements"
+                      / "spiral_bevel_10x30_synthesised_pinion.csv")
+
+
+def measured_file(edit=None, name: str = "measured.csv"):
+    """Setup: the packaged sample measurement with ``edit(lines) -> lines`` applied (the
+    text lines of the CSV), written to ``{tmp}/name`` -> ``{measured}``."""
+
+    def setup(tmp: Path) -> dict:
+        lines = SAMPLE_MEASUREMENT.read_text(encoding="utf-8").splitlines()
+        if edit is not None:
+            lines = edit(lines)
+        p = tmp / name
+        p.write_text("\n".join(lines) + "\n", encoding="utf-8")
+        return {"measured": str(p)}
+
+    return setup
+
+
+def _rows_edit(fn):
+    """An edit of the data rows (header and comments kept): ``fn(rows) -> rows``."""
+    def edit(lines):
+        head = [ln for ln in lines if ln.startswith("#") or ln.startswith("flank,")]
+        rows = [ln for ln in lines if not (ln.startswith("#") or ln.startswith("flank,"))]
+        return head + fn(rows)
+    return edit
+
+
+def _column_edit(row_index: int, column: int, fn):
+    """Replace field ``column`` of data row ``row_index`` by ``fn(old text)``."""
+    def rows_fn(rows):
+        rows = list(rows)
+        c = rows[row_index].split(",")
+        c[column] = fn(c[column])
+        rows[row_index] = ",".join(c)
+        return rows
+    return _rows_edit(rows_fn)
+
+
+def _all_deviations(fn):
+    """Apply ``fn`` to the deviation (last) field of every data row."""
+    return _rows_edit(lambda rows: [",".join(r.split(",")[:-1] + [fn(r.split(",")[-1])])
+                                    for r in rows])
+
+
 # --------------------------------------------------------------------------------------
 # the table
 
@@ -572,6 +618,123 @@ def build_cases() -> list[Case]:
     for key, (member, flank) in surface_corrupt.items():
         corrupt_case("surface", key, ["--member", member, "--flank", flank, "--grid", "11x7",
                                       "--out", "{tmp}/f.csv"])
+
+    # ---------------------------------------------------------------- correct
+    SBX = "example:spiral_bevel_10x30_synthesised"
+
+    def cor(measured="{measured}", out="{tmp}/corrected.toml", design=SBX, extra=()):
+        a = ["correct", design]
+        for f, v in (("--measured", measured), ("--out", out)):
+            if v is not None:
+                a += [f, v]
+        return a + list(extra)
+
+    sample = measured_file()
+    add("correct.ok.default", cor(), "ok", "the packaged sample measurement, default settings",
+        setup=sample)
+    add("correct.ok.json_plot", cor(extra=["--json", "--plot", "{tmp}/d.png"]),
+        "ok", "JSON report and deviation maps", setup=sample)
+    add("correct.ok.settings", cor(extra=["--settings", "point_radius,blade_angle,ratio_of_roll"]),
+        "ok", "a chosen set of settings", setup=sample)
+    add("correct.settings.ill_conditioned", cor(extra=["--settings",
+                                                       "point_radius,sliding_base"]),
+        "flag", "point radius and sliding base act alike: a warning line names them",
+        setup=sample)
+    add("correct.settings.with_rotation",
+        cor(extra=["--settings", "point_radius,blade_angle,ratio_of_roll,axis_rotation"]),
+        "flag", "the measurement's rotation ~ equal point radius changes: warned",
+        setup=sample, also={"ok"})
+    for key, v in (("unknown", "frobnicate"), ("empty", ""), ("comma", ","),
+                   ("twice", "point_radius,point_radius"),
+                   ("empty_item", "point_radius,,blade_angle"), ("capitals", "Point_Radius")):
+        add(f"correct.settings.{key}", cor(extra=["--settings", v]), "refuse",
+            f"--settings {v!r}", setup=sample)
+    for v in ("nan", "-1", "2", "inf", "abc"):
+        add(f"correct.regularisation={_slug(v)}", cor(extra=["--regularisation", v]), "refuse",
+            f"--regularisation {v}", setup=sample)
+    for v in ("0", "-3", "1e9", "2.5", "abc"):
+        add(f"correct.max-iter={_slug(v)}", cor(extra=["--max-iter", v]), "refuse",
+            f"--max-iter {v}", setup=sample)
+    add("correct.max-iter=1", cor(extra=["--max-iter", "1"]), "flag",
+        "one step: not converged (exit 3, one line) or converged", setup=sample, also={"ok"})
+    bad_measured = {
+        "nan": (_column_edit(5, 11, lambda v: "nan"), "a deviation NaN"),
+        "inf": (_column_edit(9, 11, lambda v: "inf"), "a deviation inf"),
+        "empty_deviation": (_column_edit(9, 11, lambda v: ""), "a deviation left empty"),
+        "text_deviation": (_column_edit(9, 11, lambda v: "12um"), "a deviation with a unit"),
+        "missing_point": (_rows_edit(lambda r: r[:17] + r[18:]), "a grid point missing"),
+        "duplicate_point": (_rows_edit(lambda r: r + r[:1]), "a grid point twice"),
+        "in_mm": (_all_deviations(lambda v: f"{float(v) / 1000.0:.8f}"),
+                  "deviations in mm instead of um"),
+        "huge": (_column_edit(3, 11, lambda v: "2500"), "a deviation of 2.5 mm"),
+        "wrong_grid": (lambda ls: [ln.replace("grid = 9x5", "grid = 7x5") for ln in ls],
+                       "header grid 7x5, rows of a 9x5 grid"),
+        "off_grid": (_column_edit(7, 5, lambda v: f"{float(v) + 0.05:.10f}"),
+                     "a point 0.05 mm off the design's grid"),
+        "other_member": (lambda ls: [ln.replace("member = pinion", "member = gear")
+                                     for ln in ls], "the pinion's grid declared as the gear's"),
+        "no_member": (lambda ls: [ln for ln in ls if not ln.startswith("# member")],
+                      "header without member"),
+        "bad_margin": (lambda ls: [ln.replace("face_margin = 0.1", "face_margin = 0.7")
+                                   for ln in ls], "face margin 0.7"),
+        "missing_column": (lambda ls: [",".join(ln.split(",")[:-1]) if not ln.startswith("#")
+                                       else ln for ln in ls], "no deviation column"),
+        "bad_flank": (_column_edit(0, 0, lambda v: "left"), "flank 'left'"),
+        "unnormalised": (_column_edit(4, 8, lambda v: "0.9"), "a normal that is not unit"),
+        "header_only": (lambda ls: [ln for ln in ls if ln.startswith("#")
+                                    or ln.startswith("flank,")], "no data rows"),
+    }
+    for key, (edit, why) in bad_measured.items():
+        add(f"correct.measured.{key}", cor(), "refuse", why, setup=measured_file(edit))
+    add("correct.measured.missing_file", cor(measured="{tmp}/none.csv"), "refuse",
+        "--measured does not exist")
+    add("correct.measured.directory", cor(measured="{dir}"), "refuse",
+        "--measured is a directory", setup=a_directory("m.csv"))
+    add("correct.measured.binary", cor(measured="{design}"), "refuse", "--measured binary",
+        setup=raw_file(b"\x89PNG\r\n\x1a\n\x00\xff\xfe", name="m.csv"))
+    add("correct.measured.empty", cor(measured="{design}"), "refuse", "--measured empty",
+        setup=raw_file(b"", name="m.csv"))
+    add("correct.missing_measured", cor(measured=None), "refuse", "--measured missing")
+    add("correct.missing_out", cor(out=None), "refuse", "--out missing", setup=sample)
+    add("correct.out.bad_extension", cor(out="{tmp}/c.txt"), "refuse", "--out .txt",
+        setup=sample)
+    add("correct.out.missing_dir", cor(out="{tmp}/no/dir/c.toml"), "refuse",
+        "--out in a missing directory", setup=sample)
+    add("correct.out.same_as_plot", cor(out="{tmp}/c.png", extra=["--plot", "{tmp}/c.png"]),
+        "refuse", "--out and --plot the same file (and --out not .toml)", setup=sample)
+    add("correct.plot.bad_extension", cor(extra=["--plot", "{tmp}/d.jpg2"]), "refuse",
+        "--plot .jpg2", setup=sample)
+    add("correct.example.involute", cor(design="example:khk_spur_12x24"), "refuse",
+        "a family without machine settings", setup=sample)
+    add("correct.example.other_hypoid", cor(design="example:hft_8x43"), "refuse",
+        "another design's grid", setup=sample)
+    add("correct.example.unknown", cor(design="example:nope"), "refuse",
+        "unknown example", setup=sample)
+    add("correct.formate_roll", cor(design="example:hypoid_iso_10x41_synthesised", extra=[
+        "--settings", "ratio_of_roll"]), "refuse", "roll setting of a formate gear",
+        setup=measured_file(lambda ls: [ln.replace("member = pinion", "member = gear")
+                                        for ln in ls]))
+    # reference grids of gearjax surface
+    add("surface.ok.reference_grid", ["surface", SBX, "--member", "gear", "--reference-grid",
+                                      "--out", "{tmp}/grid.csv"], "ok", "measuring grid")
+    add("surface.reference_grid.stl", ["surface", SBX, "--member", "gear", "--reference-grid",
+                                       "--out", "{tmp}/grid.stl"], "refuse",
+        "--reference-grid to STL")
+    add("surface.reference_grid.margin=0.5", ["surface", SBX, "--member", "gear",
+                                              "--reference-grid", "--face-margin", "0.5",
+                                              "--out", "{tmp}/grid.csv"], "refuse",
+        "--face-margin 0.5")
+    add("surface.reference_grid.margin_nan", ["surface", SBX, "--member", "gear",
+                                              "--reference-grid", "--height-margin", "nan",
+                                              "--out", "{tmp}/grid.csv"], "refuse",
+        "--height-margin nan")
+    add("surface.reference_grid.margin_without", srf(extra=["--face-margin", "0.1"]), "refuse",
+        "--face-margin without --reference-grid")
+    add("surface.reference_grid.vh_catt", ["surface", "example:vh_catt_17x23", "--member",
+                                           "gear", "--reference-grid", "--out",
+                                           "{tmp}/grid.csv"], "refuse",
+        "a family without a measuring grid")
+    add("surface.missing_flank", srf(flank=None), "refuse", "--flank missing")
 
     # ---------------------------------------------------------------- friction
     add("friction.ok.table", ["friction", *_argv(FRI)], "ok", "README example")

@@ -7,7 +7,12 @@ Every exported point is a converged solve: a grid with any point whose solve did
 converge (or whose point or normal is not finite) is refused in every format, CSV, XYZ
 and STL, with one ``gearjax: error:`` line naming the flank, the number of such points
 and the largest residual, status 3, and nothing is written
-(:func:`gearjax.io.check_grid_converged`; an existing file is left unchanged)."""
+(:func:`gearjax.io.check_grid_converged`; an existing file is left unchanged).
+
+``--reference-grid`` writes the measuring grid of a hypoid / spiral-bevel member instead:
+the nominal points and normals (both flanks unless ``--flank`` is given) inside a border
+(``--face-margin``, ``--height-margin``), as the measured-grid CSV that ``gearjax correct``
+reads back with the deviations filled in (docs/correct.md)."""
 
 from __future__ import annotations
 
@@ -33,9 +38,23 @@ def register(sub):
                                    "face-width and face-cone conditions); every point is a converged solve.")
     p.add_argument("design", help="design file path or example:NAME")
     p.add_argument("--member", choices=["pinion", "gear"], required=True)
-    p.add_argument("--flank", choices=["convex", "concave"], required=True)
-    p.add_argument("--grid", default="41x21", help="face-width x height points (default 41x21)")
-    p.add_argument("--out", required=True, help="output file: .csv, .xyz or .stl")
+    p.add_argument("--flank", choices=["convex", "concave"], default=None,
+                   help="the flank (required, except with --reference-grid, where the "
+                        "default is both flanks)")
+    p.add_argument("--grid", default=None,
+                   help="face-width x height points (default 41x21; 9x5 with --reference-grid)")
+    p.add_argument("--out", required=True, help="output file: .csv, .xyz or .stl "
+                                                "(.csv with --reference-grid)")
+    p.add_argument("--reference-grid", action="store_true",
+                   help="write the measuring grid instead (hypoid / spiral bevel): nominal "
+                        "points and normals to measure at, inside the margins, in the "
+                        "measured-grid CSV format of `gearjax correct` (docs/correct.md)")
+    p.add_argument("--face-margin", type=float, default=None,
+                   help="with --reference-grid: border at the toe and at the heel as a "
+                        "fraction of the face width, in [0, 0.4] (default 0.1)")
+    p.add_argument("--height-margin", type=float, default=None,
+                   help="with --reference-grid: border at the root and at the tip as a "
+                        "fraction of the active blade length, in [0, 0.4] (default 0.1)")
     p.add_argument("--tooth", action="store_true",
                    help="with .stl: write the whole tooth (both flanks, top land, root)")
     p.add_argument("--plot", default=None,
@@ -47,7 +66,15 @@ def run(args) -> int:
     from gearjax import load_design
     from gearjax.io import check_output_path, write_flank, write_stl_tooth
     from gearjax.progress import Progress
-    n_xi, n_s = _grid(args.grid)
+    if args.reference_grid:
+        return _reference_grid(args)
+    for flag, v in (("--face-margin", args.face_margin), ("--height-margin", args.height_margin)):
+        if v is not None:
+            raise ValueError(f"{flag} applies only with --reference-grid")
+    if args.flank is None:
+        raise ValueError("--flank is required (convex or concave) unless --reference-grid "
+                         "is given")
+    n_xi, n_s = _grid("41x21" if args.grid is None else args.grid)
     out = check_output_path(args.out, "--out", (".csv", ".xyz", ".stl"))
     if args.tooth and out.suffix.lower() != ".stl":
         raise ValueError("--tooth needs an .stl output file")
@@ -85,5 +112,48 @@ def run(args) -> int:
     import numpy as np
     sys.stdout.write(f"{args.member} {'tooth' if args.tooth else args.flank + ' flank'}: "
                      f"{n_xi}x{n_s} points, max residual {float(np.max(g.residual)):.2e} mm, "
+                     f"written to {out}\n")
+    return 0
+
+
+#: default measuring grid (face-width x profile points) and margins of --reference-grid
+REFERENCE_GRID = "9x5"
+REFERENCE_MARGIN = 0.1
+
+
+def _reference_grid(args) -> int:
+    """``--reference-grid``: the nominal points and normals to measure at (the
+    measured-grid CSV of :mod:`gearjax.io.measured_grid`, deviations left empty)."""
+    from gearjax import load_design
+    from gearjax.errors import check_range
+    from gearjax.io import check_grid_converged, check_output_path, write_reference_grid
+    if args.tooth or args.plot is not None:
+        raise ValueError(f"{'--tooth' if args.tooth else '--plot'} does not apply with "
+                         f"--reference-grid")
+    n_xi, n_s = _grid(REFERENCE_GRID if args.grid is None else args.grid)
+    if n_xi > 101 or n_s > 101:
+        raise ValueError(f"--grid = {args.grid!r}: a measuring grid has at most 101 x 101 "
+                         f"points")
+    fm = check_range("--face-margin", REFERENCE_MARGIN if args.face_margin is None
+                     else args.face_margin, 0.0, 0.4)
+    hm = check_range("--height-margin", REFERENCE_MARGIN if args.height_margin is None
+                     else args.height_margin, 0.0, 0.4)
+    out = check_output_path(args.out, "--out", (".csv",))
+    design = load_design(args.design)
+    if not hasattr(design, "reference_grid"):
+        raise ValueError(f"--reference-grid: measuring grids are defined for hypoid and "
+                         f"spiral-bevel designs only, not for [design] kind = "
+                         f"{design.data['design']['kind']!r}")
+    flanks = [args.flank] if args.flank else [f for m, f in design.flanks()
+                                              if m == args.member]
+    if not flanks:
+        raise ValueError(f"--member = {args.member!r}: the design has no {args.member} flanks")
+    grids = {f: design.reference_grid(args.member, f, n_xi, n_s, fm, hm) for f in flanks}
+    for f, g in grids.items():
+        check_grid_converged(g, f"{design.name} {args.member} {f} flank")
+    write_reference_grid(out, design=design.name, member=args.member, grids=grids,
+                         face_margin=fm, height_margin=hm)
+    sys.stdout.write(f"{args.member} reference grid ({', '.join(flanks)}): {n_xi}x{n_s} points "
+                     f"per flank, margins {fm:g} of the face width and {hm:g} of the blade, "
                      f"written to {out}\n")
     return 0

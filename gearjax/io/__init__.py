@@ -1,7 +1,8 @@
 """File formats shared by every gear family, apart from the chain: atomic writes and
 strict JSON (:mod:`~gearjax.io.files`), TOML and the value checks of design-file
 readers, packaged examples (:mod:`~gearjax.io.toml`), the design-file registry
-(:mod:`~gearjax.io.designs`), flank exports (:mod:`~gearjax.io.exports`).
+(:mod:`~gearjax.io.designs`), flank exports (:mod:`~gearjax.io.exports`), measured flank grids
+(:mod:`~gearjax.io.measured_grid`).
 
 A leaf: nothing here imports a gear family or the chain.  Each family reads its own
 design files (for instance :mod:`gearjax.gears.hypoid.design_file`) with
@@ -19,6 +20,8 @@ from gearjax.io.designs import (DesignFileMixin, design_from_dict, design_kinds,
 from gearjax.io.exports import (FlankGrid, UnconvergedExportError, check_grid_converged,
                                 flank_triangles, tooth_mesh, write_csv, write_flank,
                                 write_stl_flank, write_stl_tooth, write_xyz)
+from gearjax.io.measured_grid import (MeasuredGrid, check_on_reference, grid_heights,
+                                      parse_grid_size, read_measured_grid, write_reference_grid)
 
 __all__ = ["read_toml", "check_keys", "require_key", "check_number", "check_integer",
            "check_string", "is_number", "dumps_toml", "list_examples", "EXAMPLE_ALIASES",
@@ -27,4 +30,6 @@ __all__ = ["read_toml", "check_keys", "require_key", "check_number", "check_inte
            "write_csv", "write_xyz", "write_stl_flank",
            "write_stl_tooth", "tooth_mesh", "flank_triangles", "write_flank",
            "register_design_kind", "design_kinds", "design_from_dict", "load_design",
-           "DesignFileMixin", "FlankGrid", "UnconvergedExportError", "check_grid_converged"]
+           "DesignFileMixin", "FlankGrid", "UnconvergedExportError", "check_grid_converged",
+           "MeasuredGrid", "read_measured_grid", "write_reference_grid", "check_on_reference",
+           "parse_grid_size", "grid_heights"]

@@ -267,6 +267,17 @@ class HypoidDesign:
         from gearjax.gears.hypoid.flank import flank_surface
         return flank_surface(self.flank(member, flank), n_u, n_v)
 
+    def reference_grid(self, member: str, flank: str, n_u: int, n_v: int,
+                       face_margin: float, height_margin: float):
+        """The measuring grid of ``flank`` of ``member`` (a :class:`gearjax.io.FlankGrid`):
+        ``n_u`` face-width positions by ``n_v`` points along the blade inside a border of
+        ``face_margin`` of the face width and ``height_margin`` of the active blade
+        length (:func:`~gearjax.gears.hypoid.flank.flank_surface`; docs/correct.md) --
+        the nominal points and normals of ``gearjax surface --reference-grid``."""
+        from gearjax.gears.hypoid.flank import flank_surface
+        return flank_surface(self.flank(member, flank), n_u, n_v, face_margin=face_margin,
+                             height_margin=height_margin)
+
     def teeth(self, member: str) -> int:
         """Number of teeth of ``member``."""
         return int(self.member_blank(member).teeth)

@@ -429,13 +429,20 @@ def _row(fl: FlankSpec, s_min, ts, tip_x, xi0):
     return jax.lax.scan(step, (tip_x[1:], tip_x[1:]), ts)[1]
 
 
-def flank_points(fl: FlankSpec, n_xi: int = 21, n_s: int = 11) -> FlankGrid:
+def flank_points(fl: FlankSpec, n_xi: int = 21, n_s: int = 11, face_margin: float = 0.0,
+                 height_margin: float = 0.0) -> FlankGrid:
     """Flank grid by the algorithm of [HFT-hypoid] (pure and jit-friendly; no validation).
 
     ``n_xi`` face-width positions ``xi`` in [-1, 1] (toe to heel), ``n_s`` blade
     positions from the fillet start ``s_min`` to the tip ``s_max(xi)``, uniformly
     spaced in ``s``.  Use :func:`flank_surface` for a validated, convergence-checked
     result.  Differentiable w.r.t. ``fl`` (jacfwd/jacrev) through the implicit solves.
+
+    ``face_margin`` and ``height_margin`` (static fractions, default 0) keep the grid
+    inside a border, as a measuring machine's grid is: ``xi`` in ``[-1 + 2 m_f, 1 -
+    2 m_f]`` (a margin ``m_f`` of the face width at the toe and at the heel) and the
+    blade fraction ``(s - s_min)/(s_max - s_min)`` in ``[m_h, 1 - m_h]`` (a margin
+    ``m_h`` of the active blade length at the root and at the tip; docs/correct.md).
 
     Returns a :class:`gearjax.io.FlankGrid`, shape (n_xi, n_s) per field, index j
     from root (fillet start) to tip: points (n_xi, n_s, 3) mm and normals (n_xi,
@@ -444,8 +451,9 @@ def flank_points(fl: FlankSpec, n_xi: int = 21, n_s: int = 11) -> FlankGrid:
     max |F| of the solve (mm); converged (n_xi, n_s) bool (point solve and its row's
     tip solve both converged).
     """
-    xis = np.linspace(-1.0, 1.0, int(n_xi))
-    ts = jnp.asarray(np.linspace(1.0, 0.0, int(n_s)))          # tip -> root
+    fm, hm = float(face_margin), float(height_margin)
+    xis = np.linspace(-1.0 + 2.0 * fm, 1.0 - 2.0 * fm, int(n_xi))
+    ts = jnp.asarray(np.linspace(1.0 - hm, hm, int(n_s)))          # tip -> root
     tips, tip_ok = _tips(fl, xis)
     s_min = fillet_start(fl.cutter)
     r, n, prm, res, conv, _ = jax.vmap(lambda x, xi: _row(fl, s_min, ts, x, xi))(
@@ -456,17 +464,21 @@ def flank_points(fl: FlankSpec, n_xi: int = 21, n_s: int = 11) -> FlankGrid:
     return FlankGrid(flip(r), flip(n), flip(prm), jnp.asarray(xis), res, conv)
 
 
-@functools.partial(jax.jit, static_argnums=(1, 2))
-def _flank_points_jit(fl, n_xi, n_s):
-    return flank_points(fl, n_xi, n_s)
+@functools.partial(jax.jit, static_argnums=(1, 2, 3, 4))
+def _flank_points_jit(fl, n_xi, n_s, face_margin, height_margin):
+    return flank_points(fl, n_xi, n_s, face_margin, height_margin)
 
 
-def flank_surface(fl: FlankSpec, n_xi: int = 21, n_s: int = 11, *, throw: bool = True) -> FlankGrid:
+def flank_surface(fl: FlankSpec, n_xi: int = 21, n_s: int = 11, *, face_margin: float = 0.0,
+                  height_margin: float = 0.0, throw: bool = True) -> FlankGrid:
     """Validated, jitted :func:`flank_points`; raises ConvergenceError unless every point
-    converged (``throw=False`` returns the grid with its ``converged`` mask)."""
+    converged (``throw=False`` returns the grid with its ``converged`` mask).  The
+    margins (fractions in [0, 0.4]) as in :func:`flank_points`."""
     n_xi = check_int("n_xi", n_xi, 2, 2001)
     n_s = check_int("n_s", n_s, 2, 2001)
-    g = _flank_points_jit(program_pair(fl), n_xi, n_s)
+    fm = check_range("face_margin", face_margin, 0.0, 0.4)
+    hm = check_range("height_margin", height_margin, 0.0, 0.4)
+    g = _flank_points_jit(program_pair(fl), n_xi, n_s, fm, hm)
     if throw:
         require_converged(g.converged, "hypoid flank grid", g.residual)
     return g
