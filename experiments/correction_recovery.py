@@ -18,8 +18,6 @@ structure).
 
 from __future__ import annotations
 
-import copy
-import json
 import math
 import time
 from pathlib import Path
@@ -28,7 +26,6 @@ import numpy as np
 
 import gearjax
 from gearjax.gears.hypoid import flank_correction as fc
-from gearjax.gears.hypoid.design_file import design_from_dict
 from gearjax.io import MeasuredGrid, atomic_write, dumps_json
 
 RESULTS = Path(__file__).resolve().parent / "results"
@@ -64,19 +61,10 @@ CASES = [
 ]
 
 
-def perturbed(design, member, errors):
-    data = copy.deepcopy(design.to_dict())
-    for key, v in errors.items():
-        flank, name = key.split(".") if "." in key else (None, key)
-        for f in ([flank] if flank else ["convex", "concave"]):
-            data[member][f][fc.SETTINGS[name][0]][name] += v
-    return design_from_dict(data)
-
-
 def measure(design, member, errors, rotation_deg, rng, nominal=None):
     """Second route: the perturbed design's grid (turned by the measurement's rotation)
     met by the nominal lines through tangent planes, plus noise (um)."""
-    bad = perturbed(design, member, errors)
+    bad = fc.with_setting_errors(design, member, errors)
     nominal = design if nominal is None else nominal
     c, s = math.cos(math.radians(rotation_deg)), math.sin(math.radians(rotation_deg))
     R = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])

@@ -10,7 +10,6 @@ gear of hypoid_iso_10x41_synthesised in one recovery case.  Also: the measuremen
 rotation about the axis, and a target ease-off (issue item 4) that a known change of
 settings produces."""
 
-import copy
 import json
 import math
 
@@ -22,7 +21,6 @@ import pytest
 import gearjax
 from gearjax.cli import main
 from gearjax.gears.hypoid import flank_correction as fc
-from gearjax.gears.hypoid.design_file import design_from_dict
 from gearjax.gears.hypoid.flank import solve_point, work_point
 from gearjax.io import read_measured_grid, write_reference_grid
 
@@ -33,23 +31,12 @@ MARGIN = 0.1
 NOISE_UM = 1.0
 
 
-def _perturbed(design, member, errors):
-    """The design with setting errors (``flank.name`` or ``name`` for both flanks ->
-    file units) added to its tables."""
-    data = copy.deepcopy(design.to_dict())
-    for key, v in errors.items():
-        flank, name = key.split(".") if "." in key else (None, key)
-        for f in ([flank] if flank else ["convex", "concave"]):
-            data[member][f][fc.SETTINGS[name][0]][name] += v
-    return design_from_dict(data)
-
-
 def _measured_by_grid(design, member, errors, rng=None, noise=0.0):
     """Deviations (n_f, n_xi, n_s) um of the perturbed design's flanks from the nominal
     grid: its own reference grid (same grid coordinates) intersected with the nominal
     normals through the tangent plane at each of its points (second route; exact to
     second order in the in-plane shift)."""
-    bad = _perturbed(design, member, errors)
+    bad = fc.with_setting_errors(design, member, errors)
     out = []
     for f in ("convex", "concave"):
         g0 = design.reference_grid(member, f, *GRID, MARGIN, MARGIN)
@@ -158,7 +145,7 @@ def test_line_deviations_are_exact_and_match_the_perturbed_design(sb, zero_probl
     assert np.max(np.abs(dev)) > 10.0
     meas = _measured_by_grid(sb, "pinion", errors)
     assert np.max(np.abs(dev - meas)) < 0.1
-    bad = _perturbed(sb, "pinion", errors)
+    bad = fc.with_setting_errors(sb, "pinion", errors)
     for k, f in enumerate(("convex", "concave")):
         g = zero_problem.reference[f]
         fl = bad.flank("pinion", f)
@@ -342,7 +329,7 @@ def test_cli_writes_the_corrected_design(sb, tmp_path, capsys):
         assert k in EPILOG and f"`{k}`" in doc, k
     new = gearjax.load_design(str(out))
     # the corrected design cut with the machine's errors
-    recut = _perturbed(new, "pinion", errors)
+    recut = fc.with_setting_errors(new, "pinion", errors)
     after = []
     for f in ("convex", "concave"):
         g0 = sb.reference_grid("pinion", f, *GRID, MARGIN, MARGIN)
@@ -365,7 +352,7 @@ def test_ease_off_target_reached_where_one_exists(sb):
     and the written design's ease-off, evaluated anew from its file, is the target."""
     from gearjax.gears.hypoid import ease_off as eo
     change = {"modified_roll_2c": 0.01, "ratio_of_roll": 0.001, "blade_angle": 0.05}
-    bent = _perturbed(sb, "pinion", {f"concave.{k}": v for k, v in change.items()})
+    bent = fc.with_setting_errors(sb, "pinion", {f"concave.{k}": v for k, v in change.items()})
     settings = ["blade_angle", "ratio_of_roll", "modified_roll_2c", "modified_roll_6d",
                 "axis_rotation"]
     target = eo.ease_off(eo.ease_off_problem(bent, "drive", settings=settings))

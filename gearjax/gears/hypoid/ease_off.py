@@ -114,7 +114,7 @@ def ease_off_problem(design, side: str, target_um=None, *, settings=None, grid=(
     conj = conjugate_start(pair).pinion
     real = design.reference_grid("pinion", flank, n_xi, n_s, face_margin, height_margin)
     gc = flank_surface(conj, n_xi, n_s, face_margin=face_margin, height_margin=height_margin)
-    Pa, Na = np.asarray(real.points), np.asarray(real.normals)
+    Pa = np.asarray(real.points)
     Pc, Nc = np.asarray(gc.points), np.asarray(gc.normals)
     # turn the conjugate tooth about the axis until its mid grid point lies on the real
     # flank: the real flank met by the circle of that point about the axis

@@ -58,6 +58,8 @@ squares, [Hansen1998] for the Tikhonov filter factors.
 
 from __future__ import annotations
 
+import copy
+
 import math
 import time
 from dataclasses import dataclass, replace
@@ -77,7 +79,7 @@ from gearjax.newton import newton_solve
 __all__ = ["SETTINGS", "ROTATION", "DEFAULT_GENERATED", "DEFAULT_FORMATE", "INDISTINCT",
            "DEFAULT_REGULARISATION", "CorrectionProblem", "CorrectionResult",
            "line_deviations", "correction_problem", "model_deviations", "correct_flanks",
-           "corrected_design", "apply_settings", "problem_on_lines"]
+           "corrected_design", "apply_settings", "problem_on_lines", "with_setting_errors"]
 
 #: correctable setting -> (design-file table, unit at the boundary); angles in degrees
 SETTINGS = {
@@ -521,4 +523,25 @@ def corrected_design(result: CorrectionResult, *, description: str | None = None
         data[p.member][f] = {"cutter": table["cutter"], "machine": table["machine"]}
     if description is not None:
         data["design"]["description"] = description
+    return design_from_dict(data)
+
+
+def with_setting_errors(design, member: str, errors: dict):
+    """The design cut with setting errors: ``errors`` maps ``"flank.name"`` (one flank of
+    ``member``) or ``"name"`` (both flanks) of :data:`SETTINGS` to the error in file
+    units (mm, deg, 1, 1/rad, 1/rad^2), added to the member's flank tables; validated by
+    the family's loader (a synthetic measurement's "machine": the perturbed design's own
+    flanks are what it cut)."""
+    data = copy.deepcopy(design.to_dict())
+    for key, v in errors.items():
+        flank, name = key.split(".", 1) if "." in key else (None, key)
+        if name not in SETTINGS:
+            raise ValueError(f"errors: {name!r} is not a correctable setting; allowed: "
+                             f"{', '.join(SETTINGS)}")
+        for f in ([flank] if flank else ["convex", "concave"]):
+            table = data.get(member, {}).get(f, {}).get(SETTINGS[name][0], {})
+            if name not in table:
+                raise ValueError(f"errors: {key!r}: the design's [{member}.{f}."
+                                 f"{SETTINGS[name][0]}] table has no {name!r}")
+            table[name] += v
     return design_from_dict(data)
