@@ -212,3 +212,27 @@ def test_spur_result_quantities_and_flags(spur):
         # conjugate: the TE curves of consecutive pairs coincide, both pairs touch at
         # the hand-over, no pair carries the load alone at a flank edge
         assert not f["edge_contact"]
+
+
+def test_continuous_te_ptp_is_exact_for_a_parabolic_te_wherever_the_grid_falls():
+    """``te_ptp_arcsec`` of a study (gearjax.studies.quantities.te_ptp_continuous) on the
+    parabolic-TE closed form: p-t-p = a (p/2)^2 (top at the vertex, bottom at the
+    transfers delta +- p/2), at 8 offsets of the grid and three vertex positions, and
+    its derivative in the curvature ``a`` is (p/2)^2.  The sample maximum (or a smooth
+    maximum at a small temperature) misses the vertex by up to a (h/2)^2 and its
+    derivative jumps as the top passes a grid point; linear interpolation of the bottom
+    errs by a h^2/8.  Contact ratio 1.4: a grid point always lies between each
+    crossing and the flank boundary."""
+    import jax
+    from gearjax.studies.quantities import te_ptp_continuous
+    p = 2 * np.pi / 10
+    for frac in (0.0, 0.013, -0.041):
+        for offset in np.linspace(0.0, 1.0, 8, endpoint=False):
+            def ptp(a):
+                res = _parabolic_pair(frac * p, offset, w_pitches=0.7, a=a)[0]
+                return te_ptp_continuous(res)
+            a = 4.9e-4
+            val, der = jax.value_and_grad(ptp)(a)
+            want = a * (p / 2) ** 2 / gj.ARCSEC
+            assert float(val) == pytest.approx(want, rel=1e-9), (frac, offset)
+            assert float(der) == pytest.approx((p / 2) ** 2 / gj.ARCSEC, rel=1e-9)

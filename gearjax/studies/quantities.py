@@ -45,7 +45,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from gearjax.tca.multi_pair import transfer_gaps
+from gearjax.tca.multi_pair import interp_uniform, transfer_gaps
 from gearjax.tca.path import ARCSEC
 
 __all__ = ["Quantity", "QUANTITIES", "smooth_max", "smooth_min", "te_ptp_continuous",
@@ -90,10 +90,6 @@ def _mid(res):
     return res.path.phi1.shape[0] // 2
 
 
-#: temperature of the smooth top of the TE envelope (arcsec)
-TE_TEMPERATURE = 1e-3
-
-
 def te_ptp_continuous(res):
     """Peak-to-peak of the unloaded TE envelope (arcsec) with the hand-overs at their
     continuous positions (traceable).
@@ -102,10 +98,11 @@ def te_ptp_continuous(res):
     -- where two tooth pairs hand over, between grid points -- snaps from point to point
     as the design moves, so its gradient jumps whenever the hand-over crosses one.  Here
     the bottom is the TE of pair 0 at the two transfer angles ``res.transfer_phi1``
-    (linear interpolation of the crossing, continuous in the design), and the top is the
-    smooth maximum (:data:`TE_TEMPERATURE`) of the envelope over the pitch window, where
-    a localised TE is flat (snapping error ``kappa h^2/8``): the window is pair 0's
-    active interval between the two transfer angles.  For the coast side (the
+    (linear interpolation of the crossing, continuous in the design; pair 0's TE there by
+    quadratic interpolation of the path), and the top is the vertex of the parabola
+    through the envelope's largest sample in pair 0's active interval between the two
+    transfer angles and its neighbours (:func:`_vertex_top`: exact for a parabolic TE,
+    where the sample maximum errs by up to ``kappa h^2/8`` and its gradient jumps).  For the coast side (the
     envelope is the minimum over the pairs) top and bottom change roles.  Where a
     transfer angle is not found (conjugate or touching pairs), or the hand-over is not a
     crossing of two TE curves on the flank (an edge contact: the envelope jumps there), it
@@ -121,7 +118,10 @@ def te_ptp_continuous(res):
     te0 = jnp.where(te_in[k0], m.te_pairs[k0], 0.0)
     tin, tout = m.transfer_phi1[0], m.transfer_phi1[1]
     t = jnp.nan_to_num(jnp.stack([tin, tout]))
-    at = jnp.interp(t, phi, te0)
+    # pair 0's TE at the transfer angles: quadratic interpolation of the path's TE (which
+    # continues past the flank boundaries, so the stencil may reach beyond them)
+    h = phi[1] - phi[0]
+    at = jax.vmap(lambda x: interp_uniform(phi[0], h, res.path.te, x))(t)
     # a crossing of two TE curves: both pairs on the flank at the grid points around each
     # transfer angle (else the hand-over is at an edge: the grid value is returned)
     def on(k, tk):
@@ -132,8 +132,28 @@ def te_ptp_continuous(res):
     bottom = jnp.minimum(sgn * at[0], sgn * at[1])
     lo, up = jnp.minimum(tin, tout), jnp.maximum(tin, tout)
     window = ok & (phi >= lo) & (phi <= up)         # pair 0 carries the load
-    top = smooth_max(sgn * env / ARCSEC, window, TE_TEMPERATURE) * ARCSEC
+    top = _vertex_top(sgn * env, window)
     return jnp.where(found, (top - bottom) / ARCSEC, m.ptp / ARCSEC)
+
+
+def _vertex_top(f, window):
+    """The top of the envelope ``f`` (rad) inside ``window``: the vertex of the parabola
+    through the largest sample ``f_k`` and its neighbours,
+
+        top = f_k + (f_{k+1} - f_{k-1})^2 / (8 (2 f_k - f_{k-1} - f_{k+1})),
+
+    exact for a parabolic TE wherever the grid falls, so that it moves continuously
+    (value and gradient) when the largest sample passes from one grid point to the next
+    (the sample maximum, or a log-sum-exp of the samples at a small temperature, has a
+    gradient that jumps there).  The sample maximum where a neighbour is outside the
+    window or the samples do not curve downwards."""
+    g = jnp.where(window, f, -jnp.inf)
+    k = jnp.clip(jnp.argmax(g), 1, f.shape[0] - 2)
+    a, b, c = f[k - 1], f[k], f[k + 1]
+    curv = 2.0 * b - a - c
+    inner = window[k - 1] & window[k] & window[k + 1] & (curv > 0.0)
+    vertex = b + (c - a) ** 2 / (8.0 * jnp.where(inner, curv, 1.0))
+    return jnp.where(inner & (vertex >= jnp.max(g)), vertex, jnp.max(g))
 
 
 #: temperature of the smooth largest transfer gap (arcsec)
@@ -172,7 +192,7 @@ def _peak_pressure(res, eff, mask, pair):
 
 QUANTITIES: dict = {
     "te_ptp_arcsec": Quantity(
-        "arcsec", False, False, TE_TEMPERATURE,
+        "arcsec", False, False, None,
         "peak-to-peak of the unloaded TE envelope over one pitch, hand-overs at their "
         "continuous positions (te_ptp_continuous)",
         lambda res, eff, mask, pair: te_ptp_continuous(res)),
