@@ -221,15 +221,18 @@ def test_continuous_te_ptp_is_exact_for_a_parabolic_te_wherever_the_grid_falls()
     its derivative in the curvature ``a`` is (p/2)^2.  The sample maximum (or a smooth
     maximum at a small temperature) misses the vertex by up to a (h/2)^2 and its
     derivative jumps as the top passes a grid point; linear interpolation of the bottom
-    errs by a h^2/8.  Contact ratio 1.4: a grid point always lies between each
-    crossing and the flank boundary."""
+    errs by a h^2/8.  Contact ratios 1.4 (a grid point always lies between each
+    crossing and the flank boundary) and 1.1 (at some offsets none does: the grid alone
+    would take the hand-over for an edge and fall back to the grid value)."""
+    import itertools
+
     import jax
     from gearjax.studies.quantities import te_ptp_continuous
     p = 2 * np.pi / 10
-    for frac in (0.0, 0.013, -0.041):
+    for frac, w in itertools.product((0.0, 0.013, -0.041), (0.7, 0.55)):
         for offset in np.linspace(0.0, 1.0, 8, endpoint=False):
             def ptp(a):
-                res = _parabolic_pair(frac * p, offset, w_pitches=0.7, a=a)[0]
+                res = _parabolic_pair(frac * p, offset, w_pitches=w, a=a)[0]
                 return te_ptp_continuous(res)
             a = 4.9e-4
             val, der = jax.value_and_grad(ptp)(a)

@@ -97,40 +97,49 @@ def te_ptp_continuous(res):
     The grid value ``res.ptp`` takes the envelope's extremes at grid points: its bottom
     -- where two tooth pairs hand over, between grid points -- snaps from point to point
     as the design moves, so its gradient jumps whenever the hand-over crosses one.  Here
-    the bottom is the TE of pair 0 at the two transfer angles ``res.transfer_phi1``
-    (linear interpolation of the crossing, continuous in the design; pair 0's TE there by
-    quadratic interpolation of the path), and the top is the vertex of the parabola
-    through the envelope's largest sample in pair 0's active interval between the two
-    transfer angles and its neighbours (:func:`_vertex_top`: exact for a parabolic TE,
-    where the sample maximum errs by up to ``kappa h^2/8`` and its gradient jumps).  For the coast side (the
-    envelope is the minimum over the pairs) top and bottom change roles.  Where a
-    transfer angle is not found (conjugate or touching pairs), or the hand-over is not a
-    crossing of two TE curves on the flank (an edge contact: the envelope jumps there), it
-    is the grid value.
+    the bottom is pair 0's TE at the two crossings of its TE curve with those of the
+    neighbouring pairs, ``TE_0(x) = TE_0(x + p)`` entering and ``TE_0(x) = TE_0(x - p)``
+    leaving (pair +-1 is pair 0 shifted by a pitch ``p``; three Newton steps from the
+    grid's transfer angles on the quadratic interpolant of the path's TE, which
+    continues past the flank boundaries), and the top is the vertex of the parabola
+    through the envelope's largest sample between the two crossings and its neighbours
+    (:func:`_vertex_top`: exact for a parabolic TE, where the sample maximum errs by up
+    to ``kappa h^2/8`` and its gradient jumps).  For the coast side (the envelope is the
+    minimum over the pairs) top and bottom change roles.  It is the grid value where a
+    transfer is not found (conjugate or touching pairs) or is not a crossing inside the
+    flanks: a continuous transfer gap (:func:`gearjax.tca.multi_pair.transfer_gaps`) not
+    below 0 or a contact ratio below 1 (an edge hand-over, where the envelope jumps).
+    The test does not depend on where the grid falls (the crossing may lie between the
+    last grid point on the flank and the flank boundary).
     """
     m = res.multi
-    phi = res.path.phi1
-    te_in = m.inside & jnp.isfinite(m.te_pairs)
+    path = res.path
+    phi = path.phi1
     env = m.envelope
     ok = jnp.isfinite(env)
     sgn = m.sign          # +1 when the envelope is the maximum over the pairs
-    k0 = m.te_pairs.shape[0] // 2
-    te0 = jnp.where(te_in[k0], m.te_pairs[k0], 0.0)
-    tin, tout = m.transfer_phi1[0], m.transfer_phi1[1]
-    t = jnp.nan_to_num(jnp.stack([tin, tout]))
-    # pair 0's TE at the transfer angles: quadratic interpolation of the path's TE (which
-    # continues past the flank boundaries, so the stencil may reach beyond them)
     h = phi[1] - phi[0]
-    at = jax.vmap(lambda x: interp_uniform(phi[0], h, res.path.te, x))(t)
-    # a crossing of two TE curves: both pairs on the flank at the grid points around each
-    # transfer angle (else the hand-over is at an edge: the grid value is returned)
-    def on(k, tk):
-        return jax.lax.stop_gradient(jnp.interp(tk, phi, te_in[k].astype(float))) > 1.0 - 1e-12
 
-    on = jnp.stack([on(k0, t[0]), on(k0 - 1, t[0]), on(k0, t[1]), on(k0 + 1, t[1])])
-    found = jnp.isfinite(tin) & jnp.isfinite(tout) & jnp.all(on)
+    def te0(x):
+        return interp_uniform(phi[0], h, path.te, x)
+
+    def crossing(x, shift):
+        for _ in range(3):
+            d, dd = jax.jvp(lambda y: te0(y) - te0(y + shift), (x,), (jnp.ones_like(x),))
+            x = x - jnp.where(dd != 0.0, d / jnp.where(dd != 0.0, dd, 1.0), 0.0)
+        return x
+
+    t_grid = jnp.nan_to_num(m.transfer_phi1)
+    p = jnp.nan_to_num(m.pitch)
+    t = jnp.stack([crossing(t_grid[0], p), crossing(t_grid[1], -p)])
+    gaps = jnp.stack(transfer_gaps(path, res.margin, m))
+    found = jax.lax.stop_gradient(
+        jnp.all(jnp.isfinite(m.transfer_phi1)) & jnp.all(jnp.isfinite(t))
+        & jnp.all(gaps < 0.0) & (m.contact_ratio >= 1.0))
+    t = jnp.where(found, t, t_grid)          # no NaN in the branch not taken
+    at = jax.vmap(te0)(t)
     bottom = jnp.minimum(sgn * at[0], sgn * at[1])
-    lo, up = jnp.minimum(tin, tout), jnp.maximum(tin, tout)
+    lo, up = jnp.minimum(t[0], t[1]), jnp.maximum(t[0], t[1])
     window = ok & (phi >= lo) & (phi <= up)         # pair 0 carries the load
     top = _vertex_top(sgn * env, window)
     return jnp.where(found, (top - bottom) / ARCSEC, m.ptp / ARCSEC)
