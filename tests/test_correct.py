@@ -291,9 +291,15 @@ def test_bad_measurement_files_are_refused(tmp_path, capsys, ref_file):
                     "deviation_um = nan", "finite")
     # deviations in mm
     _one_line_error(capsys, base + [file("mm.csv", rows, dev="0.0015")], "look like mm")
-    # beyond the sane bound
+    # beyond the sane bound, on both sides
     _one_line_error(capsys, base + [file("b.csv", rows[:3] + [rows[3] + "2500"] + rows[4:])],
                     "2500", "[-1000, 1000] um")
+    _one_line_error(capsys, base + [file("c.csv", rows[:3] + [rows[3] + "-2500"] + rows[4:])],
+                    "-2500", "[-1000, 1000] um")
+    # deviations in mm, all negative (an undersize part)
+    _one_line_error(capsys, base + [file("mn.csv", rows, dev="-0.0015")], "look like mm")
+    # every point present and one given twice
+    _one_line_error(capsys, base + [file("d.csv", rows + [rows[5]])], "given twice")
     # unknown setting, named with the allowed list
     ok = file("ok.csv", rows)
     msg = _one_line_error(capsys, base + [ok, "--settings", "point_radius,frobnicate"],
@@ -327,6 +333,15 @@ def test_cli_writes_the_corrected_design(sb, tmp_path, capsys):
     doc = (Path(__file__).resolve().parent.parent / "docs" / "correct.md").read_text()
     for k in rep:
         assert k in EPILOG and f"`{k}`" in doc, k
+    # --regularisation reaches the fit: the library's fit with that alpha
+    strong_argv = ["correct", SB, "--measured", str(meas), "--out", str(tmp_path / "s.toml")]
+    assert main(strong_argv + ["--json", "--regularisation", "0.5"]) == 0
+    strong = json.loads(capsys.readouterr().out)
+    lib = fc.correct_flanks(fc.correction_problem(sb, read_measured_grid(meas)),
+                            regularisation=0.5)
+    assert strong["regularisation"] == 0.5
+    assert strong["fitted_error"] == pytest.approx(dict(lib.fitted), rel=1e-9)
+    assert strong["fitted_error"] != rep["fitted_error"]
     new = gearjax.load_design(str(out))
     # the corrected design cut with the machine's errors
     recut = fc.with_setting_errors(new, "pinion", errors)
@@ -404,3 +419,49 @@ def test_a_windows_export_reads_the_same(ref_file, tmp_path):
     b = read_measured_grid(p, require_deviations=False)
     assert (a.member, a.n_xi, a.n_s, a.flanks) == (b.member, b.n_xi, b.n_s, b.flanks)
     np.testing.assert_array_equal(a.points, b.points)
+
+
+def test_reference_grid_of_one_flank_with_unequal_margins(sb, tmp_path):
+    """``--flank convex`` writes that flank only (9 x 5 rows), and the face and height
+    margins go where they are named: the grid equals the library's flank grid with those
+    margins, xi spans [-1 + 2 m_f, 1 - 2 m_f] and the blade fraction [m_h, 1 - m_h]."""
+    from gearjax.gears.hypoid.flank import flank_surface
+    out = tmp_path / "convex.csv"
+    assert main(["surface", SB, "--member", "pinion", "--flank", "convex", "--reference-grid",
+                 "--face-margin", "0.05", "--height-margin", "0.3", "--out", str(out)]) == 0
+    m = read_measured_grid(out, require_deviations=False)
+    assert m.flanks == ("convex",) and m.points.shape == (1, 9, 5, 3)
+    g = flank_surface(sb.flank("pinion", "convex"), 9, 5, face_margin=0.05, height_margin=0.3)
+    np.testing.assert_allclose(m.points[0], np.asarray(g.points), atol=1e-9)
+    np.testing.assert_allclose(np.asarray(g.xi)[[0, -1]], [-0.9, 0.9], atol=1e-12)
+    s = np.asarray(g.params)[..., 0]                     # blade position, root -> tip
+    frac = (s - s[:, :1]) / (s[:, -1:] - s[:, :1])
+    np.testing.assert_allclose(frac[:, [1, 2, 3]], np.broadcast_to([0.25, 0.5, 0.75], (9, 3)),
+                               atol=1e-9)
+    rows = [ln for ln in out.read_text().splitlines() if ln.startswith("convex,")]
+    assert len(rows) == 45 and not any(ln.startswith("concave,") for ln in
+                                       out.read_text().splitlines())
+
+
+def test_deviation_maps_are_drawn_root_at_the_bottom(monkeypatch, tmp_path):
+    """The before/after figure draws deviation[i, j] (face position i, blade point j from
+    the root) at x = xi[i], y = height[j]: an array that is not symmetric, read back from
+    what the figure plots."""
+    import matplotlib.axes
+    from gearjax.plot.correction import save_correction_plot
+    seen = []
+    orig = matplotlib.axes.Axes.pcolormesh
+
+    def spy(self, X, Y, C, **kw):
+        seen.append((np.asarray(X), np.asarray(Y), np.asarray(C)))
+        return orig(self, X, Y, C, **kw)
+
+    monkeypatch.setattr(matplotlib.axes.Axes, "pcolormesh", spy)
+    xi, h = np.linspace(-0.8, 0.8, 4), np.linspace(0.1, 0.9, 3)
+    before = np.arange(12.0).reshape(1, 4, 3)            # before[0, i, j] = 3 i + j
+    save_correction_plot(tmp_path / "m.png", ["convex"], xi, h, before, before * 0.1)
+    X, Y, C = seen[0]
+    for i, j in ((0, 0), (3, 0), (0, 2), (2, 1)):
+        assert C[j, i] == before[0, i, j]                # C rows: y (height), columns: x
+    np.testing.assert_array_equal(X, xi)
+    np.testing.assert_array_equal(Y, h)
