@@ -102,17 +102,14 @@ def _parabolic_pair(delta, offset, m=8, z1=10, w_pitches=0.55, a=4.9e-4):
     from gearjax.tca.path import multi_pair
     p = 2 * np.pi / z1
     n = 4 * m + 1
-    phi = (np.arange(n) - n // 2 + offset) * (p / m)
+    phi = (jnp.arange(n) - n // 2 + offset) * (p / m)       # traceable in every argument
     te = -a * (phi - delta) ** 2
-    margin = w_pitches * p - np.abs(phi)
-    base = _result(np.ones(N), np.zeros((3, N)), np.ones((3, N), bool), [0.0, 0.0], 1.0).path
+    margin = w_pitches * p - jnp.abs(phi)
     z, z3 = jnp.zeros(n), jnp.zeros((n, 3))
-    path = ContactPath(jnp.asarray(phi), z, jnp.asarray(te), jnp.zeros((n, 2)),
-                       jnp.zeros((n, 2)), z3, z3, z3, z3, z, z, z, z, z + 1.0, z + 0.5, z3, z,
-                       jnp.ones(n, bool))
-    assert type(path) is type(base)
-    multi = multi_pair(path, jnp.asarray(margin), m, z1)
-    return TCAResult(path, jnp.asarray(margin), multi, {}, None, "drive", "test"), phi, p
+    path = ContactPath(phi, z, te, jnp.zeros((n, 2)), jnp.zeros((n, 2)), z3, z3, z3, z3, z,
+                       z, z, z, z + 1.0, z + 0.5, z3, z, jnp.ones(n, bool))
+    multi = multi_pair(path, margin, m, z1)
+    return TCAResult(path, margin, multi, {}, None, "drive", "test"), phi, p
 
 
 def test_edge_flag_does_not_depend_on_where_the_grid_falls():
@@ -138,6 +135,7 @@ def test_edge_flag_does_not_depend_on_where_the_grid_falls():
             assert f["edge_contact"] is edge, (frac, offset, gap_out / gj.ARCSEC)
             assert not (f["face_end_contact"] or f["tip_contact"] or f["low_contact_ratio"])
             cross = delta + p / 2
+            phi = np.asarray(phi)
             uncovered += (not edge) and not np.any((phi > cross) & (phi <= w * p))
     assert uncovered >= 4        # the offsets where the grid alone would flag an edge
 
@@ -229,13 +227,16 @@ def test_continuous_te_ptp_is_exact_for_a_parabolic_te_wherever_the_grid_falls()
     import jax
     from gearjax.studies.quantities import te_ptp_continuous
     p = 2 * np.pi / 10
+
+    @jax.jit
+    def value_and_derivative(a, delta, offset, w):
+        return jax.value_and_grad(lambda aa: te_ptp_continuous(
+            _parabolic_pair(delta, offset, w_pitches=w, a=aa)[0]))(a)
+
     for frac, w in itertools.product((0.0, 0.013, -0.041), (0.7, 0.55)):
         for offset in np.linspace(0.0, 1.0, 8, endpoint=False):
-            def ptp(a):
-                res = _parabolic_pair(frac * p, offset, w_pitches=w, a=a)[0]
-                return te_ptp_continuous(res)
             a = 4.9e-4
-            val, der = jax.value_and_grad(ptp)(a)
+            val, der = value_and_derivative(a, frac * p, offset, w)
             want = a * (p / 2) ** 2 / gj.ARCSEC
             assert float(val) == pytest.approx(want, rel=1e-9), (frac, offset)
             assert float(der) == pytest.approx((p / 2) ** 2 / gj.ARCSEC, rel=1e-9)
