@@ -465,3 +465,25 @@ def test_deviation_maps_are_drawn_root_at_the_bottom(monkeypatch, tmp_path):
         assert C[j, i] == before[0, i, j]                # C rows: y (height), columns: x
     np.testing.assert_array_equal(X, xi)
     np.testing.assert_array_equal(Y, h)
+
+
+# -- the notebook of this subject (tests/notebook_run.py)
+
+def test_flank_correction_notebook_measures_corrects_and_verifies(tmp_path):
+    """notebooks/07_flank_correction.ipynb: the fit recovers the machine's errors within
+    3 sigma, the recut flank is within the noise of the nominal one, and the bearing the
+    errors moved (by 0.019 in xi) comes back to the nominal one within 0.005."""
+    import re
+    from notebook_run import images, run_notebook
+    nb, text = run_notebook("07_flank_correction", tmp_path)
+    assert images(nb) == 1
+    assert "converged: True" in text
+    assert float(re.search(r"largest error of the fit: ([0-9.]+) sigma", text).group(1)) < 3.0
+    cut, recut = (float(v) for v in re.search(
+        r"as cut ([0-9.]+) um, recut ([0-9.]+) um", text).groups())
+    assert cut > 20.0 and recut < 0.5
+    xi = {m.group(1).strip(): float(m.group(2)) for m in re.finditer(
+        r"TCA (\w[\w ]*?)\s*: TE p-t-p\s+[0-9.]+ arcsec, bearing xi ([+-][0-9.]+)", text)}
+    assert abs(xi["as cut"] - xi["nominal"]) > 0.01
+    assert abs(xi["recut"] - xi["nominal"]) < 0.005
+    assert (tmp_path / "pinion_measured.csv").exists()
