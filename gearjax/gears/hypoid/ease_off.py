@@ -43,7 +43,7 @@ import numpy as np
 
 from gearjax import frames
 from gearjax.errors import ConvergenceError
-from gearjax.gears.hypoid.flank import chain_normal, chain_point, flank_surface, machine_chain
+from gearjax.gears.hypoid.flank import flank_surface, machine_chain, point_and_first_equation
 from gearjax.newton import newton_solve
 from gearjax.gears.hypoid.flank_correction import (DEFAULT_GENERATED, ROTATION, correct_flanks,
                                                    corrected_design, line_deviations,
@@ -72,22 +72,14 @@ def _circle_system(y, p):
     """The flank point ``r_w(s, theta, psi)`` on the circle ``Rz(a) P`` about the axis:
     ``y = (theta, s, psi, a)`` (generated flank: with its meshing equation)."""
     k, P = p
-    th, s, psi, a = y[0], y[1], y[2], y[3]
-    uv = jnp.stack([th, s])
-    r, v = jax.jvp(lambda q: chain_point(k, uv, q), (psi,), (jnp.ones_like(psi),))
-    f1 = jnp.dot(chain_normal(k, uv, psi), v)
-    return jnp.concatenate([r - frames.matrix_z(a) @ P, f1[None]])
+    r, f1 = point_and_first_equation(k, y[1], y[0], y[2])
+    return jnp.concatenate([r - frames.matrix_z(y[3]) @ P, f1[None]])
 
 
 @jax.jit
 def _circle_solve(fl, P, y0):
     return newton_solve(_circle_system, y0, (machine_chain(fl), P), tol=1e-10,
                         noise_floor=True)
-
-
-def _rz(a):
-    c, s = math.cos(a), math.sin(a)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
 def ease_off_problem(design, side: str, target_um=None, *, settings=None, grid=(9, 5),
@@ -127,7 +119,7 @@ def ease_off_problem(design, side: str, target_um=None, *, settings=None, grid=(
         raise ConvergenceError(f"ease-off: the conjugate pinion's mid point turned about the "
                                f"axis meets the {flank} pinion flank nowhere near (residual "
                                f"{float(res.residual):.3g} mm)")
-    R = _rz(float(res.x[3]))
+    R = np.asarray(frames.matrix_z(float(res.x[3])))
     lines = FlankGrid(Pc @ R.T, Nc @ R.T, np.asarray(real.params), np.asarray(real.xi),
                       np.asarray(gc.residual), np.asarray(gc.converged))
     tgt = np.zeros((n_xi, n_s)) if target_um is None else np.asarray(target_um, float)

@@ -331,8 +331,9 @@ def _target(b: MemberBlank, xi0):
     return b.outer_cone_distance - 0.5 * b.face_width * (1.0 - xi0)
 
 
-def _point_and_first_eq(k: MachineChain, s, th, psi):
-    """Work point and the first equation (meshing, or ``psi`` for formate): one pass."""
+def point_and_first_equation(k: MachineChain, s, th, psi):
+    """Work point and the first equation of every solve on the flank: the meshing
+    equation of a generated flank, ``psi`` itself for a formate one (one pass)."""
     if k.generated:
         r, n, v = _carried(k, s, th, psi)
         return r, jnp.dot(n, v)
@@ -342,14 +343,14 @@ def _point_and_first_eq(k: MachineChain, s, th, psi):
 def _F_tip(x, p):
     k, b, xi0 = p
     s, th, psi = x[0], x[1], x[2]
-    r, f1 = _point_and_first_eq(k, s, th, psi)
+    r, f1 = point_and_first_equation(k, s, th, psi)
     return jnp.stack([f1, pitch_distance(b, r) - _target(b, xi0), face_cone_gap(b, r)])
 
 
 def _F_point(x, p):
     k, b, s, xi0 = p
     th, psi = x[0], x[1]
-    r, f1 = _point_and_first_eq(k, s, th, psi)
+    r, f1 = point_and_first_equation(k, s, th, psi)
     return jnp.stack([f1, pitch_distance(b, r) - _target(b, xi0)])
 
 

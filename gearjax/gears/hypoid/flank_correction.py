@@ -71,7 +71,7 @@ import numpy as np
 from gearjax import frames, optimize
 from gearjax.errors import check_int, check_range
 from gearjax.gears.hypoid.design_file import design_from_dict, flank_settings_table
-from gearjax.gears.hypoid.flank import chain_normal, chain_point, machine_chain
+from gearjax.gears.hypoid.flank import machine_chain, point_and_first_equation
 from gearjax.gears.hypoid.pair import program_pair
 from gearjax.io import check_on_reference
 from gearjax.newton import newton_solve
@@ -135,13 +135,8 @@ def apply_settings(fl, delta):
 def _line_system(y, p):
     """Line-flank intersection (module docstring): ``y = (theta, s, psi, t)``."""
     k, P, n = p
-    th, s, psi, t = y[0], y[1], y[2], y[3]
-    uv = jnp.stack([th, s])
-    if k.generated:
-        r, v = jax.jvp(lambda q: chain_point(k, uv, q), (psi,), (jnp.ones_like(psi),))
-        f1 = jnp.dot(chain_normal(k, uv, psi), v)
-    else:
-        r, f1 = chain_point(k, uv, psi), psi
+    r, f1 = point_and_first_equation(k, y[1], y[0], y[2])
+    t = y[3]
     return jnp.concatenate([r - P - t * n, f1[None]])
 
 
@@ -424,8 +419,7 @@ class CorrectionResult:
 
 def _combination(v, names):
     """'0.71 radial_distance - 0.70 cradle_angle' of a singular vector (terms >= 0.1)."""
-    v = v / np.max(np.abs(v)) * (1.0 if v[np.argmax(np.abs(v))] > 0 else -1.0)
-    v = v / np.linalg.norm(v)
+    v = np.sign(v[np.argmax(np.abs(v))]) * v / np.linalg.norm(v)    # largest term > 0
     order = [i for i in np.argsort(-np.abs(v)) if abs(v[i]) >= 0.1]
     parts = []
     for m, i in enumerate(order):
