@@ -64,6 +64,9 @@ class InvoluteFile(DesignFileMixin):
 
     data: dict = field(compare=True)
     design: InvoluteTCA = field(compare=False)
+    #: the ``[microgeometry]`` tables (:class:`~gearjax.gears.involute.microgeometry.MicroGeometry`),
+    #: or None without them
+    micro: object = field(default=None, compare=False)
 
     def defaults_lines(self) -> list:
         """The documented defaults this design relies on (printable lines)."""

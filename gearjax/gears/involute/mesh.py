@@ -24,7 +24,7 @@ from gearjax.gears.involute.geometry import pair_geometry
 from gearjax.loading.loaded_contact import MeshTeeth
 from gearjax.tca.result import TCAResult
 
-__all__ = ["involute_mesh_teeth", "check_mesh_supported", "ohlendorf_loss_factor"]
+__all__ = ["involute_mesh_teeth", "virtual_teeth", "check_mesh_supported", "ohlendorf_loss_factor"]
 
 
 def check_mesh_supported(des, line_contact: bool) -> None:
@@ -39,14 +39,6 @@ def involute_mesh_teeth(des, res: TCAResult, line_contact: bool,
                         drive: bool) -> MeshTeeth:
     """:class:`~gearjax.loading.loaded_contact.MeshTeeth` of the involute pair along the path of
     ``res`` (traceable; module docstring)."""
-    p = des.pair
-    geo = pair_geometry(p)
-    beta = p.helix
-    cb = jnp.cos(geo["beta_b"]) ** 2 * jnp.cos(beta)
-    z = jnp.stack([p.z1 / cb, p.z2 / cb]).astype(float)
-    mn = p.module
-    r_ref = jnp.stack([0.5 * p.z1 * mn / jnp.cos(beta), 0.5 * p.z2 * mn / jnp.cos(beta)])
-    r_load = 0.5 * z[:, None] * mn + (jnp.stack([res.path.radial1, res.path.radial2]) - r_ref[:, None])
     b = des.face_width
     if line_contact:
         width = jnp.full(res.path.phi1.shape, 1.0) * b
@@ -55,8 +47,25 @@ def involute_mesh_teeth(des, res: TCAResult, line_contact: bool,
         width = jnp.minimum(2.0 * jnp.nan_to_num(res.path.semi_major, nan=0.0, posinf=1e9), b)
         width = jnp.where(width > 0.0, width, b)
         line = None
+    return virtual_teeth(des.pair, res.path.radial1, res.path.radial2, width, line, drive,
+                         des.dalpha)
+
+
+def virtual_teeth(p, radial1, radial2, width, line, drive, dalpha=0.0) -> MeshTeeth:
+    """:class:`~gearjax.loading.loaded_contact.MeshTeeth` of the pair ``p`` at contact radii
+    ``radial1``, ``radial2`` (mm, transverse, any shape (N,)) carried over ``width``
+    (mm) and, for a line contact, along ``line`` (mm; ``None`` for a point contact):
+    the virtual spur gears of the normal section (module docstring); ``dalpha`` the
+    pinion rack's pressure-angle change (rad).  Traceable."""
+    geo = pair_geometry(p)
+    beta = p.helix
+    cb = jnp.cos(geo["beta_b"]) ** 2 * jnp.cos(beta)
+    z = jnp.stack([p.z1 / cb, p.z2 / cb]).astype(float)
+    mn = p.module
+    r_ref = jnp.stack([0.5 * p.z1 * mn / jnp.cos(beta), 0.5 * p.z2 * mn / jnp.cos(beta)])
+    r_load = 0.5 * z[:, None] * mn + (jnp.stack([radial1, radial2]) - r_ref[:, None])
     one = jnp.ones(2)
-    return MeshTeeth(z, mn, jnp.stack([p.pressure_angle + des.dalpha, p.pressure_angle]),
+    return MeshTeeth(z, mn, jnp.stack([p.pressure_angle + dalpha, p.pressure_angle]),
                      beta, jnp.stack([p.x1, p.x2]), one, 1.25 * one, r_load, width, line,
                      jnp.asarray(drive))
 

@@ -1,0 +1,156 @@
+"""Public entry points of the loaded line contact (:mod:`gearjax.gears.involute.line_load`):
+one operating point, and the map over a torque range and a misalignment set in one
+vmapped program.
+
+``design`` is an :class:`~gearjax.gears.involute.tca.InvoluteTCA` (no micro-geometry
+unless ``mods`` is given) or an involute design file (its ``[microgeometry]`` tables
+and ``[material]``).  The rack mismatches of the TCA route (``dalpha``,
+``profile_crown``, ``lead_crown``) are not flank modifications of this model and are
+refused; their flank-side equivalents are the micro-geometry fields.
+
+Every input is checked before any work (one-line ``ValueError`` naming the parameter,
+its value and the allowed range); the programs are jitted once per option set.
+Units: N m for torques, µm for misalignments and TEs, mm, MPa.
+"""
+
+from __future__ import annotations
+
+from functools import partial
+from typing import NamedTuple
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from gearjax.errors import check_int, check_range
+from gearjax.gears.involute.line_load import (LineLoad, LineLoadOptions, line_load_traced,
+                                              pair_range, smooth_ptp)
+from gearjax.gears.involute.microgeometry import (MicroGeometry, PairModification,
+                                                  check_modification)
+from gearjax.loading.loaded_contact import COMPLIANCE_MODELS
+from gearjax.loading.materials import pair_material
+
+__all__ = ["line_contact", "loaded_te_map", "LoadedTEMap", "line_design",
+           "TORQUE_RANGE_NM", "MISALIGNMENT_RANGE_UM"]
+
+#: accepted pinion torques (N m)
+TORQUE_RANGE_NM = (1e-3, 1e7)
+#: accepted mesh misalignments (µm)
+MISALIGNMENT_RANGE_UM = (-1000.0, 1000.0)
+
+
+def line_design(design, mods=None, side: str = "drive"):
+    """``(pair, face_width, mods, material)`` of ``design`` for the line-contact model
+    (module docstring); ``mods`` (a :class:`PairModification`) replaces the design's."""
+    from gearjax.gears.involute.design_file import InvoluteFile
+    from gearjax.gears.involute.tca import InvoluteTCA
+    if side not in ("drive", "coast"):
+        raise ValueError(f"side = {side!r} must be 'drive' or 'coast'")
+    micro = None
+    des = design
+    if isinstance(design, InvoluteFile):
+        des, micro = design.design, design.micro
+    if not isinstance(des, InvoluteTCA):
+        raise TypeError(f"the loaded line contact is for involute pairs, not a "
+                        f"{type(design).__name__}")
+    for k in ("dalpha", "profile_crown", "lead_crown"):
+        v = float(getattr(des, k))
+        if v != 0.0:
+            raise ValueError(f"{k} = {v:g}: the line-contact model takes flank modifications "
+                             "([microgeometry] / PairModification), not the rack mismatches of "
+                             "the TCA route")
+    if mods is None:
+        mods = (micro if micro is not None else MicroGeometry.none()).flanks(side)
+    if not isinstance(mods, PairModification):
+        raise TypeError(f"mods must be a PairModification, not a {type(mods).__name__}")
+    check_modification(mods.pinion, "pinion."), check_modification(mods.gear, "gear.")
+    return des.pair, des.face_width, mods, pair_material(design)
+
+
+def _options(pair, b, positions, slices, compliance):
+    check_int("positions", positions, lo=4, hi=1024)
+    check_int("slices", slices, lo=1, hi=400)
+    if compliance not in COMPLIANCE_MODELS:
+        raise ValueError(f"compliance = {compliance!r} must be one of {COMPLIANCE_MODELS}")
+    k_lo, k_hi = pair_range(pair, b)
+    return LineLoadOptions(int(positions), int(slices), k_lo, k_hi, compliance)
+
+
+@partial(jax.jit, static_argnames=("opts", "drive"))
+def _one(pair, b, mods, T, f_ma, E, nu, opts, drive):
+    return line_load_traced(pair, b, mods, T, f_ma, opts, E, nu, drive)
+
+
+def line_contact(design, torque_Nm, *, mods=None, misalignment_um=0.0, side="drive",
+                 positions=32, slices=20, compliance="weber") -> LineLoad:
+    """The loaded line contact of ``design`` at ``torque_Nm`` (pinion, N m) and mesh
+    misalignment ``misalignment_um`` (µm over the face width): a
+    :class:`~gearjax.gears.involute.line_load.LineLoad` over one mesh cycle
+    (``positions`` per base pitch, ``slices`` across the face)."""
+    T = check_range("torque_Nm", torque_Nm, *TORQUE_RANGE_NM, unit="N m")
+    f = check_range("misalignment_um", misalignment_um, *MISALIGNMENT_RANGE_UM, unit="um")
+    pair, b, mods, mat = line_design(design, mods, side)
+    opts = _options(pair, b, positions, slices, compliance)
+    return _one(pair, b, mods, 1e3 * T, f, mat.youngs_modulus_MPa, mat.poisson, opts,
+                side == "drive")
+
+
+class LoadedTEMap(NamedTuple):
+    """Loaded-TE summaries over torques x misalignments (shapes (T, A)).
+
+    torque_Nm : (T,).  misalignment_um : (A,).
+    te_ptp_um : peak-to-peak of the loaded TE over the cycle (µm).
+    te_ptp_smooth_um : its smooth form (:func:`~gearjax.gears.involute.line_load.smooth_ptp`
+        at ``temperature_um``), the one to differentiate.
+    te_mean_um : mean loaded TE (µm).  p_max : highest Hertz pressure (MPa).
+    k_hbeta : face load factor of the cycle-mean distribution.  end_load : highest
+        end-slice load ratio over the cycle.
+    converged : every position of the cycle converged.
+    """
+
+    torque_Nm: jax.Array
+    misalignment_um: jax.Array
+    te_ptp_um: jax.Array
+    te_ptp_smooth_um: jax.Array
+    te_mean_um: jax.Array
+    p_max: jax.Array
+    k_hbeta: jax.Array
+    end_load: jax.Array
+    converged: jax.Array
+
+
+def te_map_traced(pair, b, mods, torques_Nmm, f_ma, E, nu, opts, drive, temperature_um):
+    """:class:`LoadedTEMap` fields over ``torques_Nmm`` (T,) x ``f_ma`` (A,) (traceable)."""
+    def one(T, f):
+        r = line_load_traced(pair, b, mods, T, f, opts, E, nu, drive)
+        te = r.te_loaded_um
+        return (jnp.max(te) - jnp.min(te), smooth_ptp(te, temperature_um), jnp.mean(te),
+                jnp.max(r.p_max), r.k_hbeta_mean, jnp.max(r.end_load), jnp.all(r.converged))
+
+    return jax.vmap(lambda T: jax.vmap(lambda f: one(T, f))(f_ma))(torques_Nmm)
+
+
+@partial(jax.jit, static_argnames=("opts", "drive"))
+def _map(pair, b, mods, T, f_ma, E, nu, temperature_um, opts, drive):
+    return te_map_traced(pair, b, mods, T, f_ma, E, nu, opts, drive, temperature_um)
+
+
+def loaded_te_map(design, torques_Nm, misalignments_um=(0.0,), *, mods=None, side="drive",
+                  positions=32, slices=20, compliance="weber",
+                  temperature_um=0.01) -> LoadedTEMap:
+    """Loaded TE, peak pressure and face load factor of ``design`` over every torque
+    (N m) and misalignment (µm) in one vmapped, jitted program (:class:`LoadedTEMap`)."""
+    T = np.atleast_1d(np.asarray(torques_Nm, float))
+    A = np.atleast_1d(np.asarray(misalignments_um, float))
+    if T.ndim != 1 or T.size == 0 or A.ndim != 1 or A.size == 0:
+        raise ValueError("torques_Nm and misalignments_um must be non-empty 1-D lists")
+    for t in T:
+        check_range("torques_Nm", t, *TORQUE_RANGE_NM, unit="N m")
+    for a in A:
+        check_range("misalignments_um", a, *MISALIGNMENT_RANGE_UM, unit="um")
+    check_range("temperature_um", temperature_um, 0.0, 10.0, lo_open=True, unit="um")
+    pair, b, mods, mat = line_design(design, mods, side)
+    opts = _options(pair, b, positions, slices, compliance)
+    out = _map(pair, b, mods, jnp.asarray(1e3 * T), jnp.asarray(A), mat.youngs_modulus_MPa,
+               mat.poisson, float(temperature_um), opts, side == "drive")
+    return LoadedTEMap(jnp.asarray(T), jnp.asarray(A), *out)
