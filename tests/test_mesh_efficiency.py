@@ -230,6 +230,41 @@ def test_line_contact_equivalent_ellipse_spans_the_face(spur, iso_run):
     np.testing.assert_allclose(a, 0.5 * B, rtol=5e-3)
 
 
+def test_line_contact_slices_reproduce_the_spur_chain(spur, weber_run):
+    """The thin-slice line-contact model (gearjax.gears.involute.line_load), run at the mesh
+    positions of the TCA chain's cycle, reproduces the chain's spur result: the same
+    pair loads and the same loaded fall-back (approach = y r_b2) at every position, for
+    any number of slices (the aligned unmodified spur face is uniform).  Two routes to
+    the same physics: the chain from the TCA's contacts, lever arms and curvatures, the
+    slices from closed-form involute geometry.  Planted bugs caught (either model): the
+    nominal line load of the contact term, the lever arms, the virtual-gear radii."""
+    from gearjax.gears.involute.line_load import LineLoadOptions, line_load_traced, pair_range
+    from gearjax.gears.involute.microgeometry import PairModification
+    from gearjax.loading.loaded_contact import pair_arrays
+    from gearjax.loading.mesh_efficiency import cycle_window
+    eff, res = weber_run
+    pair = spur[0]
+    geo = pair_geometry(pair)
+    rb1, rb2, rho_P = float(geo["rb1"]), float(geo["rb2"]), float(geo["rho_P"])
+    spp = eff.phi1.shape[0]
+    win = cycle_window(res.path.phi1.shape[0], spp)
+    r1 = np.asarray(pair_arrays(res.path.radial1, spp, 3, np.nan, win))
+    F_chain = np.asarray(eff.loaded.load)
+    k = np.argmax(F_chain, axis=0)                   # a loaded pair at each position
+    s0 = np.sqrt(r1[k, np.arange(spp)] ** 2 - rb1 ** 2) - rho_P
+    k_lo, k_hi = pair_range(pair, B)
+    for slices in (1, 7):
+        r = jax.jit(line_load_traced, static_argnames="opts")(
+            pair, B, PairModification.none(), 1e3 * TORQUE, 0.0,
+            LineLoadOptions(spp, slices, k_lo, k_hi, "weber"), s0=jnp.asarray(s0))
+        assert bool(np.all(np.asarray(r.converged)))
+        F_sl = np.sort(np.asarray(r.pair_load), axis=0)[::-1][:2]
+        np.testing.assert_allclose(F_sl, np.sort(F_chain, axis=0)[::-1][:2], rtol=1e-7,
+                                   atol=1e-7 * F_chain.max())
+        np.testing.assert_allclose(np.asarray(r.te_loaded_um),
+                                   1e3 * rb2 * np.asarray(eff.loaded.deflection), rtol=1e-7)
+
+
 def test_loaded_edge_contact_is_flagged_and_not_valid(spur, oil_surface, weber_run):
     """A crossed uncrowned spur pair (dSigma = 0.05 deg) touches at the leading face end
     (the closed form of tests/test_edge_contact.py): that edge contact is the one the

@@ -110,13 +110,15 @@ def pair_range(pair: InvolutePair, face_width, margin: int = 1) -> tuple[int, in
     """``(k_lo, k_hi)`` covering every pair on the path for mesh positions ``s0`` in
     one base pitch from ``s_A`` (concrete values): ``k`` from ``-ceil(eps_beta/2) - 1``
     to ``ceil(eps_alpha + eps_beta/2)``, widened by ``margin`` each way so that a
-    design moved by an optimiser keeps its pairs."""
+    design moved by an optimiser keeps its pairs, and to at least ``-3 .. 4`` (the
+    range is a static option: every pair with eps_beta <= 2 and eps_alpha + eps_beta/2
+    <= 3 then shares one compiled program)."""
     geo = pair_geometry(pair)
     p_bt = 2.0 * math.pi * float(geo["rb1"]) / pair.z1
     eps_a = float(geo["contact_ratio"])
     eps_b = float(face_width) * math.tan(float(geo["beta_b"])) / p_bt
-    return (-math.ceil(eps_b / 2.0) - 1 - margin,
-            math.ceil(eps_a + eps_b / 2.0) + margin)
+    return (min(-math.ceil(eps_b / 2.0) - 1 - margin, -3),
+            max(math.ceil(eps_a + eps_b / 2.0) + margin, 4))
 
 
 class LineLoad(NamedTuple):
@@ -215,9 +217,9 @@ def line_load_traced(pair: InvolutePair, face_width, mods: PairModification, tor
     frac = jnp.where(half > 0.0, jnp.clip((hi - lo) / jnp.where(half > 0.0, 2.0 * half, 1.0),
                                           0.0, 1.0),
                      ((sc >= s_A) & (sc <= s_E)).astype(float))
-    on = frac > 0.0
-    s = jnp.where(on, jnp.where(half > 0.0, 0.5 * (lo + hi), sc), 0.5 * (s_A + s_E))
     length = frac * dy / cb
+    on = length > 0.0           # (not frac > 0: a sliver's length may round to 0)
+    s = jnp.where(on, jnp.where(half > 0.0, 0.5 * (lo + hi), sc), 0.5 * (s_A + s_E))
     yy = jnp.broadcast_to(y, s.shape)
     xi1 = rho_P + s
     xi2 = g - xi1

@@ -15,6 +15,7 @@ Units: N m for torques, µm for misalignments and TEs, mm, MPa.
 
 from __future__ import annotations
 
+import dataclasses
 from functools import partial
 from typing import NamedTuple
 
@@ -76,9 +77,21 @@ def _options(pair, b, positions, slices, compliance):
     return LineLoadOptions(int(positions), int(slices), k_lo, k_hi, compliance)
 
 
+def _split(pair):
+    """``(blank, teeth)``: the pair with tooth numbers 0 and the tooth numbers as a (2,)
+    float array, so that one compiled program serves every pair of the same options
+    (the tooth numbers only enter arithmetic inside the model)."""
+    return (dataclasses.replace(pair, z1=0, z2=0),
+            jnp.asarray(np.array([pair.z1, pair.z2], dtype=float)))
+
+
+def _join(blank, teeth):
+    return dataclasses.replace(blank, z1=teeth[0], z2=teeth[1])
+
+
 @partial(jax.jit, static_argnames=("opts", "drive"))
-def _one(pair, b, mods, T, f_ma, E, nu, opts, drive):
-    return line_load_traced(pair, b, mods, T, f_ma, opts, E, nu, drive)
+def _one(blank, teeth, b, mods, T, f_ma, E, nu, opts, drive):
+    return line_load_traced(_join(blank, teeth), b, mods, T, f_ma, opts, E, nu, drive)
 
 
 def line_contact(design, torque_Nm, *, mods=None, misalignment_um=0.0, side="drive",
@@ -91,8 +104,8 @@ def line_contact(design, torque_Nm, *, mods=None, misalignment_um=0.0, side="dri
     f = check_range("misalignment_um", misalignment_um, *MISALIGNMENT_RANGE_UM, unit="um")
     pair, b, mods, mat = line_design(design, mods, side)
     opts = _options(pair, b, positions, slices, compliance)
-    return _one(pair, b, mods, 1e3 * T, f, mat.youngs_modulus_MPa, mat.poisson, opts,
-                side == "drive")
+    return _one(*_split(pair), b, mods, 1e3 * T, f, mat.youngs_modulus_MPa, mat.poisson,
+                opts, side == "drive")
 
 
 class LoadedTEMap(NamedTuple):
@@ -131,8 +144,9 @@ def te_map_traced(pair, b, mods, torques_Nmm, f_ma, E, nu, opts, drive, temperat
 
 
 @partial(jax.jit, static_argnames=("opts", "drive"))
-def _map(pair, b, mods, T, f_ma, E, nu, temperature_um, opts, drive):
-    return te_map_traced(pair, b, mods, T, f_ma, E, nu, opts, drive, temperature_um)
+def _map(blank, teeth, b, mods, T, f_ma, E, nu, temperature_um, opts, drive):
+    return te_map_traced(_join(blank, teeth), b, mods, T, f_ma, E, nu, opts, drive,
+                         temperature_um)
 
 
 def loaded_te_map(design, torques_Nm, misalignments_um=(0.0,), *, mods=None, side="drive",
@@ -151,6 +165,6 @@ def loaded_te_map(design, torques_Nm, misalignments_um=(0.0,), *, mods=None, sid
     check_range("temperature_um", temperature_um, 0.0, 10.0, lo_open=True, unit="um")
     pair, b, mods, mat = line_design(design, mods, side)
     opts = _options(pair, b, positions, slices, compliance)
-    out = _map(pair, b, mods, jnp.asarray(1e3 * T), jnp.asarray(A), mat.youngs_modulus_MPa,
+    out = _map(*_split(pair), b, mods, jnp.asarray(1e3 * T), jnp.asarray(A), mat.youngs_modulus_MPa,
                mat.poisson, float(temperature_um), opts, side == "drive")
     return LoadedTEMap(jnp.asarray(T), jnp.asarray(A), *out)
