@@ -230,14 +230,19 @@ def test_line_contact_equivalent_ellipse_spans_the_face(spur, iso_run):
     np.testing.assert_allclose(a, 0.5 * B, rtol=5e-3)
 
 
-def test_line_contact_slices_reproduce_the_spur_chain(spur, weber_run):
+def test_line_contact_slices_reproduce_the_spur_chain(spur, weber_run, oil_surface):
     """The thin-slice line-contact model (gearjax.gears.involute.line_load), run at the mesh
     positions of the TCA chain's cycle, reproduces the chain's spur result: the same
     pair loads and the same loaded fall-back (approach = y r_b2) at every position, for
     any number of slices (the aligned unmodified spur face is uniform).  Two routes to
     the same physics: the chain from the TCA's contacts, lever arms and curvatures, the
-    slices from closed-form involute geometry.  Planted bugs caught (either model): the
-    nominal line load of the contact term, the lever arms, the virtual-gear radii."""
+    slices from closed-form involute geometry.  The same for the sliding power loss at
+    every position (gearjax.gears.involute.line_efficiency: closed-form speeds, each
+    slice given its whole line's equivalent ellipse).  Planted bugs caught (either
+    model): the nominal line load of the contact term, the lever arms, the virtual-gear
+    radii, the entrainment speed halved or doubled, a slice's own length taken for the
+    line's."""
+    from gearjax.gears.involute.line_efficiency import line_efficiency_traced
     from gearjax.gears.involute.line_load import LineLoadOptions, line_load_traced, pair_range
     from gearjax.gears.involute.microgeometry import PairModification
     from gearjax.loading.loaded_contact import pair_arrays
@@ -263,6 +268,12 @@ def test_line_contact_slices_reproduce_the_spur_chain(spur, weber_run):
                                    atol=1e-7 * F_chain.max())
         np.testing.assert_allclose(np.asarray(r.te_loaded_um),
                                    1e3 * rb2 * np.asarray(eff.loaded.deflection), rtol=1e-7)
+    le = jax.jit(line_efficiency_traced, static_argnames="opts")(
+        pair, B, PairModification.none(), 1e3 * TORQUE, 0.0, RPM, *oil_surface,
+        LineLoadOptions(spp, 3, k_lo, k_hi, "weber"), s0=jnp.asarray(s0))
+    assert bool(np.all(np.asarray(le.valid)))
+    P = np.asarray(eff.power_loss)          # (at the pitch point u_s is zero to rounding)
+    np.testing.assert_allclose(np.asarray(le.power_loss), P, rtol=1e-6, atol=1e-12 * P.max())
 
 
 def test_loaded_edge_contact_is_flagged_and_not_valid(spur, oil_surface, weber_run):

@@ -82,7 +82,7 @@ from gearjax.tribology.lubricant import Oil
 __all__ = ["MeshEfficiency", "mesh_efficiency", "DEFAULT_COMPLIANCE", "COMPLIANCE_HELP",
            "check_efficiency_inputs", "efficiency_function", "mesh_efficiency_traced",
            "cycle_window", "check_operating_point", "cycle_summary", "CycleSummary", "soften_edges",
-           "TORQUE_RANGE_NM", "RPM_RANGE", "FILM_MIN_MM"]
+           "TORQUE_RANGE_NM", "RPM_RANGE", "FILM_MIN_MM", "equivalent_ry"]
 
 
 #: the default tooth compliance model of every route (Python and the command line)
@@ -215,7 +215,7 @@ def cycle_window(n_grid: int, steps_per_pitch: int) -> np.ndarray:
     return np.arange(steps_per_pitch) + (mid - steps_per_pitch // 2)
 
 
-def _equivalent_ry(F, r_x, L, E_prime):
+def equivalent_ry(F, r_x, L, E_prime):
     """R_y of the ellipse whose major semi-axis is L/2 under F (line contact)."""
     k2 = jnp.pi * E_prime * (0.5 * L) ** 3 / (6.0 * F * r_x)
     k = jnp.sqrt(jnp.maximum(k2, 1.0))
@@ -316,7 +316,7 @@ def mesh_efficiency_traced(res: TCAResult, teeth: MeshTeeth, torque_Nm, pinion_r
         L = pairs(jnp.where(on, teeth.line_length, 1.0), 1.0)
         Fs = jnp.where(F > 0.0, F, 1.0)
         R_x = rx_p
-        R_y = _equivalent_ry(Fs, R_x, L, E_prime)
+        R_y = equivalent_ry(Fs, R_x, L, E_prime)
         p_max, a_ax, b_ax = contact_stress(F, R_x, jnp.inf, E_prime, line_length=L)
     else:
         ry_p = pairs(jnp.where(on, r_y0, 1.0), 1.0)

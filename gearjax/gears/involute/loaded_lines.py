@@ -24,6 +24,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from gearjax.errors import check_int, check_range
+from gearjax.gears.involute.line_efficiency import line_efficiency_traced
 from gearjax.gears.involute.line_load import (LineLoad, LineLoadOptions, line_load_traced,
                                               pair_range, smooth_ptp)
 from gearjax.gears.involute.microgeometry import (MicroGeometry, PairModification,
@@ -118,7 +119,10 @@ class LoadedTEMap(NamedTuple):
     te_mean_um : mean loaded TE (µm).  p_max : highest Hertz pressure (MPa).
     k_hbeta : face load factor of the cycle-mean distribution.  end_load : highest
         end-slice load ratio over the cycle.
-    converged : every position of the cycle converged.
+    converged : every position of the cycle converged (and, with efficiency, every
+        loaded point's friction).
+    power_loss_W : mean sliding power loss over the cycle (W; NaN without ``pinion_rpm``).
+    efficiency : mesh efficiency over the cycle (NaN without ``pinion_rpm``).
     """
 
     torque_Nm: jax.Array
@@ -130,30 +134,49 @@ class LoadedTEMap(NamedTuple):
     k_hbeta: jax.Array
     end_load: jax.Array
     converged: jax.Array
+    power_loss_W: jax.Array
+    efficiency: jax.Array
 
 
-def te_map_traced(pair, b, mods, torques_Nmm, f_ma, E, nu, opts, drive, temperature_um):
-    """:class:`LoadedTEMap` fields over ``torques_Nmm`` (T,) x ``f_ma`` (A,) (traceable)."""
+def te_map_traced(pair, b, mods, torques_Nmm, f_ma, E, nu, opts, drive, temperature_um,
+                  lube=None):
+    """:class:`LoadedTEMap` fields (all but the two axes) over ``torques_Nmm`` (T,) x
+    ``f_ma`` (A,) (traceable).  ``lube``: ``(pinion_rpm, oil, surface, viscosity_model,
+    film_method)`` for the efficiency columns, or None."""
     def one(T, f):
-        r = line_load_traced(pair, b, mods, T, f, opts, E, nu, drive)
+        if lube is None:
+            r = line_load_traced(pair, b, mods, T, f, opts, E, nu, drive)
+            loss = eff = jnp.nan
+            ok = jnp.all(r.converged)
+        else:
+            rpm, oil, surface, vm, fm = lube
+            le = line_efficiency_traced(pair, b, mods, T, f, rpm, oil, surface, opts, E, nu,
+                                        drive, vm, fm)
+            r, loss, eff = le.loads, jnp.mean(le.power_loss), le.mean_efficiency
+            ok = jnp.all(le.valid)
         te = r.te_loaded_um
         return (jnp.max(te) - jnp.min(te), smooth_ptp(te, temperature_um), jnp.mean(te),
-                jnp.max(r.p_max), r.k_hbeta_mean, jnp.max(r.end_load), jnp.all(r.converged))
+                jnp.max(r.p_max), r.k_hbeta_mean, jnp.max(r.end_load), ok, loss, eff)
 
     return jax.vmap(lambda T: jax.vmap(lambda f: one(T, f))(f_ma))(torques_Nmm)
 
 
-@partial(jax.jit, static_argnames=("opts", "drive"))
-def _map(blank, teeth, b, mods, T, f_ma, E, nu, temperature_um, opts, drive):
+@partial(jax.jit, static_argnames=("opts", "drive", "vm", "fm"))
+def _map(blank, teeth, b, mods, T, f_ma, E, nu, temperature_um, rpm, oil, surface, opts,
+         drive, vm, fm):
+    lube = None if rpm is None else (rpm, oil, surface, vm, fm)
     return te_map_traced(_join(blank, teeth), b, mods, T, f_ma, E, nu, opts, drive,
-                         temperature_um)
+                         temperature_um, lube)
 
 
 def loaded_te_map(design, torques_Nm, misalignments_um=(0.0,), *, mods=None, side="drive",
-                  positions=32, slices=20, compliance="weber",
-                  temperature_um=0.01) -> LoadedTEMap:
+                  positions=32, slices=20, compliance="weber", temperature_um=0.01,
+                  pinion_rpm=None, oil=None, surface=None, viscosity_model="roelands",
+                  film_method="auto") -> LoadedTEMap:
     """Loaded TE, peak pressure and face load factor of ``design`` over every torque
-    (N m) and misalignment (µm) in one vmapped, jitted program (:class:`LoadedTEMap`)."""
+    (N m) and misalignment (µm) in one vmapped, jitted program (:class:`LoadedTEMap`);
+    with ``pinion_rpm``, ``oil`` and ``surface`` also the sliding power loss and the
+    mesh efficiency (:mod:`gearjax.gears.involute.line_efficiency`)."""
     T = np.atleast_1d(np.asarray(torques_Nm, float))
     A = np.atleast_1d(np.asarray(misalignments_um, float))
     if T.ndim != 1 or T.size == 0 or A.ndim != 1 or A.size == 0:
@@ -164,7 +187,18 @@ def loaded_te_map(design, torques_Nm, misalignments_um=(0.0,), *, mods=None, sid
         check_range("misalignments_um", a, *MISALIGNMENT_RANGE_UM, unit="um")
     check_range("temperature_um", temperature_um, 0.0, 10.0, lo_open=True, unit="um")
     pair, b, mods, mat = line_design(design, mods, side)
+    rpm = None
+    if pinion_rpm is not None:
+        from gearjax.loading.efficiency_inputs import check_efficiency_inputs
+        if oil is None or surface is None:
+            raise ValueError("pinion_rpm needs an oil and a surface for the efficiency")
+        check_efficiency_inputs(min(float(T[0]), 1e6), pinion_rpm, oil, surface,
+                                mat.e_prime_MPa, mat.poisson, compliance, viscosity_model,
+                                film_method)
+        rpm = float(pinion_rpm)
+        oil = dataclasses.replace(oil, name="")     # the label is not part of the program
     opts = _options(pair, b, positions, slices, compliance)
     out = _map(*_split(pair), b, mods, jnp.asarray(1e3 * T), jnp.asarray(A), mat.youngs_modulus_MPa,
-               mat.poisson, float(temperature_um), opts, side == "drive")
+               mat.poisson, float(temperature_um), rpm, oil, surface, opts, side == "drive",
+               viscosity_model, film_method)
     return LoadedTEMap(jnp.asarray(T), jnp.asarray(A), *out)
