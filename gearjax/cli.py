@@ -27,6 +27,7 @@ COMMANDS = [
     "gearjax.commands.kinematics",
     "gearjax.commands.tca",
     "gearjax.commands.efficiency",
+    "gearjax.commands.loaded",
     "gearjax.commands.optimize",
     "gearjax.commands.sensitivity",
     "gearjax.commands.sweep",

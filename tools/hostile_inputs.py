@@ -982,6 +982,81 @@ def build_cases() -> list[Case]:
                                         "--compliance", "steel"], "refuse",
         "unknown compliance model")
 
+    # ---------------------------------------------------------------- loaded
+    ld = ["loaded", "example:helical_microgeometry"]
+    small = ["--positions", "8", "--slices", "6"]
+    add("loaded.ok.json", [*ld, "--torque-Nm", "50,200", "--misalignment-um", "0,10", *small,
+                           "--json"], "ok", "README example (micro-geometry example), JSON",
+        heavy=True)
+    add("loaded.ok.range_table", [*ld, "--torque-Nm", "50:400:3", *small, "--side", "coast",
+                                  "--compliance", "iso6336"], "ok",
+        "a torque range, the coast side, the ISO 6336 compliance", heavy=True)
+    add("loaded.ok.inline_spur", ["loaded", TCA_INV, "--torque-Nm", "100", *small], "ok",
+        "an inline spur pair, unmodified flanks", heavy=True)
+    add("loaded.ok.plot", [*ld, "--torque-Nm", "100,200", *small, "--plot", "{tmp}/l.png"],
+        "ok", "the modification map and LTE figure", heavy=True)
+    for cid, torque, why in (
+            ("torque=0", "0", "torque at the lower bound, excluded"),
+            ("torque=-100", "-100", "negative torque"),
+            ("torque=nan", "nan", "NaN torque"),
+            ("torque=inf", "inf", "infinite torque"),
+            ("torque=1e300", "1e300", "torque far above the range"),
+            ("torque=abc", "abc", "not a number"),
+            ("torque=empty_item", "50,,100", "an empty list item"),
+            ("torque=empty", "", "no torque"),
+            ("torque=twice", "50,50", "a torque twice"),
+            ("range=two_parts", "50:100", "a range without COUNT"),
+            ("range=four_parts", "50:100:3:1", "a range with four parts"),
+            ("range=count_0", "50:100:0", "a range of no torque"),
+            ("range=count_float", "50:100:2.5", "a non-integer COUNT"),
+            ("range=count_huge", "50:100:100000", "COUNT above the limit"),
+            ("range=start_neg", "-50:100:3", "a negative START"),
+            ("range=one_unequal", "50:100:1", "COUNT 1 with START != STOP")):
+        add(f"loaded.{cid}", [*ld, "--torque-Nm", torque, *small], "refuse", why)
+    for cid, mis, why in (("mis=-2000", "-2000", "misalignment beyond the range"),
+                          ("mis=nan", "nan", "NaN misalignment"),
+                          ("mis=abc", "abc", "not a number"),
+                          ("mis=empty", "", "no misalignment")):
+        add(f"loaded.{cid}", [*ld, "--torque-Nm", "100", "--misalignment-um", mis, *small],
+            "refuse", why)
+    for flag, value in (("--positions", "2"), ("--positions", "1e6"), ("--positions", "nan"),
+                        ("--slices", "0"), ("--slices", "4.5"), ("--side", "both"),
+                        ("--compliance", "steel")):
+        add(f"loaded.{flag[2:]}={_slug(value)}",
+            [*ld, "--torque-Nm", "100", *_argv([("--positions", "8"), ("--slices", "6")],
+                                             {flag: value})], "refuse", f"{flag} {value}")
+    add("loaded.no_torque", [*ld], "refuse", "missing --torque-Nm")
+    add("loaded.hypoid_design", ["loaded", "example:hft_8x43", "--torque-Nm", "100"], "refuse",
+        "not an involute pair")
+    add("loaded.inline_crown", ["loaded", TCA_INV + ",crown=0.001", "--torque-Nm", "100"],
+        "refuse", "the TCA's rack crown is not a flank modification of the line contact")
+    add("loaded.plot_dir_missing", [*ld, "--torque-Nm", "100", "--plot",
+                                    "{tmp}/no/such/dir/l.png"], "refuse",
+        "--plot into a missing directory: refused before any work")
+    mg = "microgeometry.pinion"
+    for cid, edits, why in (
+            ("unknown_key", ((f"{mg}.tip_relief_mm", 8.0),), "a key of no field"),
+            ("string_value", ((f"{mg}.lead_crowning_um", "six"),), "a string amount"),
+            ("nan_value", ((f"{mg}.lead_crowning_um", float("nan")),), "a NaN amount"),
+            ("amount_too_big", ((f"{mg}.tip_relief_um", 800.0),), "tip relief above 500 um"),
+            ("negative_relief", ((f"{mg}.tip_relief_um", -8.0),), "a negative relief"),
+            ("bad_shape", ((f"{mg}.tip_relief_shape", "cubic"),), "unknown relief shape"),
+            ("relief_without_length", ((f"{mg}.tip_relief_length_mm", _DELETE),),
+             "a relief amount without its length"),
+            ("relief_zero_length", ((f"{mg}.tip_relief_length_mm", 0.0),),
+             "a relief amount over a zero length"),
+            ("member_and_flank", (("microgeometry.pinion_drive.bias_um", 2.0),),
+             "a member table and its own flank table"),
+            ("unknown_table", (("microgeometry.wheel.bias_um", 2.0),), "an unknown sub-table"),
+            ("not_a_table", ((f"{mg}", 3.0),), "a number where a table belongs")):
+        add(f"loaded.design.{cid}", ["loaded", "{design}", "--torque-Nm", "100", *small],
+            "refuse", why, setup=design_file("helical_microgeometry", *edits))
+    add("tca.microgeometry_refused", ["tca", "example:helical_microgeometry"], "refuse",
+        "the TCA does not take [microgeometry]: refused, naming `gearjax loaded`")
+    add("efficiency.microgeometry_refused",
+        ["efficiency", "example:helical_microgeometry", *_argv(eff)], "refuse",
+        "the mesh efficiency does not take [microgeometry]: refused, naming `gearjax loaded`")
+
     # ---------------------------------------------------------------- optimize
     add("optimize.ok.list", ["optimize", "--list"], "ok", "packaged studies")
     add("optimize.ok.quantities", ["optimize", "--quantities"], "ok", "the quantity table")

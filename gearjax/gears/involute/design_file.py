@@ -22,6 +22,28 @@ units: mm and degrees.  Tables and keys:
 * ``[modification]`` (optional table, every key optional, default 0): the pinion rack's
   ``pressure_angle_change_deg`` (-5..5), ``profile_crown_per_mm`` and
   ``lead_crown_per_mm`` (0..0.1) of :class:`gearjax.gears.involute.tca.InvoluteTCA`.
+* ``[microgeometry]`` (optional): the flank modifications of
+  :mod:`gearjax.gears.involute.microgeometry` (docs/microgeometry.md), analysed by the
+  loaded line contact (``gearjax loaded``, :func:`~gearjax.gears.involute.loaded_lines.
+  loaded_te_map`).  Sub-tables ``[microgeometry.pinion]`` and ``[microgeometry.gear]``
+  set both flanks (drive and coast) of that member; ``[microgeometry.pinion_drive]``,
+  ``pinion_coast``, ``gear_drive``, ``gear_coast`` set one flank (a member table and
+  one of its own flank tables together are refused).  Keys, every one optional (default:
+  unmodified), units in the name (ranges of :data:`~gearjax.gears.involute.
+  microgeometry.FIELD_UNITS`):
+  - ``tip_relief_um`` (0..500), ``tip_relief_length_mm`` (roll length from the tip,
+    > 0 when there is a relief), ``tip_relief_shape`` ("linear" or "parabolic", default
+    "linear"); ``root_relief_um``, ``root_relief_length_mm``, ``root_relief_shape`` (the
+    same, from the start of active profile);
+  - ``profile_crowning_um``, ``profile_slope_um`` (f_Halpha), ``lead_crowning_um``,
+    ``helix_slope_um`` (f_Hbeta), ``bias_um`` (-500..500);
+  - ``end_relief_I_um``, ``end_relief_I_length_mm``, ``end_relief_II_um``,
+    ``end_relief_II_length_mm`` (axial length from the face end), ``end_relief_shape``
+    (both ends).
+  A relief amount > 0 without its length is refused.  A design file with these tables
+  is refused by the unloaded TCA, its sensitivities and the mesh efficiency
+  (``gearjax tca``, ``gearjax efficiency``, :func:`gearjax.run_tca`,
+  :func:`gearjax.mesh_efficiency`), which do not take them.
 
 Tooth form (undercut, pointed tip, tip/fillet interference) is checked on loading by
 :meth:`InvolutePair.create`, exactly as for the inline form.  Unknown or missing keys
@@ -39,12 +61,15 @@ from dataclasses import dataclass, field
 
 from gearjax.errors import check_range
 from gearjax.gears.involute.geometry import InvolutePair
+from gearjax.gears.involute.microgeometry import (FIELD_UNITS, FlankModification, MicroGeometry,
+                                                  PairModification)
 from gearjax.gears.involute.tca import ADAPTER, InvoluteTCA
 from gearjax.io import (DesignFileMixin, check_integer, check_keys, check_number, check_string,
                         register_design_kind, require_key)
 from gearjax.tca.result import register_family
 
-__all__ = ["InvoluteFile", "read_involute", "KIND", "PAIR_KEYS", "MODIFICATION_KEYS"]
+__all__ = ["InvoluteFile", "read_involute", "KIND", "PAIR_KEYS", "MODIFICATION_KEYS",
+           "MICRO_KEYS", "MICRO_SHAPES", "MICRO_TABLES"]
 
 KIND = "involute"
 #: [pair] key -> (unit, default or None when required)
@@ -55,6 +80,32 @@ PAIR_KEYS = {"z1": ("int", None), "z2": ("int", None), "normal_module_mm": ("mm"
 #: [modification] key -> unit (every key optional, default 0)
 MODIFICATION_KEYS = {"pressure_angle_change_deg": "deg", "profile_crown_per_mm": "1/mm",
                      "lead_crown_per_mm": "1/mm"}
+
+#: [microgeometry.*] key -> FlankModification field (amounts um, lengths mm)
+MICRO_KEYS = {"tip_relief_um": "tip_relief", "tip_relief_length_mm": "tip_relief_length",
+              "root_relief_um": "root_relief", "root_relief_length_mm": "root_relief_length",
+              "profile_crowning_um": "profile_crowning", "profile_slope_um": "profile_slope",
+              "lead_crowning_um": "lead_crowning", "end_relief_I_um": "end_relief_I",
+              "end_relief_I_length_mm": "end_relief_I_length",
+              "end_relief_II_um": "end_relief_II",
+              "end_relief_II_length_mm": "end_relief_II_length",
+              "helix_slope_um": "helix_slope", "bias_um": "bias"}
+#: [microgeometry.*] shape key -> FlankModification exponent field
+MICRO_SHAPE_KEYS = {"tip_relief_shape": "tip_relief_exponent",
+                    "root_relief_shape": "root_relief_exponent",
+                    "end_relief_shape": "end_relief_exponent"}
+#: relief shape -> exponent
+MICRO_SHAPES = {"linear": 1.0, "parabolic": 2.0}
+#: relief amount key -> (its length key, its shape key)
+MICRO_RELIEFS = {"tip_relief_um": ("tip_relief_length_mm", "tip_relief_shape"),
+                 "root_relief_um": ("root_relief_length_mm", "root_relief_shape"),
+                 "end_relief_I_um": ("end_relief_I_length_mm", "end_relief_shape"),
+                 "end_relief_II_um": ("end_relief_II_length_mm", "end_relief_shape")}
+#: [microgeometry] sub-table -> the (member, side) flanks it sets
+MICRO_TABLES = {"pinion": (("pinion", "drive"), ("pinion", "coast")),
+                "gear": (("gear", "drive"), ("gear", "coast")),
+                "pinion_drive": (("pinion", "drive"),), "pinion_coast": (("pinion", "coast"),),
+                "gear_drive": (("gear", "drive"),), "gear_coast": (("gear", "coast"),)}
 
 
 @dataclass(frozen=True)
@@ -75,7 +126,11 @@ class InvoluteFile(DesignFileMixin):
                if d is not None and k not in pr]
         mod = self.data.get("modification", {})
         out += [f"modification.{k} = 0" for k in MODIFICATION_KEYS if k not in mod]
-        return out
+        for name, tab in self.data.get("microgeometry", {}).items():
+            out += [f'microgeometry.{name}.{shape} = "linear"'
+                    for amount, (_, shape) in MICRO_RELIEFS.items()
+                    if tab.get(amount, 0.0) > 0.0 and shape not in tab]
+        return sorted(set(out), key=out.index)
 
     def material(self):
         """The file's ``[material]`` (:class:`gearjax.loading.materials.Material`), or None (the
@@ -99,7 +154,7 @@ class InvoluteFile(DesignFileMixin):
 def read_involute(data: dict) -> InvoluteFile:
     """Validate a parsed ``involute`` design file (module docstring) and build the pair."""
     data = copy.deepcopy(data)
-    check_keys("", data, {"design", "pair", "modification", "material"})
+    check_keys("", data, {"design", "pair", "modification", "material", "microgeometry"})
     des = data["design"]
     check_keys("design", des, {"kind", "name", "description", "source"})
     check_string("design", "kind", require_key("design", des, "kind"), (KIND,))
@@ -148,7 +203,59 @@ def read_involute(data: dict) -> InvoluteFile:
                                  m["profile_crown_per_mm"], m["lead_crown_per_mm"])
     except ValueError as exc:
         raise ValueError(f"[pair]/[modification] {exc}") from None
-    return InvoluteFile(data, tca)
+    micro = read_microgeometry(data["microgeometry"]) if "microgeometry" in data else None
+    return InvoluteFile(data, tca, micro)
+
+
+def _flank_table(where: str, tab) -> FlankModification:
+    """The :class:`FlankModification` of one ``[microgeometry.*]`` table (module
+    docstring), every value checked with the table and the key in the message."""
+    check_keys(where, tab, set(MICRO_KEYS) | set(MICRO_SHAPE_KEYS))
+    values = {}
+    for key, fld in MICRO_KEYS.items():
+        if key not in tab:
+            continue
+        unit, lo, hi = FIELD_UNITS[fld]
+        val = check_number(where, key, tab[key], unit)
+        try:
+            values[fld] = check_range(key, val, lo, hi, unit=unit)
+        except ValueError as exc:
+            raise ValueError(f"[{where}] {exc}") from None
+    for key, fld in MICRO_SHAPE_KEYS.items():
+        if key in tab:
+            values[fld] = MICRO_SHAPES[check_string(where, key, tab[key], tuple(MICRO_SHAPES))]
+    for amount, (length, _) in MICRO_RELIEFS.items():
+        a = values.get(MICRO_KEYS[amount], 0.0)
+        if a > 0.0 and values.get(MICRO_KEYS[length], 0.0) <= 0.0:
+            given = (f"{length} = {values[MICRO_KEYS[length]]:g}" if length in tab
+                     else f"no {length}")
+            raise ValueError(f"[{where}] {amount} = {a:g} with {given}: a relief needs its "
+                             f"length {length} > 0 mm")
+    try:
+        return FlankModification.create(**values)
+    except ValueError as exc:
+        raise ValueError(f"[{where}] {exc}") from None
+
+
+def read_microgeometry(micro) -> MicroGeometry:
+    """The :class:`MicroGeometry` of a ``[microgeometry]`` table (module docstring)."""
+    check_keys("microgeometry", micro, set(MICRO_TABLES))
+    for member in ("pinion", "gear"):
+        for side in ("drive", "coast"):
+            if member in micro and f"{member}_{side}" in micro:
+                raise ValueError(f"[microgeometry.{member}] and [microgeometry.{member}_{side}] "
+                                 f"both set the {member}'s {side} flank: give either the member "
+                                 "table (both flanks) or its flank tables")
+    flanks = {}
+    for name, targets in MICRO_TABLES.items():
+        if name in micro:
+            mod = _flank_table(f"microgeometry.{name}", micro[name])
+            flanks.update({t: mod for t in targets})
+    none = FlankModification.none()
+    pm = {side: PairModification(flanks.get(("pinion", side), none),
+                                 flanks.get(("gear", side), none))
+          for side in ("drive", "coast")}
+    return MicroGeometry(pm["drive"], pm["coast"])
 
 
 register_design_kind(KIND, read_involute)

@@ -316,6 +316,14 @@ class InvoluteFamily(GearFamily):
                    "lead_crown": ("modification", "lead_crown_per_mm", 1.0)}
 
     def pair(self, design):
+        """The :class:`InvoluteTCA` of ``design``; a design file with ``[microgeometry]``
+        tables is refused (one line): the TCA chain has no flank modifications but the
+        rack mismatches, and the micro-geometry is analysed by the loaded line contact."""
+        if getattr(design, "micro", None) is not None:
+            raise ValueError("[microgeometry]: this design's flank modifications are analysed "
+                             "by `gearjax loaded` (gearjax.involute.loaded_te_map); the TCA, "
+                             "its sensitivities and the mesh efficiency do not take them "
+                             "(remove the table to run without them)")
         return getattr(design, "design", design)
 
     def default_options(self, des) -> dict:

@@ -1,0 +1,267 @@
+"""``gearjax loaded`` and the ``[microgeometry]`` tables of involute design files.
+
+One real run of the command on the packaged ``helical_microgeometry`` example (8
+positions x 6 slices, 2 torques x 2 misalignments: one compiled program, shared by the
+tests through a module fixture; the table run below has the same shapes and reuses it),
+the design-file parsing (member and flank tables, shapes, refusals), the refusal of the
+TCA and the mesh efficiency of a design with micro-geometry, and refusals of bad input
+before any JAX work.  Each test's docstring names the planted bug it catches."""
+
+import contextlib
+import copy
+import io
+import json
+import os
+import re
+
+import numpy as np
+import pytest
+
+import gearjax as gj
+from gearjax.cli import build_parser, main
+from gearjax.commands.loaded import JSON_KEYS_DOC, parse_torques
+from gearjax.gears.involute.design_file import read_involute
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+EXAMPLE = "example:helical_microgeometry"
+SMALL = ["--positions", "8", "--slices", "6"]
+OPS = ["--torque-Nm", "50,200", "--misalignment-um", "0,10"]
+
+
+def _call(argv):
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            rc = main(argv)
+        except SystemExit as exc:          # argparse's refusals (one line, status 2)
+            rc = exc.code
+    return rc, out.getvalue(), err.getvalue()
+
+
+def _strict(text):
+    def no_constant(name):
+        raise AssertionError(f"non-strict JSON constant {name}")
+    return json.loads(text, parse_constant=no_constant)
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory):
+    """The one real run: JSON on stdout and a PNG."""
+    d = tmp_path_factory.mktemp("loaded")
+    png = d / "loaded.png"
+    rc, out, err = _call(["loaded", EXAMPLE, *OPS, *SMALL, "--json", "--plot", str(png)])
+    return rc, out, err, d, png
+
+
+def _documented_keys():
+    return [m.group(1) for line in JSON_KEYS_DOC.splitlines()[1:]
+            if (m := re.match(r"  (\w+)\s", line))]
+
+
+def _section(text, heading):
+    return text.split(heading, 1)[1].split("\n### ", 1)[0]
+
+
+def test_json_keys_documented_strict_and_plot(run):
+    """Catches: a JSON key added or renamed without the help epilog, the README's
+    ``gearjax loaded`` section or docs/microgeometry.md listing it; a flag missing from
+    the README; a non-strict NaN in the JSON; a figure written in place (a temporary
+    file left) or not at all."""
+    rc, text, err, d, png = run
+    assert rc == 0, err
+    assert err == ""
+    out = _strict(text)
+    assert sorted(out) == sorted(_documented_keys())
+    readme = _section(open(os.path.join(ROOT, "README.md"), encoding="utf-8").read(),
+                      "### `gearjax loaded`")
+    doc = open(os.path.join(ROOT, "docs", "microgeometry.md"), encoding="utf-8").read()
+    assert [k for k in out if f"`{k}`" not in readme] == []
+    assert [k for k in out if f"`{k}`" not in doc] == []
+    sub = build_parser()._subparsers._group_actions[0].choices["loaded"]
+    flags = [s for a in sub._actions for s in a.option_strings if s.startswith("--")
+             and s != "--help"]
+    assert [f for f in flags if f"`{f}" not in readme] == []
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and out["plot"] == str(png)
+    assert [p.name for p in d.iterdir()] == ["loaded.png"]
+
+
+def test_json_values_are_the_library_map(run):
+    """Catches: the command transposing torques x misalignments, reporting the smooth
+    p-t-p or another field under a key, or converting N m / um wrongly."""
+    out = _strict(run[1])
+    m = gj.involute.loaded_te_map(gj.load_design(EXAMPLE), [50.0, 200.0], [0.0, 10.0],
+                                  positions=8, slices=6)
+    assert out["torque_Nm"] == [50.0, 200.0] and out["misalignment_um"] == [0.0, 10.0]
+    for key, field in (("te_ptp_um", "te_ptp_um"), ("te_mean_um", "te_mean_um"),
+                       ("p_max_MPa", "p_max"), ("k_hbeta", "k_hbeta"),
+                       ("end_load_ratio", "end_load")):
+        np.testing.assert_allclose(out[key], np.asarray(getattr(m, field)), rtol=1e-12,
+                                   err_msg=key)
+    assert np.asarray(out["converged"]).shape == (2, 2) and all(map(all, out["converged"]))
+    # physics sanity: more torque, more mean approach; misalignment loads an end harder
+    te = np.asarray(out["te_mean_um"])
+    assert (te[1] > te[0]).all()
+    assert out["end_load_ratio"][0][1] > out["end_load_ratio"][0][0]
+
+
+def test_modifications_reported_from_the_file(run):
+    """Catches: the [microgeometry] tables not read (an unmodified pair analysed), the
+    member tables given to the wrong member, or the shape not mapped to the exponent."""
+    mods = _strict(run[1])["modifications"]
+    p, g = mods["pinion"], mods["gear"]
+    assert (p["tip_relief"], p["tip_relief_length"], p["tip_relief_exponent"]) == (8.0, 2.5, 1.0)
+    assert p["lead_crowning"] == 6.0 and g["lead_crowning"] == 0.0
+    assert (g["tip_relief"], g["tip_relief_length"]) == (8.0, 2.5)
+
+
+def test_table_from_a_torque_range_matches_the_json(run):
+    """Catches: ``START:STOP:COUNT`` read as a step or as COUNT + 1 values; table rows
+    out of order against the JSON; the converged column missing."""
+    rc, text, err = _call(["loaded", EXAMPLE, "--torque-Nm", "50:200:2", "--misalignment-um",
+                           "0,10", *SMALL])
+    assert rc == 0 and err == "", err
+    rows = [ln.split() for ln in text.splitlines() if not ln.startswith("#")][1:]
+    assert len(rows) == 4 and all(r[-1] == "yes" for r in rows)
+    ptp = np.asarray(_strict(run[1])["te_ptp_um"]).ravel()
+    np.testing.assert_allclose([float(r[2]) for r in rows], ptp, atol=6e-5)
+    assert [float(r[0]) for r in rows] == [50.0, 50.0, 200.0, 200.0]
+
+
+def test_not_converged_point_warns_and_exits_3(run, monkeypatch):
+    """Catches: a non-converged operating point printed as a valid result with exit 0
+    and no warning."""
+    real = gj.involute.loaded_te_map
+
+    def fake(*a, **k):
+        m = real(*a, **k)
+        conv = np.asarray(m.converged).copy()
+        conv[1, 0] = False
+        return m._replace(converged=conv)
+
+    monkeypatch.setattr(gj.involute, "loaded_te_map", fake)
+    rc, text, err = _call(["loaded", EXAMPLE, *OPS, *SMALL])
+    assert rc == 3
+    lines = err.splitlines()
+    assert len(lines) == 2 and lines[0].startswith("gearjax: warning:") and "200 N m" in lines[0]
+    assert lines[1].startswith("gearjax: error: 1 of 4 operating points")
+    assert text.splitlines()[4].split()[-1] == "no"
+
+
+def test_parse_torques_list_and_range():
+    """Catches: a range whose ends are not included or whose COUNT is ignored."""
+    assert parse_torques("50, 100,200", 1e-3, 1e7) == [50.0, 100.0, 200.0]
+    assert parse_torques("50:400:8", 1e-3, 1e7) == pytest.approx(np.linspace(50, 400, 8))
+    assert parse_torques("70:70:1", 1e-3, 1e7) == [70.0]
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (["--torque-Nm", "0"], "--torque-Nm"),
+    (["--torque-Nm", "abc"], "--torque-Nm"),
+    (["--torque-Nm", "50:100"], "START:STOP:COUNT"),
+    (["--torque-Nm", "50:100:0"], "COUNT"),
+    (["--torque-Nm", "50,,100"], "--torque-Nm"),
+    (["--torque-Nm", "100", "--misalignment-um", "-2000"], "--misalignment-um"),
+    (["--torque-Nm", "100", "--compliance", "steel"], "compliance"),
+    (["--torque-Nm", "100", "--positions", "2"], "--positions"),
+    (["--torque-Nm", "100", "--slices", "4.5"], "--slices"),
+])
+def test_bad_input_one_line_before_any_work(argv, needle, monkeypatch):
+    """Catches: bad input reaching the compiled program (the compute entry point is
+    replaced by one that fails), a traceback, or a message that does not name the flag."""
+    monkeypatch.setattr(gj.involute, "loaded_te_map",
+                        lambda *a, **k: pytest.fail("computed on bad input"))
+    rc, text, err = _call(["loaded", EXAMPLE, *argv])
+    assert rc == 2 and text == ""
+    assert len(err.splitlines()) == 1 and err.startswith("gearjax: error:") and needle in err
+
+
+def test_non_involute_design_refused(monkeypatch):
+    """Catches: a hypoid design handed to the involute line contact (a TypeError
+    traceback instead of one line)."""
+    rc, text, err = _call(["loaded", "example:hft_8x43", "--torque-Nm", "100"])
+    assert rc == 2 and len(err.splitlines()) == 1 and "involute" in err
+
+
+def test_tca_and_efficiency_refuse_microgeometry():
+    """Catches: `gearjax tca` / `gearjax efficiency` / run_tca silently ignoring the
+    [microgeometry] tables (an unmodified pair analysed as if it were the design)."""
+    for argv in (["tca", EXAMPLE],
+                 ["efficiency", EXAMPLE, "--torque-Nm", "100", "--rpm", "1000", "--oil",
+                  "mineral_vg100", "--sigma-um", "0.4"]):
+        rc, text, err = _call(argv)
+        assert rc == 2 and text == "", argv
+        assert len(err.splitlines()) == 1 and "`gearjax loaded`" in err, err
+    with pytest.raises(ValueError, match="microgeometry"):
+        gj.run_tca(gj.load_design(EXAMPLE))
+
+
+# ----------------------------------------------------------------------- the design file
+
+@pytest.fixture(scope="module")
+def raw():
+    data = gj.io.read_toml(EXAMPLE)
+    del data["microgeometry"]
+    return data
+
+
+def _with(raw, micro):
+    d = copy.deepcopy(raw)
+    d["microgeometry"] = micro
+    return read_involute(d)
+
+
+def test_member_and_flank_tables(raw):
+    """Catches: a member table setting only one flank, a flank table leaking to the other
+    flank or member, a shape not mapped (parabolic -> exponent 2)."""
+    f = _with(raw, {"pinion": {"tip_relief_um": 5.0, "tip_relief_length_mm": 1.5,
+                               "tip_relief_shape": "parabolic"},
+                    "gear_coast": {"bias_um": 3.0, "end_relief_II_um": 4.0,
+                                   "end_relief_II_length_mm": 5.0}})
+    m = f.micro
+    for side in ("drive", "coast"):
+        p = m.flanks(side).pinion
+        assert float(p.tip_relief) == 5.0 and float(p.tip_relief_exponent) == 2.0
+    assert float(m.coast.gear.bias) == 3.0 and float(m.coast.gear.end_relief_II) == 4.0
+    assert float(m.drive.gear.bias) == 0.0 and float(m.drive.gear.end_relief_II) == 0.0
+    assert float(m.coast.pinion.bias) == 0.0
+    assert _with(raw, {"pinion": {"lead_crowning_um": 2.0}}).micro.drive.gear == \
+        gj.involute.FlankModification.none()
+    assert read_involute(raw).micro is None
+
+
+@pytest.mark.parametrize("micro, needles", [
+    ({"pinion": {"tip_relief_um": 8.0}}, ("[microgeometry.pinion]", "tip_relief_um = 8",
+                                           "tip_relief_length_mm")),
+    ({"gear_drive": {"end_relief_I_um": 8.0, "end_relief_I_length_mm": 0.0}},
+     ("[microgeometry.gear_drive]", "end_relief_I_length_mm = 0")),
+    ({"pinion": {}, "pinion_drive": {}}, ("[microgeometry.pinion]",
+                                          "[microgeometry.pinion_drive]")),
+    ({"pinion": {"tip_relief_shape": "cubic"}}, ("tip_relief_shape", "'cubic'", "linear")),
+    ({"pinion": {"tip_relief_um": 600.0, "tip_relief_length_mm": 1.0}},
+     ("[microgeometry.pinion]", "tip_relief_um = 600", "[0, 500]")),
+    ({"pinion": {"tip_relif_um": 1.0}}, ("microgeometry.pinion.tip_relif_um",)),
+    ({"wheel": {}}, ("microgeometry.wheel",)),
+    ({"gear": {"bias_um": "x"}}, ("[microgeometry.gear]", "bias_um", "number")),
+    ({"gear": {"bias_um": float("nan")}}, ("[microgeometry.gear]", "bias_um", "finite")),
+    (3.0, ("[microgeometry]", "table")),
+])
+def test_bad_tables_refused_in_one_line(raw, micro, needles):
+    """Catches: a relief without its length taking a silent 1 mm, a member and a flank
+    table both applied, an unknown shape, key or sub-table accepted, an out-of-range or
+    non-number value passed on, a message that does not name the table and key."""
+    with pytest.raises(ValueError) as exc:
+        _with(raw, micro)
+    msg = str(exc.value)
+    assert "\n" not in msg
+    for n in needles:
+        assert n in msg, (n, msg)
+
+
+def test_example_show_loads_back():
+    """Catches: the packaged example listing a defaults line that does not load as TOML
+    comments, or the example failing its tooth-form checks."""
+    rc, text, err = _call(["example", "show", "helical_microgeometry"])
+    assert rc == 0 and err == ""
+    import tomllib
+    d = tomllib.loads(text)
+    assert d["microgeometry"]["pinion"]["lead_crowning_um"] == 6.0
