@@ -265,3 +265,42 @@ def test_example_show_loads_back():
     import tomllib
     d = tomllib.loads(text)
     assert d["microgeometry"]["pinion"]["lead_crowning_um"] == 6.0
+
+
+def test_efficiency_columns_are_the_library_map():
+    """``--rpm`` with the lubrication adds power loss and efficiency equal to
+    ``loaded_te_map`` with the same oil and surface (1e-12); without --rpm they are null
+    (the fixture's run).  Planted bugs caught: the oil or roughness not passed, the
+    columns from another torque, the efficiency printed as a loss."""
+    rc, text, err = _call(["loaded", EXAMPLE, "--torque-Nm", "200", *SMALL, "--rpm", "1500",
+                           "--oil", "mineral_vg100", "--sigma-um", "0.4", "--json"])
+    assert rc == 0, err
+    out = _strict(text)
+    oil = gj.tribology.get_oil("mineral_vg100")
+    surf = gj.tribology.make_surface(0.4)
+    ref = gj.involute.loaded_te_map(gj.load_design(EXAMPLE), [200.0], [0.0], positions=8,
+                                    slices=6, pinion_rpm=1500.0, oil=oil, surface=surf)
+    assert out["efficiency"][0][0] == pytest.approx(float(ref.efficiency[0, 0]), rel=1e-12)
+    assert out["power_loss_W"][0][0] == pytest.approx(float(ref.power_loss_W[0, 0]),
+                                                      rel=1e-12)
+    assert 0.98 < out["efficiency"][0][0] < 1.0
+    assert out["input"]["rpm"] == 1500.0 and out["input"]["oil"] == "mineral_vg100"
+
+
+@pytest.mark.parametrize("extra, msg", [
+    (["--rpm", "1500"], "--rpm needs the lubrication"),
+    (["--rpm", "1500", "--oil", "mineral_vg100"], "--rpm needs the lubrication"),
+    (["--oil", "mineral_vg100", "--sigma-um", "0.4"], "apply with --rpm only"),
+    (["--sigma-um", "0.4"], "apply with --rpm only"),
+    (["--rpm", "-5", "--oil", "mineral_vg100", "--sigma-um", "0.4"], "pinion_rpm = -5"),
+    (["--rpm", "1500", "--oil", "mineral_vg100", "--sigma-um", "50"], "--sigma-um"),
+])
+def test_lubrication_flags_refused_before_work(extra, msg, monkeypatch):
+    """The efficiency needs --rpm, an oil and a roughness together; each bad combination
+    or value is one line and exit 2 before any JAX work.  Planted bug caught: the
+    lubrication silently ignored without --rpm, or a default oil assumed."""
+    monkeypatch.setattr(gj.involute, "loaded_te_map",
+                        lambda *a, **k: pytest.fail("work started before the refusal"))
+    rc, out, err = _call(["loaded", EXAMPLE, "--torque-Nm", "200", *extra])
+    assert rc == 2, (rc, err)
+    assert msg in err and len(err.strip().splitlines()) == 1, err

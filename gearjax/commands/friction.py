@@ -84,13 +84,15 @@ E_PRIME_HELP = ("reduced modulus E' = 2/((1-v1^2)/E1+(1-v2^2)/E2) (MPa, in (0, 1
                 "default steel 226374)")
 
 
-def add_lubricant_options(p, e_prime_help: str = E_PRIME_HELP):
+def add_lubricant_options(p, e_prime_help: str | None = E_PRIME_HELP, required: bool = True):
     """The oil (--oil NAME, or --eta0 with --alpha-per-GPa/--tau0-MPa), surface
     (--sigma-um, asperity options, --fc), --E-prime-MPa, --film and --viscosity
-    options shared by the friction, stribeck and efficiency commands
+    options shared by the friction, stribeck, efficiency and loaded commands
     (read back by :func:`lubricant_from_args`); ``e_prime_help`` the help of
-    --E-prime-MPa (its default differs between commands)."""
-    g = p.add_mutually_exclusive_group(required=True)
+    --E-prime-MPa (its default differs between commands; None: no such option, the
+    design's material applies); ``required=False`` where the lubrication is optional
+    (the command checks that the oil and --sigma-um come together)."""
+    g = p.add_mutually_exclusive_group(required=required)
     g.add_argument("--oil", help="example oil: mineral_vg100 | mineral_vg220 | pao_vg100 "
                                  "(gearjax.tribology.OILS)")
     g.add_argument("--eta0", type=float, help="inlet viscosity (Pa·s, in (6.31e-5, 100])")
@@ -98,7 +100,7 @@ def add_lubricant_options(p, e_prime_help: str = E_PRIME_HELP):
                    help="pressure-viscosity coefficient with --eta0 (1/GPa, in (0, 100], default 20)")
     p.add_argument("--tau0-MPa", type=float, default=None,
                    help="Eyring stress with --eta0 (MPa, in (0, 100], default 5)")
-    p.add_argument("--sigma-um", type=float, required=True,
+    p.add_argument("--sigma-um", type=float, required=required,
                    help="composite RMS roughness sqrt(s1^2+s2^2) (um, in (0, 10])")
     p.add_argument("--asperity-density-per-mm2", type=float, default=1e4,
                    help="asperity density (1/mm^2, in (0, 1e6], default 1e4)")
@@ -106,7 +108,8 @@ def add_lubricant_options(p, e_prime_help: str = E_PRIME_HELP):
                    help="asperity tip radius (um, in (0, 1000], default 10)")
     p.add_argument("--fc", type=float, default=0.1,
                    help="boundary friction coefficient (in [0, 1], default 0.1)")
-    p.add_argument("--E-prime-MPa", type=float, default=None, help=e_prime_help)
+    if e_prime_help is not None:
+        p.add_argument("--E-prime-MPa", type=float, default=None, help=e_prime_help)
     p.add_argument("--film", choices=["auto", "point", "line"], default="auto",
                    help="film formula (default auto: Hamrock-Dowson blended into line contact)")
     p.add_argument("--viscosity", choices=["roelands", "barus"], default="roelands")
@@ -175,7 +178,8 @@ def lubricant_from_args(args):
             check_flag(flag, getattr(args, flag[2:].replace("-", "_")))
         oil = make_oil(args.eta0, args.alpha_per_GPa, args.tau0_MPa)
     surf = make_surface(args.sigma_um, args.asperity_density_per_mm2, args.asperity_radius_um, args.fc)
-    Ep = STEEL_E_PRIME if args.E_prime_MPa is None else check_flag("--E-prime-MPa", args.E_prime_MPa)
+    e_prime = getattr(args, "E_prime_MPa", None)
+    Ep = STEEL_E_PRIME if e_prime is None else check_flag("--E-prime-MPa", e_prime)
     return oil, surf, Ep
 
 

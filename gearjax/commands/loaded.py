@@ -25,6 +25,7 @@ import sys
 import numpy as np
 
 from gearjax.commands.designs import involute_design, is_involute
+from gearjax.commands.friction import add_lubricant_options, lubricant_from_args
 
 #: most torques and most misalignments of one run
 MAX_TORQUES = 200
@@ -34,7 +35,8 @@ NOT_CONVERGED_STATUS = 3
 
 JSON_KEYS_DOC = """JSON keys:
   input            the design and options as given (design, side, torque_Nm,
-                   misalignment_um, positions, slices, compliance)
+                   misalignment_um, positions, slices, compliance, rpm, oil, sigma_um,
+                   film, viscosity)
   torque_Nm        the pinion torques (N m), T values
   misalignment_um  the mesh misalignments f_ma (um over the face width), A values
   te_ptp_um        loaded TE peak-to-peak over the mesh cycle (um along the line of
@@ -44,7 +46,10 @@ JSON_KEYS_DOC = """JSON keys:
   k_hbeta          face load factor K_Hbeta of the cycle-mean load distribution, T x A
   end_load_ratio   highest load per unit face width in an end slice over the mean
                    (> 1: the face ends carry more than the middle), T x A
-  converged        every position of the cycle converged, T x A booleans
+  power_loss_W     mean sliding power loss over the cycle (W), T x A; null without --rpm
+  efficiency       mesh efficiency over the cycle, T x A; null without --rpm
+  converged        every position of the cycle converged (with --rpm: and every
+                   loaded point's friction solve), T x A booleans
   modifications    {pinion, gear}: the flank modifications of the analysed side, by
                    field (um amounts, mm lengths, exponents; docs/microgeometry.md)
   warnings         the warning lines (also on stderr)
@@ -84,6 +89,12 @@ def register(sub):
                    help="tooth compliance per unit length of contact line: weber (Weber/"
                         "Sainsot cantilevers and Weber's contact term) or iso6336 (the "
                         "constant single stiffness of ISO 6336-1); default weber")
+    rlo, rhi = gj.loading.RPM_RANGE
+    p.add_argument("--rpm", type=float, default=None,
+                   help=f"pinion speed (rpm, in [{rlo:g}, {rhi:g}]): adds the sliding power "
+                        "loss and the mesh efficiency (mixed-lubrication friction along the "
+                        "contact lines); needs --oil or --eta0, and --sigma-um")
+    add_lubricant_options(p, e_prime_help=None, required=False)
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.add_argument("--plot", default=None,
                    help="write the pinion drive flank's modification map and LTE p-t-p "
@@ -167,6 +178,21 @@ def run(args) -> int:
     slices = check_int("--slices", args.slices, lo=1, hi=400)
     if args.plot is not None:
         check_output_path(args.plot, "--plot", (".png", ".pdf", ".svg"))
+    lube = {}
+    oil_given = args.oil is not None or args.eta0 is not None
+    if args.rpm is None:
+        if oil_given or args.sigma_um is not None:
+            raise ValueError("--oil/--eta0 and --sigma-um apply with --rpm only (the "
+                             "efficiency); give --rpm or leave them out")
+    else:
+        from gearjax.loading.efficiency_inputs import check_operating_point
+        check_operating_point(torques[0], args.rpm)
+        if not oil_given or args.sigma_um is None:
+            raise ValueError("--rpm needs the lubrication: --oil NAME (or --eta0) and "
+                             "--sigma-um")
+        oil, surf, _ = lubricant_from_args(args)
+        lube = dict(pinion_rpm=args.rpm, oil=oil, surface=surf,
+                    viscosity_model=args.viscosity, film_method=args.film)
     design = (involute_design(args.design)[1] if is_involute(args.design)
               else gj.load_design(args.design))
     if not isinstance(design, (gj.involute.InvoluteFile, gj.involute.InvoluteTCA)):
@@ -178,17 +204,20 @@ def run(args) -> int:
             f"{len(mis)} misalignment(s), {positions} positions x {slices} slices"):
         res = gj.involute.loaded_te_map(design, torques, mis, side=args.side,
                                         positions=positions, slices=slices,
-                                        compliance=args.compliance)
+                                        compliance=args.compliance, **lube)
         bar.update()
     arr = lambda a: np.asarray(a, float).tolist()  # noqa: E731
     out = {
         "input": {"design": args.design, "side": args.side, "torque_Nm": torques,
                   "misalignment_um": mis, "positions": positions, "slices": slices,
-                  "compliance": args.compliance},
+                  "compliance": args.compliance, "rpm": args.rpm, "oil": args.oil,
+                  "sigma_um": args.sigma_um, "film": args.film, "viscosity": args.viscosity},
         "torque_Nm": arr(res.torque_Nm), "misalignment_um": arr(res.misalignment_um),
         "te_ptp_um": arr(res.te_ptp_um), "te_mean_um": arr(res.te_mean_um),
         "p_max_MPa": arr(res.p_max), "k_hbeta": arr(res.k_hbeta),
         "end_load_ratio": arr(res.end_load),
+        "power_loss_W": arr(res.power_loss_W) if lube else None,
+        "efficiency": arr(res.efficiency) if lube else None,
         "converged": np.asarray(res.converged, bool).tolist(),
         "modifications": _modifications(design, args.side),
         "warnings": [], "plot": args.plot,
@@ -212,8 +241,9 @@ def run(args) -> int:
     if args.json:
         print_json(out)
         return status
-    warn_nonfinite(f"{k}[{i}][{j}]" for k in ("te_ptp_um", "te_mean_um", "p_max_MPa",
-                                               "k_hbeta", "end_load_ratio")
+    keys = ("te_ptp_um", "te_mean_um", "p_max_MPa", "k_hbeta", "end_load_ratio") + (
+        ("power_loss_W", "efficiency") if lube else ())
+    warn_nonfinite(f"{k}[{i}][{j}]" for k in keys
                    for i, j, _, _ in _rows(out) if not math.isfinite(out[k][i][j]))
     _print_table(out, args)
     return status
@@ -223,12 +253,16 @@ def _print_table(out, args):
     inp = out["input"]
     print(f"# loaded line contact {args.design} ({args.side}); {inp['positions']} positions "
           f"x {inp['slices']} slices, compliance {inp['compliance']}")
+    eff = out["efficiency"] is not None
     print(f"{'torque[Nm]':>11s} {'f_ma[um]':>9s} {'LTE_ptp[um]':>12s} {'LTE_mean[um]':>13s} "
-          f"{'p_max[MPa]':>11s} {'K_Hbeta':>8s} {'end_load':>9s} converged")
+          f"{'p_max[MPa]':>11s} {'K_Hbeta':>8s} {'end_load':>9s} "
+          + (f"{'P_loss[W]':>10s} {'eta[%]':>8s} " if eff else "") + "converged")
     for i, j, T, a in _rows(out):
+        extra = (f"{out['power_loss_W'][i][j]:10.2f} {100 * out['efficiency'][i][j]:8.3f} "
+                 if eff else "")
         print(f"{T:11.4g} {a:9.3g} {out['te_ptp_um'][i][j]:12.4f} "
               f"{out['te_mean_um'][i][j]:13.4f} {out['p_max_MPa'][i][j]:11.1f} "
-              f"{out['k_hbeta'][i][j]:8.4f} {out['end_load_ratio'][i][j]:9.4f} "
-              f"{'yes' if out['converged'][i][j] else 'no'}")
+              f"{out['k_hbeta'][i][j]:8.4f} {out['end_load_ratio'][i][j]:9.4f} " + extra
+              + f"{'yes' if out['converged'][i][j] else 'no'}")
     if out["plot"]:
         print(f"# plot written to {out['plot']}")
