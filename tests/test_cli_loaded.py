@@ -292,7 +292,7 @@ def test_efficiency_columns_are_the_library_map():
     (["--rpm", "1500", "--oil", "mineral_vg100"], "--rpm needs the lubrication"),
     (["--oil", "mineral_vg100", "--sigma-um", "0.4"], "apply with --rpm only"),
     (["--sigma-um", "0.4"], "apply with --rpm only"),
-    (["--rpm", "-5", "--oil", "mineral_vg100", "--sigma-um", "0.4"], "pinion_rpm = -5"),
+    (["--rpm", "-5", "--oil", "mineral_vg100", "--sigma-um", "0.4"], "--rpm = -5"),
     (["--rpm", "1500", "--oil", "mineral_vg100", "--sigma-um", "50"], "--sigma-um"),
 ])
 def test_lubrication_flags_refused_before_work(extra, msg, monkeypatch):

@@ -1026,6 +1026,22 @@ def build_cases() -> list[Case]:
             [*ld, "--torque-Nm", "100", *_argv([("--positions", "8"), ("--slices", "6")],
                                              {flag: value})], "refuse", f"{flag} {value}")
     add("loaded.no_torque", [*ld], "refuse", "missing --torque-Nm")
+    lub = ["--oil", "mineral_vg100", "--sigma-um", "0.4"]
+    for cid, extra, why in (
+            ("rpm_no_oil", ["--rpm", "1500"], "--rpm without the lubrication"),
+            ("rpm_no_sigma", ["--rpm", "1500", "--oil", "mineral_vg100"], "--rpm, no --sigma-um"),
+            ("oil_no_rpm", lub, "lubrication without --rpm"),
+            ("rpm_negative", ["--rpm", "-1", *lub], "negative speed"),
+            ("rpm_nan", ["--rpm", "nan", *lub], "NaN speed"),
+            ("rpm_huge", ["--rpm", "1e9", *lub], "speed above the range"),
+            ("sigma_huge", ["--rpm", "1500", "--oil", "mineral_vg100", "--sigma-um", "1e4"],
+             "roughness in nm typed as um"),
+            ("oil_unknown", ["--rpm", "1500", "--oil", "olive", "--sigma-um", "0.4"],
+             "unknown oil"),
+            ("oil_and_eta0", ["--rpm", "1500", *lub, "--eta0", "0.1"], "two oils")):
+        add(f"loaded.{cid}", [*ld, "--torque-Nm", "100", *small, *extra], "refuse", why)
+    add("loaded.ok.efficiency", [*ld, "--torque-Nm", "100", *small, "--rpm", "1500", *lub,
+                                 "--json"], "ok", "efficiency columns")
     add("loaded.hypoid_design", ["loaded", "example:hft_8x43", "--torque-Nm", "100"], "refuse",
         "not an involute pair")
     add("loaded.inline_crown", ["loaded", TCA_INV + ",crown=0.001", "--torque-Nm", "100"],

@@ -166,7 +166,7 @@ def _rows(out):
 def run(args) -> int:
     import gearjax as gj
     from gearjax.commands import print_json, warn_nonfinite
-    from gearjax.errors import check_int
+    from gearjax.errors import check_int, check_range
     from gearjax.io import check_output_path
     from gearjax.progress import Progress
 
@@ -185,8 +185,7 @@ def run(args) -> int:
             raise ValueError("--oil/--eta0 and --sigma-um apply with --rpm only (the "
                              "efficiency); give --rpm or leave them out")
     else:
-        from gearjax.loading.efficiency_inputs import check_operating_point
-        check_operating_point(torques[0], args.rpm)
+        check_range("--rpm", args.rpm, *gj.loading.RPM_RANGE, unit="rpm")
         if not oil_given or args.sigma_um is None:
             raise ValueError("--rpm needs the lubrication: --oil NAME (or --eta0) and "
                              "--sigma-um")
