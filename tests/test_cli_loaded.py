@@ -93,6 +93,7 @@ def test_json_values_are_the_library_map(run):
                                   positions=8, slices=6)
     assert out["torque_Nm"] == [50.0, 200.0] and out["misalignment_um"] == [0.0, 10.0]
     for key, field in (("te_ptp_um", "te_ptp_um"), ("te_mean_um", "te_mean_um"),
+                       ("te_unloaded_ptp_um", "te_unloaded_ptp_um"),
                        ("p_max_MPa", "p_max"), ("k_hbeta", "k_hbeta"),
                        ("end_load_ratio", "end_load")):
         np.testing.assert_allclose(out[key], np.asarray(getattr(m, field)), rtol=1e-12,

@@ -121,7 +121,8 @@ def test_harris_long_relief_closed_form(nasa):
     d = W'/(2k) + C/2, so p-t-p = (W - W')/(2k).  Zero at W.  Evaluated at the exact
     positions of the extremes (zone ends, middles, single contact).  Planted bugs caught:
     the gear's relief mapped to the wrong end of the path, the pinion's or gear's
-    roll length off the pitch point, the exact solve's active count off by one."""
+    roll length off the pitch point, the exact solve's active count off by one, the
+    unloaded TE not the smallest separation."""
     pair, des = nasa
     geo = pair_geometry(pair)
     p_b = 2 * math.pi * float(geo["rb1"]) / pair.z1
@@ -145,6 +146,10 @@ def test_harris_long_relief_closed_form(nasa):
         want = 1e3 * abs(T - T_design) / rb1 / (2 * k)
         assert np.ptp(te) == pytest.approx(want, abs=1e-9), (T, te)
         assert te[-1] == pytest.approx(1e3 * T / rb1 / k, rel=1e-12)   # single contact
+        # unloaded: the smaller of the two reliefs, min(C (1-t), C t), at most C/2
+        te0 = np.asarray(r.te_unloaded_um)
+        np.testing.assert_allclose(te0, [0.0, C_um / 4, C_um / 2, C_um / 4, 0.0, 0.0],
+                                   atol=1e-9)
     # unmodified: single/double contact deflections W/k and W/(2k)
     r = _run(pair, B_NASA, PairModification.none(), T_design, s0=s0)
     te = np.asarray(r.te_loaded_um)

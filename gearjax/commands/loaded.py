@@ -42,6 +42,8 @@ JSON_KEYS_DOC = """JSON keys:
   te_ptp_um        loaded TE peak-to-peak over the mesh cycle (um along the line of
                    action), T lists of A values
   te_mean_um       mean loaded TE (um), T x A
+  te_unloaded_ptp_um  unloaded TE peak-to-peak (um; the modifications' TCA: the
+                   separation closed first at zero load), T x A
   p_max_MPa        highest Hertz pressure over the cycle and the face (MPa), T x A
   k_hbeta          face load factor K_Hbeta of the cycle-mean load distribution, T x A
   end_load_ratio   highest load per unit face width in an end slice over the mean
@@ -213,6 +215,7 @@ def run(args) -> int:
                   "sigma_um": args.sigma_um, "film": args.film, "viscosity": args.viscosity},
         "torque_Nm": arr(res.torque_Nm), "misalignment_um": arr(res.misalignment_um),
         "te_ptp_um": arr(res.te_ptp_um), "te_mean_um": arr(res.te_mean_um),
+        "te_unloaded_ptp_um": arr(res.te_unloaded_ptp_um),
         "p_max_MPa": arr(res.p_max), "k_hbeta": arr(res.k_hbeta),
         "end_load_ratio": arr(res.end_load),
         "power_loss_W": arr(res.power_loss_W) if lube else None,
@@ -240,7 +243,7 @@ def run(args) -> int:
     if args.json:
         print_json(out)
         return status
-    keys = ("te_ptp_um", "te_mean_um", "p_max_MPa", "k_hbeta", "end_load_ratio") + (
+    keys = ("te_ptp_um", "te_mean_um", "te_unloaded_ptp_um", "p_max_MPa", "k_hbeta", "end_load_ratio") + (
         ("power_loss_W", "efficiency") if lube else ())
     warn_nonfinite(f"{k}[{i}][{j}]" for k in keys
                    for i, j, _, _ in _rows(out) if not math.isfinite(out[k][i][j]))

@@ -116,7 +116,9 @@ class LoadedTEMap(NamedTuple):
     te_ptp_um : peak-to-peak of the loaded TE over the cycle (µm).
     te_ptp_smooth_um : its smooth form (:func:`~gearjax.gears.involute.line_load.smooth_ptp`
         at ``temperature_um``), the one to differentiate.
-    te_mean_um : mean loaded TE (µm).  p_max : highest Hertz pressure (MPa).
+    te_mean_um : mean loaded TE (µm).
+    te_unloaded_ptp_um : peak-to-peak of the unloaded TE (the separation closed first,
+        the approach at zero load; µm): the TCA of the modified line contact.  p_max : highest Hertz pressure (MPa).
     k_hbeta : face load factor of the cycle-mean distribution.  end_load : highest
         end-slice load ratio over the cycle.
     converged : every position of the cycle converged (and, with efficiency, every
@@ -130,6 +132,7 @@ class LoadedTEMap(NamedTuple):
     te_ptp_um: jax.Array
     te_ptp_smooth_um: jax.Array
     te_mean_um: jax.Array
+    te_unloaded_ptp_um: jax.Array
     p_max: jax.Array
     k_hbeta: jax.Array
     end_load: jax.Array
@@ -155,8 +158,9 @@ def te_map_traced(pair, b, mods, torques_Nmm, f_ma, E, nu, opts, drive, temperat
             r, loss, eff = le.loads, jnp.mean(le.power_loss), le.mean_efficiency
             ok = jnp.all(le.valid)
         te = r.te_loaded_um
+        te0 = r.te_unloaded_um
         return (jnp.max(te) - jnp.min(te), smooth_ptp(te, temperature_um), jnp.mean(te),
-                jnp.max(r.p_max), r.k_hbeta_mean, jnp.max(r.end_load), ok, loss, eff)
+                jnp.max(te0) - jnp.min(te0), jnp.max(r.p_max), r.k_hbeta_mean, jnp.max(r.end_load), ok, loss, eff)
 
     return jax.vmap(lambda T: jax.vmap(lambda f: one(T, f))(f_ma))(torques_Nmm)
 
