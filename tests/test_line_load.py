@@ -148,8 +148,10 @@ def test_harris_long_relief_closed_form(nasa):
         assert te[-1] == pytest.approx(1e3 * T / rb1 / k, rel=1e-12)   # single contact
         # unloaded: the smaller of the two reliefs, min(C (1-t), C t), at most C/2
         te0 = np.asarray(r.te_unloaded_um)
-        np.testing.assert_allclose(te0, [0.0, C_um / 4, C_um / 2, C_um / 4, 0.0, 0.0],
-                                   atol=1e-9)
+        t = np.clip((s0 - s_A) / L, 0.0, 1.0)
+        want0 = np.where(s0 - s_A <= L, C_um * np.minimum(t, 1.0 - t), 0.0)
+        np.testing.assert_allclose(te0, want0, atol=1e-9)
+        assert te0[2] == pytest.approx(C_um / 2, rel=1e-12)
     # unmodified: single/double contact deflections W/k and W/(2k)
     r = _run(pair, B_NASA, PairModification.none(), T_design, s0=s0)
     te = np.asarray(r.te_loaded_um)
