@@ -23,6 +23,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from gearjax.compile_ahead import call
 from gearjax.errors import check_int, check_range
 from gearjax.gears.involute.line_efficiency import line_efficiency_traced
 from gearjax.gears.involute.line_load import (LineLoad, LineLoadOptions, line_load_traced,
@@ -202,7 +203,7 @@ def loaded_te_map(design, torques_Nm, misalignments_um=(0.0,), *, mods=None, sid
         rpm = float(pinion_rpm)
         oil = dataclasses.replace(oil, name="")     # the label is not part of the program
     opts = _options(pair, b, positions, slices, compliance)
-    out = _map(*_split(pair), b, mods, jnp.asarray(1e3 * T), jnp.asarray(A), mat.youngs_modulus_MPa,
-               mat.poisson, float(temperature_um), rpm, oil, surface, opts, side == "drive",
-               viscosity_model, film_method)
+    out = call(_map, *_split(pair), b, mods, jnp.asarray(1e3 * T), jnp.asarray(A), mat.youngs_modulus_MPa,
+               mat.poisson, float(temperature_um), rpm, oil, surface, opts=opts,
+               drive=side == "drive", vm=viscosity_model, fm=film_method)
     return LoadedTEMap(jnp.asarray(T), jnp.asarray(A), *out)
