@@ -30,8 +30,13 @@ Lagrangian ``f + lam^T g`` at the updated multipliers.
     complementarity  max_i |min(lam_i, -g_i)|
 
 Status: 0 (:data:`~gearjax.optimize.CONVERGED`) when the test is met, 2 (``FAILED``) when
-``f``, ``g`` or the gradient turn non-finite, else 1 (``MAX_ITERATIONS``).  An infeasible
-problem ends with 1 and ``feasibility > tol``.
+``f``, ``g`` or the gradient turn non-finite or the solve stalls (an inner solve ends out
+of steps, or in a failed line search after starting from steepest descent -- the matrix
+reset after the previous failure --, having lowered ``L_rho`` by no more than 1e-12
+relative, with the multipliers unchanged: every later outer iteration would repeat it
+-- a kink of a piecewise-smooth objective, or a decrease below rounding), else 1
+(``MAX_ITERATIONS``).
+An infeasible problem ends with 1 and ``feasibility > tol``.
 
 **Inner solver**: a projected quasi-Newton method (Bertsekas 1982) on the box.  The
 eps-active set ``A`` (variables within ``min(1e-3, |P(x - grad) - x|)`` of a bound whose
@@ -76,6 +81,8 @@ __all__ = ["ConstrainedResult", "minimize_constrained"]
 _RHO_MAX = 1e8
 _LAM_MAX = 1e20
 _MAX_BACKTRACK = 20
+#: relative decrease of L_rho over an inner solve below which a failed one stalls
+_STALL = 1e-12
 _ARMIJO = 1e-4
 
 
@@ -225,7 +232,19 @@ def _run(fun, max_outer, max_inner, callback, x0, lo, hi, tol, rho0, args,
         finite = (jnp.isfinite(f) & jnp.all(jnp.isfinite(g)) & jnp.all(jnp.isfinite(grad))
                   & jnp.all(jnp.isfinite(x)))
         done = (stat <= tol) & (feas <= tol) & (compl <= tol)
-        status = jnp.where(~finite, FAILED, jnp.where(done, CONVERGED, MAX_ITERATIONS))
+        # stalled: an inner solve ends out of steps, or in a failed line search after
+        # starting from steepest descent (the matrix reset after the last failure),
+        # having lowered L by no more than rounding, and the multipliers do not move --
+        # every later outer iteration would repeat it (a kink of f or g, or a decrease
+        # below rounding): no step can reduce L, the FAILED status
+        L0 = jnp.where(reset, Le, st["L0"])           # L where this inner solve started
+        fresh0 = jnp.where(reset, st["fresh"], st["fresh0"])
+        by_eps = ok & (_pg(x, grad, lo, hi) <= st["eps"])
+        stalled = (inner_done & ~by_eps & (fresh0 | ~give_up)
+                   & (L0 - L <= _STALL * jnp.maximum(1.0, jnp.abs(L)))
+                   & jnp.all(lam_new == lam) & ~done)
+        status = jnp.where(~finite | stalled, FAILED,
+                           jnp.where(done, CONVERGED, MAX_ITERATIONS))
         if callback is not None:
             jax.debug.callback(_report(callback), inner_done, k + 1, f, feas, stat)
         outer = lambda a, b: jax.tree_util.tree_map(  # noqa: E731
@@ -249,7 +268,7 @@ def _run(fun, max_outer, max_inner, callback, x0, lo, hi, tol, rho0, args,
         bt = jnp.where(ok | inner_done, 0, st["bt"] + 1)
         return dict(x=x, L=L, grad=grad, f=f, g=g, B=B, fresh=fresh, it=it, xe=xe, d=d, a=a,
                     bt=bt, mode=mode, lam=lam, rho=rho, V=V, eps=eps, k=k_new,
-                    nev=st["nev"] + 1, status=status, stat=jnp.where(inner_done, stat,
+                    nev=st["nev"] + 1, status=status, L0=L0, fresh0=fresh0, stat=jnp.where(inner_done, stat,
                                                                      st["stat"]),
                     feas=jnp.where(inner_done, feas, st["feas"]),
                     compl=jnp.where(inner_done, compl, st["compl"]),
@@ -260,6 +279,7 @@ def _run(fun, max_outer, max_inner, callback, x0, lo, hi, tol, rho0, args,
               g=jnp.full(m, jnp.nan, dt), B=jnp.eye(n, dtype=dt), fresh=jnp.asarray(True),
               it=jnp.asarray(0), xe=x0, d=jnp.zeros(n, dt), a=jnp.ones((), dt),
               bt=jnp.asarray(0), mode=jnp.asarray(_RESET), lam=jnp.zeros(m, dt), rho=rho0 + z,
+              L0=jnp.inf + z, fresh0=jnp.asarray(True),
               V=jnp.inf + z, eps=(tol if m == 0 else jnp.maximum(tol, 0.1)) + z,
               k=jnp.asarray(0), nev=jnp.asarray(0), status=jnp.asarray(MAX_ITERATIONS),
               stat=jnp.nan + z, feas=jnp.nan + z, compl=jnp.nan + z,

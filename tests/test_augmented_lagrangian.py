@@ -183,6 +183,29 @@ def test_non_finite_values_fail():
     assert int(r.status) == FAILED and r.message.startswith("failed")
 
 
+def kinked(x):
+    """|x0 - 1| + 3 |x1 + 0.5| + x2^2, with an inactive constraint: the minimum (1, -0.5,
+    0) sits on the kinks, where no line search succeeds once x0 and x1 are there."""
+    return (jnp.abs(x[0] - 1.0) + 3.0 * jnp.abs(x[1] + 0.5) + x[2] ** 2,
+            jnp.array([x[2] - 5.0]))
+
+
+def test_a_stalled_solve_stops_as_failed():
+    """At a kink every inner solve either runs out of steps lowering L by rounding only or
+    fails its line search from steepest descent; with the multipliers unchanged each
+    later outer iteration would repeat it.  The solve stops there, FAILED ("no step
+    reduced the objective"), at the kink, after the second outer iteration.  Measured:
+    before this exit it ran all 30 outer iterations, 10 697 evaluations, and reported
+    the iteration limit.  Planted bugs caught: the stall test removed (30 iterations
+    again), or taken on a solve that ended at its eps test (the smooth problems of
+    test_known_optimum stop early, not converged)."""
+    r = minimize_constrained(kinked, jnp.array([0.3, 0.7, 2.0]), lower=-10.0, upper=10.0,
+                             tol=1e-8)
+    assert int(r.status) == FAILED and r.message.startswith("failed")
+    assert int(r.outer_iterations) <= 3 and int(r.evaluations) < 1500
+    np.testing.assert_allclose(np.asarray(r.x), [1.0, -0.5, 0.0], atol=1e-9)
+
+
 CALLS = []
 
 
