@@ -46,8 +46,9 @@ JSON_KEYS_DOC = """JSON keys:
                    separation closed first at zero load), T x A
   p_max_MPa        highest Hertz pressure over the cycle and the face (MPa), T x A
   k_hbeta          face load factor K_Hbeta of the cycle-mean load distribution, T x A
-  end_load_ratio   highest load per unit face width in an end slice over the mean
-                   (> 1: the face ends carry more than the middle), T x A
+  end_load_ratio   load per unit face width in the end slices over the mean, of the
+                   cycle-mean distribution (> 1: the face ends carry more than the
+                   middle), T x A
   power_loss_W     mean sliding power loss over the cycle (W), T x A; null without --rpm
   efficiency       mesh efficiency over the cycle, T x A; null without --rpm
   converged        every position of the cycle converged (with --rpm: and every
@@ -243,7 +244,8 @@ def run(args) -> int:
     if args.json:
         print_json(out)
         return status
-    keys = ("te_ptp_um", "te_mean_um", "te_unloaded_ptp_um", "p_max_MPa", "k_hbeta", "end_load_ratio") + (
+    keys = ("te_ptp_um", "te_mean_um", "te_unloaded_ptp_um", "p_max_MPa", "k_hbeta",
+            "end_load_ratio") + (
         ("power_loss_W", "efficiency") if lube else ())
     warn_nonfinite(f"{k}[{i}][{j}]" for k in keys
                    for i, j, _, _ in _rows(out) if not math.isfinite(out[k][i][j]))

@@ -49,7 +49,12 @@ a continuous, piecewise-linear, increasing function of ``delta``: solved exactly
 sorting the separations (the count ``m`` of points in contact is the number of
 breakpoints below the load, then ``delta = (W + sum_{j<m} k_j e_j) / sum_{j<m} k_j``),
 with no iteration and no smoothing; the derivative of ``delta`` (and of every load)
-with respect to every design field is that of the active piece, exact.  The normal
+with respect to every design field is that of the active piece, exact.  The results
+are therefore piecewise smooth in the design: the derivative jumps where a slice point
+enters or leaves contact, and where a sampled point crosses the start of a linear
+relief (a parabolic relief has no such kink).  At a kink the gradient is one of the
+one-sided slopes; an optimiser's stationarity test is limited there (the
+augmented Lagrangian stops as stalled, :mod:`gearjax.augmented_lagrangian`).  The normal
 load of a point is ``F_j = k_j max(delta - e_j, 0) cos(beta_b)``.
 
 **Outputs**: the loaded transmission error as the approach ``delta`` (µm along the line
@@ -139,8 +144,12 @@ class LineLoad(NamedTuple):
     face_load : (M, N) load per unit face width along the face (N/mm, normal).
     k_hbeta : (M,) face load factor per position.  k_hbeta_mean : the factor of the
         cycle-mean distribution.
-    end_load : (M,) load per unit face width in the end slices over the mean (the
-        larger end; > 1: the face ends are loaded harder than the middle).
+    end_load : (M,) load per unit face width in the end slices over the mean, per
+        position (the larger end).  For a helical pair it also follows how many contact
+        lines cross each slice at that position (1.25 for an aligned unmodified pair),
+        so the edge loading is read from ``end_load_mean``.
+    end_load_mean : the same of the cycle-mean distribution (> 1: the face ends carry
+        more than the middle over the cycle; 1 for an aligned unmodified pair).
     n_points : (M,) slice points carrying load.
     balance : (M,) relative torque residual.  converged : (M,) balance below
         :data:`BALANCE_TOL` and some point on the path.
@@ -162,6 +171,7 @@ class LineLoad(NamedTuple):
     k_hbeta: jax.Array
     k_hbeta_mean: jax.Array
     end_load: jax.Array
+    end_load_mean: jax.Array
     n_points: jax.Array
     balance: jax.Array
     converged: jax.Array
@@ -262,6 +272,7 @@ def line_load_traced(pair: InvolutePair, face_width, mods: PairModification, tor
                     te_unloaded_um=1e3 * jnp.min(e_pos, axis=1), mesh_stiffness=stiff,
                     face_load=face, k_hbeta=k_hb, k_hbeta_mean=jnp.max(cyc) / jnp.mean(cyc),
                     end_load=jnp.maximum(face[:, 0], face[:, -1]) / mean_face,
+                    end_load_mean=jnp.maximum(cyc[0], cyc[-1]) / jnp.mean(cyc),
                     n_points=jnp.sum(loaded, axis=(0, 2)), balance=balance,
                     converged=converged)
 

@@ -120,8 +120,8 @@ class LoadedTEMap(NamedTuple):
     te_mean_um : mean loaded TE (µm).
     te_unloaded_ptp_um : peak-to-peak of the unloaded TE (the separation closed first,
         the approach at zero load; µm): the TCA of the modified line contact.  p_max : highest Hertz pressure (MPa).
-    k_hbeta : face load factor of the cycle-mean distribution.  end_load : highest
-        end-slice load ratio over the cycle.
+    k_hbeta : face load factor of the cycle-mean distribution.  end_load : end-slice
+        load per unit face width over the mean, of the cycle-mean distribution.
     converged : every position of the cycle converged (and, with efficiency, every
         loaded point's friction).
     power_loss_W : mean sliding power loss over the cycle (W; NaN without ``pinion_rpm``).
@@ -161,7 +161,7 @@ def te_map_traced(pair, b, mods, torques_Nmm, f_ma, E, nu, opts, drive, temperat
         te = r.te_loaded_um
         te0 = r.te_unloaded_um
         return (jnp.max(te) - jnp.min(te), smooth_ptp(te, temperature_um), jnp.mean(te),
-                jnp.max(te0) - jnp.min(te0), jnp.max(r.p_max), r.k_hbeta_mean, jnp.max(r.end_load), ok, loss, eff)
+                jnp.max(te0) - jnp.min(te0), jnp.max(r.p_max), r.k_hbeta_mean, r.end_load_mean, ok, loss, eff)
 
     return jax.vmap(lambda T: jax.vmap(lambda f: one(T, f))(f_ma))(torques_Nmm)
 
