@@ -437,3 +437,21 @@ def test_sliding_loss_factor_closed_forms(nasa):
             if pair.helix == 0.0:
                 from gearjax.gears.involute.mesh import ohlendorf_loss_factor
                 assert float(ohlendorf_loss_factor(pair)) == pytest.approx(H_V, rel=1e-12)
+
+
+# ------------------------------------------------------------------ the notebook
+
+def test_microgeometry_notebook_runs(tmp_path):
+    """notebooks/08_microgeometry.ipynb top to bottom (after this file's programs): every
+    operating point converged, its exact gradient against central differences, its
+    robust design better than the unmodified and the packaged flanks, three figures."""
+    import re
+
+    from notebook_run import images, run_notebook
+    nb, text = run_notebook("08_microgeometry", tmp_path)
+    assert "all converged: True" in text
+    assert float(re.search(r"max rel\. error ([0-9.e+-]+)", text).group(1)) < 1e-6
+    m = re.search(r"unmodified ([0-9.]+), packaged ([0-9.]+), robust design ([0-9.]+)", text)
+    unmod, packaged, robust = map(float, m.groups())
+    assert robust < packaged < unmod
+    assert images(nb) == 3
