@@ -260,10 +260,11 @@ def run_al(prob: Problem, x0, tol, max_outer, warm=True):
                "recorded_evaluations": len(prob.al_trace)}, list(prob.al_trace)
 
 
-def run_cobyla(prob: Problem, x0, maxfev):
-    from scipy.optimize import minimize
-    trace = []
-    cache = {}
+def _cached_fg(prob: Problem):
+    """``(fg, trace)``: ``prob.numpy_fg`` evaluated once per distinct point (scipy asks
+    for the objective and the constraints of a point separately), and the trace of
+    (objective, largest constraint) of every distinct point."""
+    trace, cache = [], {}
 
     def fg(x):
         key = np.asarray(x).tobytes()
@@ -271,7 +272,12 @@ def run_cobyla(prob: Problem, x0, maxfev):
             cache[key] = prob.numpy_fg(x)
             trace.append((cache[key][0], float(np.max(cache[key][1]))))
         return cache[key]
+    return fg, trace
 
+
+def run_cobyla(prob: Problem, x0, maxfev):
+    from scipy.optimize import minimize
+    fg, trace = _cached_fg(prob)
     prob.n_eval = 0
     t0 = time.perf_counter()
     r = minimize(lambda x: fg(x)[0], x0, method="COBYLA",
@@ -312,15 +318,7 @@ def run_de(prob: Problem, maxiter, popsize=10):
     """scipy's differential evolution (a global derivative-free search) with the two
     constraints as a NonlinearConstraint (its feasibility rules), seed 0, no polish."""
     from scipy.optimize import NonlinearConstraint, differential_evolution
-    trace, cache = [], {}
-
-    def fg(x):
-        key = np.asarray(x).tobytes()
-        if key not in cache:
-            cache[key] = prob.numpy_fg(x)
-            trace.append((cache[key][0], float(np.max(cache[key][1]))))
-        return cache[key]
-
+    fg, trace = _cached_fg(prob)
     prob.n_eval = 0
     t0 = time.perf_counter()
     r = differential_evolution(lambda x: fg(x)[0], [(0.0, 1.0)] * X_START.size,
