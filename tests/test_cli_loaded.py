@@ -228,6 +228,37 @@ def test_member_and_flank_tables(raw):
     assert _with(raw, {"pinion": {"lead_crowning_um": 2.0}}).micro.drive.gear == \
         gj.involute.FlankModification.none()
     assert read_involute(raw).micro is None
+    f = _with(raw, {"pinion_drive": {"tip_relief_um": 7.0, "tip_relief_length_mm": 2.0},
+                    "pinion_coast": {"lead_crowning_um": 3.0}})
+    assert float(f.micro.drive.pinion.tip_relief) == 7.0
+    assert float(f.micro.drive.pinion.lead_crowning) == 0.0
+    assert float(f.micro.coast.pinion.lead_crowning) == 3.0
+    assert float(f.micro.coast.pinion.tip_relief) == 0.0
+
+
+def test_coast_side_reports_and_analyses_the_coast_flanks(raw, tmp_path):
+    """``--side coast`` on a design whose coast flanks differ from its drive flanks: the
+    JSON's ``modifications`` are the coast flanks' and the numbers those of
+    ``loaded_te_map(side="coast")`` (not the drive side's).  Planted bugs caught: the
+    reported modifications always the drive side's, the side not passed to the map, a
+    pinion_coast table read into the drive flank."""
+    d = copy.deepcopy(raw)
+    d["microgeometry"] = {"pinion_drive": {"tip_relief_um": 7.0, "tip_relief_length_mm": 2.0},
+                          "pinion_coast": {"lead_crowning_um": 9.0}}
+    path = tmp_path / "coast.toml"
+    from gearjax.io.toml import dumps_toml
+    path.write_text(dumps_toml(d))
+    rc, text, err = _call(["loaded", str(path), "--torque-Nm", "150", *SMALL, "--side",
+                           "coast", "--json"])
+    assert rc == 0, err
+    out = _strict(text)
+    assert out["modifications"]["pinion"]["lead_crowning"] == 9.0
+    assert out["modifications"]["pinion"]["tip_relief"] == 0.0
+    f = gj.load_design(str(path))
+    for side in ("coast", "drive"):
+        m = gj.involute.loaded_te_map(f, [150.0], [0.0], side=side, positions=8, slices=6)
+        same = out["te_ptp_um"][0][0] == pytest.approx(float(m.te_ptp_um[0, 0]), rel=1e-12)
+        assert same == (side == "coast")
 
 
 @pytest.mark.parametrize("micro, needles", [

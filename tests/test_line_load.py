@@ -158,6 +158,52 @@ def test_harris_long_relief_closed_form(nasa):
     np.testing.assert_allclose(te[1:4], 0.5 * te[-1], rtol=1e-12)
 
 
+def test_one_member_relief_acts_on_its_own_tip(nasa):
+    """Linear long relief C = W/(2k) on the pinion only, constant stiffness: at fraction t
+    of the first double zone the entering pair (at the gear's tip, unmodified) has no
+    separation and the leaving pair (at the pinion's tip) C t, so d = W/(2k) + C t/2; in
+    single contact d = W/k.  Mirrored in time if the relief were put on the gear's tip.
+    Planted bugs caught: the members' modifications evaluated on each other's roll
+    lengths, the gear's roll length measured from the wrong end."""
+    pair, des = nasa
+    geo = pair_geometry(pair)
+    p_b = 2 * math.pi * float(geo["rb1"]) / pair.z1
+    L = (float(geo["contact_ratio"]) - 1.0) * p_b
+    s_A = float(geo["rho_A"] - geo["rho_P"])
+    T = 71.8e3
+    k = float(iso6336_single_stiffness(*NASA[:2]).c_prime) * 1e3 * B_NASA
+    W_k_um = 1e3 * T / float(geo["rb1"]) / k
+    C = 0.5 * W_k_um
+    mods = PairModification(FlankModification.create(tip_relief=C, tip_relief_length=L),
+                            FlankModification.none())
+    t = np.array([0.1, 0.3, 0.6, 0.9])
+    r = _run(pair, B_NASA, mods, T, s0=np.concatenate([s_A + t * L, [s_A + L + 0.5 * (p_b - L)]]))
+    want = np.concatenate([0.5 * W_k_um + 0.5 * C * t, [W_k_um]])
+    np.testing.assert_allclose(np.asarray(r.te_loaded_um), want, rtol=1e-12)
+
+
+def test_slice_fraction_at_the_path_ends():
+    """A helical slice whose contact-line piece crosses an end of the path carries the
+    part on the path: centred h/2 inside s_A (h its half-extent along the path,
+    dy tan(beta_b)/2) it carries 3/4 of its length, centred on s_A one half, centred h/2
+    outside one quarter.  Planted bug caught: the piece's extent along the path doubled
+    or halved (the total over a tiling face is unchanged by it: only a local check
+    sees it)."""
+    pair = _pair(23, 67, 3.0, 20.0, 20.0, 0.2, -0.1)
+    geo = pair_geometry(pair)
+    b, N = 30.0, 10
+    dy = b / N
+    tb, cb = math.tan(float(geo["beta_b"])), math.cos(float(geo["beta_b"]))
+    h = 0.5 * dy * tb
+    s_A = float(geo["rho_A"] - geo["rho_P"])
+    y0 = -0.5 * b + 0.5 * dy                       # centre of slice 0
+    s0 = np.array([s_A + 0.5 * h, s_A, s_A - 0.5 * h]) - y0 * tb
+    r = _run(pair, b, PairModification.none(), 200e3, s0=s0, slices=N)
+    k0 = -pair_range(pair, b)[0]                  # index of pair k = 0
+    np.testing.assert_allclose(np.asarray(r.length)[k0, :, 0] / (dy / cb), [0.75, 0.5, 0.25],
+                               rtol=1e-12)
+
+
 # ------------------------------------------------------------------ face load factor
 
 @pytest.mark.parametrize("f_ma", [4.0, 20.0, -20.0], ids=["linear", "separated", "end II"])
@@ -201,7 +247,9 @@ def test_aligned_helical_pair_equal_approach_and_contact_length():
     line load x compliance per unit length is the same at all of them (Weber model;
     with the ISO constant compliance the line load itself is uniform).  Planted bugs
     caught: a slice's fraction on the path computed from its centre only, the line
-    length without 1/cos(beta_b), the helix offset's sign per pair."""
+    length without 1/cos(beta_b), the helix offset's sign (the end-I/end-II axis of
+    the docs mirrored: an end relief would act on the other end), the Hertz radius
+    not that of the normal section."""
     pair = _pair(23, 67, 3.0, 20.0, 20.0, 0.2, -0.1)
     geo = pair_geometry(pair)
     p_bt = 2 * math.pi * float(geo["rb1"]) / pair.z1
@@ -214,6 +262,11 @@ def test_aligned_helical_pair_equal_approach_and_contact_length():
         assert bool(np.all(r.converged))
         Ltot = np.asarray(r.length).sum(axis=(0, 2))
         np.testing.assert_allclose(Ltot, eps * b / cb, rtol=1e-9)
+        # the documented axis: along each contact line the path coordinate grows from
+        # end I to end II by b tan(beta_b), so a pair first touches at end II (its
+        # end reliefs and slopes act on the end the user named)
+        ds = np.diff(np.asarray(r.s), axis=2)
+        np.testing.assert_allclose(ds, b / 24 * math.tan(float(geo["beta_b"])), rtol=1e-9)
         if model == "iso6336":
             # the face is loaded evenly over the cycle (the ends like the middle), to the
             # sampling of the cycle: 12 positions leave 0.9 % (the per-position ratio is
@@ -225,6 +278,17 @@ def test_aligned_helical_pair_equal_approach_and_contact_length():
         w = np.asarray(r.line_load)[on]
         if model == "iso6336":
             np.testing.assert_allclose(w, w.mean(), rtol=1e-9)
+            # Hertz line contact of the normal section ([Johnson1985] 4.45):
+            # p = sqrt(w E' / (2 pi R)), R = xi1 xi2 / ((xi1 + xi2) cos(beta_b)), at the
+            # slices wholly on the path (their centre is their contact point)
+            full = on & np.isclose(np.asarray(r.length), b / 24 / cb, rtol=1e-12)
+            xi1 = float(geo["rho_P"]) + np.asarray(r.s)[full]
+            xi2 = float(geo["a_w"]) * math.sin(float(geo["alpha_wt"])) - xi1
+            R = xi1 * xi2 / ((xi1 + xi2) * cb)
+            Ep = 206000.0 / (1 - 0.3 ** 2)
+            wf = np.asarray(r.line_load)[full]
+            np.testing.assert_allclose(np.asarray(r.p_max)[full],
+                                       np.sqrt(wf * Ep / (2 * math.pi * R)), rtol=1e-12)
         else:
             k = np.asarray(r.load)[on] / cb / 1.0     # normal load = k (d - e) cos(beta_b)
             # normal approach = F / k_slice; k_slice = length / q'  ->  w q' = const
@@ -455,3 +519,41 @@ def test_microgeometry_notebook_runs(tmp_path):
     unmod, packaged, robust = map(float, m.groups())
     assert robust < packaged < unmod
     assert images(nb) == 3
+
+
+def test_library_entry_points_refuse_bad_input(nasa, monkeypatch):
+    """One-line ValueErrors naming the parameter before any work (the programs are never
+    called): the map's torques, misalignments, smoothing temperature, resolution and
+    model; a rack mismatch of the TCA route (not a flank modification of this model);
+    speed without lubrication.  Planted bugs caught: a refusal dropped (a zero
+    temperature gives NaN, a crowned design is analysed as unmodified)."""
+    from gearjax.gears.involute import loaded_lines
+    monkeypatch.setattr(loaded_lines, "_map", None)      # any call would fail differently
+    monkeypatch.setattr(loaded_lines, "_one", None)
+    pair, des = nasa
+    cases = [
+        (dict(torques_Nm=[0.0]), r"torques_Nm = 0 .*\[0.001, 1e\+07\]"),
+        (dict(misalignments_um=[2000.0]), r"misalignments_um = 2000"),
+        (dict(temperature_um=0.0), r"temperature_um = 0"),
+        (dict(positions=2), r"positions = 2"),
+        (dict(slices=0), r"slices = 0"),
+        (dict(compliance="steel"), r"compliance = 'steel'"),
+        (dict(pinion_rpm=1000.0), r"pinion_rpm needs an oil"),
+    ]
+    for kw, msg in cases:
+        args = dict(torques_Nm=[100.0])
+        args.update(kw)
+        with pytest.raises(ValueError, match=msg):
+            loaded_lines.loaded_te_map(des, **args)
+    for field in ("lead_crown", "profile_crown", "dalpha"):
+        crowned = gj.involute.InvoluteTCA(pair, **{**dict(dalpha=des.dalpha,
+                                                          profile_crown=des.profile_crown,
+                                                          lead_crown=des.lead_crown,
+                                                          face_width=des.face_width),
+                                                   field: jnp.asarray(1e-4)})
+        with pytest.raises(ValueError, match=f"{field} = 0.0001: the line-contact model"):
+            loaded_lines.loaded_te_map(crowned, [100.0])
+        with pytest.raises(ValueError, match=field):
+            loaded_lines.line_contact(crowned, 100.0)
+    with pytest.raises(TypeError, match="involute pairs"):
+        loaded_lines.line_contact(gj.load_design("example:hft_8x43"), 100.0)
