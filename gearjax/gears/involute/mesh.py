@@ -10,8 +10,10 @@ Load-carrying width: a line contact (spur pair) carries its load along the whole
 face width ``b``; a point contact (crowned pinion) over the major axis of its
 contact ellipse at the elastic approach of the TCA (0.00632 mm, the bearing
 length of Gleason practice), at most ``b``.  A helical pair in *line* contact is
-not supported (its contact lines leave the transverse section of the TCA: give
-the pinion a lead crown, which every helical pinion carries in practice).
+not supported here (its contact lines leave the transverse section of the TCA: give
+the pinion a lead crown, which every helical pinion carries in practice); the line
+contact of spur and helical pairs, with their micro-geometry, is
+:mod:`gearjax.gears.involute.line_load` (``gearjax loaded``).
 
 Units: mm, rad.  References (docs/references.md): [ISO6336-1].
 """
@@ -31,8 +33,10 @@ def check_mesh_supported(des, line_contact: bool) -> None:
     """Refuse a helical pair in line contact (concrete; module docstring)."""
     if line_contact and float(des.pair.helix) != 0.0:
         raise ValueError(f"helix = {float(des.pair.helix) * 180 / jnp.pi:g} deg in line contact: "
-                         "the loaded contact of a helical pair needs point contact "
-                         "(give the pinion a lead crown, e.g. lead_crown=1e-4 1/mm)")
+                         "this loaded contact (through the TCA) needs point contact: give the "
+                         "pinion a lead crown (e.g. lead_crown=1e-4 1/mm), or analyse the line "
+                         "contact with `gearjax loaded --rpm ...` "
+                         "(gearjax.involute.loaded_te_map)")
 
 
 def involute_mesh_teeth(des, res: TCAResult, line_contact: bool,
