@@ -312,9 +312,27 @@ TCA_INV = "involute:z1=20,z2=40,m=4,alpha=20,b=30"
 _BAD_POSITIVE = ("0", "-1", "nan", "inf", "-inf", "1e300", "abc")
 
 
+def _example_data(example: str) -> dict:
+    return tomllib.loads((EXAMPLES_DIR / f"{example}.toml").read_text(encoding="utf-8"))
+
+
 def _has_flanks(example: str) -> bool:
-    data = tomllib.loads((EXAMPLES_DIR / f"{example}.toml").read_text(encoding="utf-8"))
-    return "pinion" in data and "gear" in data
+    """The example has flanks for the TCA: machine settings of both members (hypoid,
+    spiral bevel), an involute pair (rack-generated) without a [microgeometry] table
+    (which the TCA refuses: `gearjax loaded` analyses it), or a family whose flanks
+    follow from the design (preset-TE bevel, VH-CATT)."""
+    data = _example_data(example)
+    kind = data.get("design", {}).get("kind")
+    if kind == "involute":
+        return "microgeometry" not in data
+    if kind in ("hypoid", "spiral_bevel"):
+        return "pinion" in data and "gear" in data
+    return True                 # the preset-TE bevel and VH-CATT pairs: flanks by design
+
+
+def _is_bevel(example: str) -> bool:
+    """The example is a hypoid or spiral-bevel design file (what `gearjax blank` takes)."""
+    return _example_data(example).get("design", {}).get("kind") in ("hypoid", "spiral_bevel")
 
 
 def build_cases() -> list[Case]:
@@ -512,8 +530,13 @@ def build_cases() -> list[Case]:
 
     # ---------------------------------------------------------------- blank
     for name in EXAMPLES:
-        add(f"blank.example.{name}", ["blank", f"example:{name}", "--json"], "ok",
-            "packaged example")
+        if _is_bevel(name):
+            add(f"blank.example.{name}", ["blank", f"example:{name}", "--json"], "ok",
+                "packaged example")
+        else:
+            add(f"blank.example.{name}", ["blank", f"example:{name}", "--json"], "refuse",
+                "packaged example of another kind: the blank is for hypoid and "
+                "spiral-bevel designs")
     add("blank.example_table", ["blank", "example:hft_8x43"], "flag",
         "table output; the seed formula's cutter tilt has no solution for the 8/43 set "
         "('none' and a warning)")
@@ -935,7 +958,8 @@ def build_cases() -> list[Case]:
                 heavy=True)
         else:
             add(f"tca.example.{name}", ["tca", f"example:{name}", "--side", "both", "--json"],
-                "refuse", "packaged example without machine settings (a blank only)")
+                "refuse", "packaged example without machine settings (a blank only), or "
+                "with [microgeometry] (analysed by gearjax loaded)")
     add("tca.example.spiral_bevel_kinematics",
         ["tca", "example:spiral_bevel_10x30_synthesised", "--kinematics", "--json"], "flag",
         "packaged example with kinematics; its drive TE parabola opens upwards (pair 0 is "
