@@ -336,3 +336,19 @@ def test_lubrication_flags_refused_before_work(extra, msg, monkeypatch):
     rc, out, err = _call(["loaded", EXAMPLE, "--torque-Nm", "200", *extra])
     assert rc == 2, (rc, err)
     assert msg in err and len(err.strip().splitlines()) == 1, err
+
+
+def test_coarse_slices_warned():
+    """A helical face cut into one slice (its piece spans more than a quarter of the path
+    of contact) gets a warning line naming the slices to use; the default cut of the
+    example and any spur pair none.  Planted bug caught: the helix angle left out of
+    the check (spur pairs warned, helical ones not)."""
+    design = gj.load_design(EXAMPLE)
+    w = gj.involute.resolution_warnings(design, 1)
+    assert len(w) == 1 and "use at least" in w[0]
+    n = int(w[0].rsplit("at least ", 1)[1].split()[0])
+    assert gj.involute.resolution_warnings(design, n) == []
+    assert gj.involute.resolution_warnings(design, n - 1) != []
+    assert gj.involute.resolution_warnings(design, 20) == []
+    spur = gj.involute.InvoluteTCA.create(gj.involute.InvolutePair.create(20, 40, 4, 20), 80.0)
+    assert gj.involute.resolution_warnings(spur, 1) == []

@@ -25,6 +25,7 @@ import numpy as np
 
 from gearjax.compile_ahead import call
 from gearjax.errors import check_int, check_range
+from gearjax.gears.involute.geometry import pair_geometry
 from gearjax.gears.involute.line_efficiency import line_efficiency_traced
 from gearjax.gears.involute.line_load import (LineLoad, LineLoadOptions, line_load_traced,
                                               pair_range, smooth_ptp)
@@ -33,7 +34,7 @@ from gearjax.gears.involute.microgeometry import (MicroGeometry, PairModificatio
 from gearjax.loading.loaded_contact import COMPLIANCE_MODELS
 from gearjax.loading.materials import pair_material
 
-__all__ = ["line_contact", "loaded_te_map", "LoadedTEMap", "line_design",
+__all__ = ["line_contact", "loaded_te_map", "LoadedTEMap", "line_design", "resolution_warnings",
            "TORQUE_RANGE_NM", "MISALIGNMENT_RANGE_UM"]
 
 #: accepted pinion torques (N m)
@@ -68,6 +69,29 @@ def line_design(design, mods=None, side: str = "drive"):
         raise TypeError(f"mods must be a PairModification, not a {type(mods).__name__}")
     check_modification(mods.pinion, "pinion."), check_modification(mods.gear, "gear.")
     return des.pair, des.face_width, mods, pair_material(design)
+
+
+#: largest part of the path of contact one slice's contact-line piece may span before
+#: :func:`resolution_warnings` calls the face coarse
+COARSE_SLICE_SHARE = 0.25
+
+
+def resolution_warnings(design, slices) -> list:
+    """Warning lines (no output) when the face is cut too coarsely for the helix: a
+    slice's contact-line piece spans ``dy tan(beta_b)`` of the path of contact, and
+    beyond :data:`COARSE_SLICE_SHARE` of it the load along a line is resolved by a few
+    pieces only (the results converge with more slices; docs/microgeometry.md)."""
+    pair, b, _, _ = line_design(design)
+    geo = pair_geometry(pair)
+    span = float(b) / int(slices) * float(np.tan(float(geo["beta_b"])))
+    path = float(geo["rho_E"] - geo["rho_A"])
+    if span <= COARSE_SLICE_SHARE * path:
+        return []
+    need = int(np.ceil(float(b) * float(np.tan(float(geo["beta_b"])))
+                       / (COARSE_SLICE_SHARE * path)))
+    return [f"a face slice's contact line spans {span:.3g} mm of the {path:.3g} mm path of "
+            f"contact (more than {COARSE_SLICE_SHARE:g} of it): the load along the contact "
+            f"lines is coarsely resolved; use at least {need} slices"]
 
 
 def _options(pair, b, positions, slices, compliance):
