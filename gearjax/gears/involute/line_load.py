@@ -28,10 +28,12 @@ and the mesh misalignment).  A rigid approach ``delta`` of the two bodies along 
 line of action (transverse, mm) compresses the point by ``(delta - e) cos(beta_b)``
 along its normal.
 
-**Compliance: a Winkler foundation of thin slices** (the thin-slice model of ISO
-6336-1's face load factor method and of the load-distribution programs; slices are
-not coupled along the face: a modification's effect spreads only as far as the
-slice width, which is the model's stated limit).  A slice of contact-line length
+**Compliance: a Winkler foundation of thin slices.**  This is the elastic foundation
+behind ISO 6336-1's face load factor: the mesh as independent springs of stiffness
+``c_gamma`` per unit face width.  Their linear load distribution under a mesh
+misalignment gives the standard's K_Hbeta formulas, which the tests reproduce.  The
+slices are not coupled along the face, so a modification's effect spreads only as
+far as the slice width; that is the model's stated limit.  A slice of contact-line length
 ``l`` has the normal stiffness ``k = l / q'(s)`` (N/mm), ``q'`` the compliance of the
 tooth pair per unit length of contact line at that point of the path: both teeth as
 Weber/Sainsot cantilevers of the virtual spur gears of the normal section plus
