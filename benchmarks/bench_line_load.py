@@ -25,7 +25,7 @@ import jax.numpy as jnp
 import numpy as np
 
 import gearjax as gj
-from gearjax.gears.involute.line_load import LineLoadOptions, pair_range
+from gearjax.gears.involute.line_load import LineLoadOptions, pair_range, path_points_bound
 from gearjax.gears.involute.loaded_lines import te_map_traced
 from program_memory import memory_cell, peak_rss_mb, program_memory
 
@@ -55,7 +55,9 @@ def main():
     f = gj.load_design("example:helical_microgeometry")
     pair, b = f.design.pair, f.design.face_width
     mods = f.micro.flanks("drive")
-    opts = LineLoadOptions(a.positions, a.slices, *pair_range(pair, b), "weber")
+    opts = LineLoadOptions(a.positions, a.slices, *pair_range(pair, b), "weber",
+                           path_points_bound(pair, b, a.slices))
+    every = opts._replace(path_points=0)
     T = jnp.linspace(50e3, 400e3, a.torques)
     A = jnp.linspace(-10.0, 10.0, a.misalignments)
     oil = dataclasses.replace(gj.tribology.get_oil(gj.tribology.OILS[0]), name="")
@@ -71,10 +73,15 @@ def main():
         return te_map_traced(pair, b, m, T, A, E, nu, opts, True, 0.02,
                              (1500.0, oil, surf, "roelands", "auto"))
 
+    def friction_everywhere(m):
+        return te_map_traced(pair, b, m, T, A, E, nu, every, True, 0.02,
+                             (1500.0, oil, surf, "roelands", "auto"))
+
     def objective(m):
         return jnp.mean(loads(m)[1])
 
-    rows = [("loads", loads), ("loads + friction", with_friction),
+    rows = [("loads", loads), ("loads + friction (on-path points)", with_friction),
+            ("loads + friction (every pair's slices)", friction_everywhere),
             ("grad of mean smooth LTE p-t-p (32 fields)", jax.grad(objective))]
     print(f"# helical_microgeometry: {a.torques} torques x {a.misalignments} misalignments, "
           f"{a.positions} positions x {a.slices} slices x {opts.k_hi - opts.k_lo + 1} pairs "
@@ -89,7 +96,8 @@ def main():
         print(f"| {name} | {tc:.2f} | {1e3 * tr:.1f} | {n_ops / tr:.0f} | {n_pts / tr:.3g} | "
               f"{memory_cell(mem)} |")
     print(f"\ngradient / forward (loads): "
-          f"{times[rows[2][0]] / times['loads']:.2f}; peak RSS {peak_rss_mb():.0f} MB")
+          f"{times[rows[3][0]] / times['loads']:.2f}; friction on the path / everywhere: "
+          f"{times[rows[1][0]] / times[rows[2][0]]:.2f}; peak RSS {peak_rss_mb():.0f} MB")
 
 
 if __name__ == "__main__":

@@ -557,3 +557,33 @@ def test_library_entry_points_refuse_bad_input(nasa, monkeypatch):
             loaded_lines.line_contact(crowned, 100.0)
     with pytest.raises(TypeError, match="involute pairs"):
         loaded_lines.line_contact(gj.load_design("example:hft_8x43"), 100.0)
+
+
+def test_friction_only_where_the_path_is():
+    """The friction evaluated at the bound of path points per position
+    (``path_points_bound``) equals the friction at every pair's slices (1e-12), for a
+    helical and a spur pair; the bound is never exceeded over a cycle, and a bound set
+    too small is reported (the positions not valid), never silently truncated.
+    Planted bugs caught: the compacted friction put back at the wrong points, the
+    bound one pair short."""
+    from gearjax.gears.involute.line_load import path_points_bound
+    oil, surface = gj.tribology.get_oil(gj.tribology.OILS[0]), gj.tribology.make_surface(0.4)
+    relief = FlankModification.create(tip_relief=6.0, tip_relief_length=2.0, lead_crowning=4.0)
+    mods = PairModification(relief, relief)
+    run = jax.jit(line_efficiency_traced, static_argnames="opts")
+    for pair, b in ((_pair(23, 67, 3.0, 20.0, 20.0, 0.2, -0.1), 30.0),):
+        k_lo, k_hi = pair_range(pair, b)
+        full = LineLoadOptions(16, 10, k_lo, k_hi, "weber")
+        P = path_points_bound(pair, b, 10)
+        assert P < (k_hi - k_lo + 1) * 10
+        ref = run(pair, b, mods, 200e3, 5.0, 1500.0, oil, surface, full)
+        cut = run(pair, b, mods, 200e3, 5.0, 1500.0, oil, surface, full._replace(path_points=P))
+        on = np.asarray(ref.loads.length) > 0
+        assert int(on.reshape(on.shape[0], 16, 10).sum(axis=(0, 2)).max()) <= P
+        np.testing.assert_allclose(np.asarray(cut.mu), np.asarray(ref.mu), rtol=1e-12, atol=0)
+        np.testing.assert_allclose(np.asarray(cut.power_loss), np.asarray(ref.power_loss),
+                                   rtol=1e-12)
+        assert bool(np.all(cut.valid)) and bool(np.all(ref.valid))
+        short = run(pair, b, mods, 200e3, 5.0, 1500.0, oil, surface,
+                    full._replace(path_points=P // 3))
+        assert not bool(np.all(short.valid))

@@ -109,14 +109,42 @@ def line_efficiency_traced(pair, face_width, mods, torque_Nmm, misalignment_um_,
     F_eq = jnp.where(loaded, r.line_load * L_line, 1.0)
     E_prime = E / (1.0 - nu ** 2)
     r_y = equivalent_ry(F_eq, r_x, jnp.broadcast_to(L_line, F_eq.shape), E_prime)
-    fr = friction_traced(F_eq, jnp.where(loaded, u_e, 1.0), jnp.abs(u_s), r_x, r_y, oil,
-                         surface, E_prime, viscosity_model=viscosity_model,
-                         film_method=film_method)
+    ue_in = jnp.where(loaded, u_e, 1.0)
+
+    def friction(F_, ue_, us_, rx_, ry_):
+        return friction_traced(F_, ue_, us_, rx_, ry_, oil, surface, E_prime,
+                               viscosity_model=viscosity_model, film_method=film_method)
+
+    K, M, N = r.load.shape
+    P = opts.path_points
+    if 0 < P < K * N:
+        # only the points on the path can carry load: at most P per position
+        # (:func:`~gearjax.gears.involute.line_load.path_points_bound`); the friction
+        # of those, put back in place (the rest carry no load: mu 0)
+        def pos(a):
+            return jnp.moveaxis(a, 1, 0).reshape(M, K * N)
+
+        on = pos(r.length > 0.0)
+        idx = jax.lax.top_k(on.astype(r.load.dtype), P)[1]          # (M, P)
+        take = lambda a: jnp.take_along_axis(pos(a), idx, axis=1)  # noqa: E731
+        fr_p = friction(*(take(a) for a in (F_eq, ue_in, jnp.abs(u_s), r_x, r_y)))
+        rows = jnp.arange(M)[:, None]
+
+        def back(a):
+            full = jnp.zeros((M, K * N), a.dtype).at[rows, idx].set(a)
+            return jnp.moveaxis(full.reshape(M, K, N), 0, 1)
+
+        fr = jax.tree.map(back, fr_p)
+        fr = fr._replace(converged=fr.converged | ~loaded)
+        overflow = jnp.sum(on, axis=1) > P
+    else:
+        fr = friction(F_eq, ue_in, jnp.abs(u_s), r_x, r_y)
+        overflow = jnp.zeros(M, bool)
     mu = jnp.where(loaded, fr.mu, 0.0)
     slide = jnp.sum(r.load * jnp.abs(u_s), axis=(0, 2))          # N mm/s
     loss = 1e-3 * jnp.sum(mu * r.load * jnp.abs(u_s), axis=(0, 2))
     p_in = 1e-3 * jnp.asarray(torque_Nmm, float) * w1
-    fr_ok = jnp.all(jnp.where(loaded, fr.converged, True), axis=(0, 2))
+    fr_ok = jnp.all(jnp.where(loaded, fr.converged, True), axis=(0, 2)) & ~overflow
     return LineEfficiency(r, u_e, u_s, r_x, r_y, fr, mu, loss, p_in, 1.0 - loss / p_in,
                           1.0 - jnp.sum(loss) / (p_in * loss.shape[0]),
                           1e3 * jnp.sum(loss) / jnp.sum(slide), 1e-3 * slide,

@@ -90,6 +90,7 @@ from gearjax.loading.loaded_contact import pair_compliance
 from gearjax.loading.tooth_compliance import E_STEEL, NU_STEEL
 
 __all__ = ["LineLoad", "LineLoadOptions", "line_load_traced", "pair_range", "smooth_ptp",
+           "path_points_bound",
            "BALANCE_TOL"]
 
 #: relative tolerance of the torque balance of a converged position
@@ -104,6 +105,10 @@ class LineLoadOptions(NamedTuple):
     positions : mesh positions per base pitch.  slices : face-width slices.
     k_lo, k_hi : the tooth pairs ``k_lo <= k <= k_hi`` tried (:func:`pair_range`).
     compliance : ``"weber"`` or ``"iso6336"`` (module docstring).
+    path_points : at most this many slice points of one position lie on the path
+        (:func:`path_points_bound`; 0: no bound known).  The friction of
+        :mod:`gearjax.gears.involute.line_efficiency` is evaluated at that many points
+        per position instead of at every pair's slices.
     """
 
     positions: int = 32
@@ -111,6 +116,20 @@ class LineLoadOptions(NamedTuple):
     k_lo: int = -2
     k_hi: int = 3
     compliance: str = "weber"
+    path_points: int = 0
+
+
+def path_points_bound(pair: InvolutePair, face_width, slices: int) -> int:
+    """An upper bound of the slice points on the path at any mesh position (concrete
+    values): along one slice the pairs lie ``p_bt`` apart in ``s`` and a piece reaches
+    ``dy tan(beta_b)/2`` either side of its centre, so at most ``floor((s_E - s_A +
+    dy tan(beta_b)) / p_bt) + 1`` of them touch the path ``[s_A, s_E]``; times the
+    slices, plus one pair's worth of margin for a design an optimiser moves."""
+    geo = pair_geometry(pair)
+    p_bt = 2.0 * math.pi * float(geo["rb1"]) / pair.z1
+    extent = float(geo["rho_E"] - geo["rho_A"]) + float(face_width) / slices * math.tan(
+        float(geo["beta_b"]))
+    return int(slices) * (math.floor(extent / p_bt) + 2)
 
 
 def pair_range(pair: InvolutePair, face_width, margin: int = 1) -> tuple[int, int]:

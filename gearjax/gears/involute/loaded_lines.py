@@ -28,7 +28,7 @@ from gearjax.errors import check_int, check_range
 from gearjax.gears.involute.geometry import pair_geometry
 from gearjax.gears.involute.line_efficiency import line_efficiency_traced
 from gearjax.gears.involute.line_load import (LineLoad, LineLoadOptions, line_load_traced,
-                                              pair_range, smooth_ptp)
+                                              pair_range, path_points_bound, smooth_ptp)
 from gearjax.gears.involute.microgeometry import (MicroGeometry, PairModification,
                                                   check_modification)
 from gearjax.loading.loaded_contact import COMPLIANCE_MODELS
@@ -100,7 +100,8 @@ def _options(pair, b, positions, slices, compliance):
     if compliance not in COMPLIANCE_MODELS:
         raise ValueError(f"compliance = {compliance!r} must be one of {COMPLIANCE_MODELS}")
     k_lo, k_hi = pair_range(pair, b)
-    return LineLoadOptions(int(positions), int(slices), k_lo, k_hi, compliance)
+    return LineLoadOptions(int(positions), int(slices), k_lo, k_hi, compliance,
+                           path_points_bound(pair, b, int(slices)))
 
 
 def _split(pair):
