@@ -221,9 +221,10 @@ def _run(fun, max_outer, max_inner, callback, x0, lo, hi, tol, rho0, args,
         fresh = give_up | jnp.where(acc, fresh_n, st["fresh"])
         it = jnp.where(reset, 0, st["it"] + acc.astype(int))
         # -- the inner solve ends: converged to eps, out of steps or stuck -------------
-        inner_done = ok & ((_pg(x, grad, lo, hi) <= st["eps"]) | (it >= max_inner)) | give_up
-        lam_new = jnp.clip(lam + rho * g, 0.0, _LAM_MAX)
         stat = _pg(x, grad, lo, hi)
+        by_eps = ok & (stat <= st["eps"])
+        inner_done = by_eps | (ok & (it >= max_inner)) | give_up
+        lam_new = jnp.clip(lam + rho * g, 0.0, _LAM_MAX)
         feas, compl = _measures(g, lam_new)
         V = jnp.max(jnp.abs(jnp.minimum(-g, lam / rho)), initial=0.0)
         k = st["k"]
@@ -239,7 +240,6 @@ def _run(fun, max_outer, max_inner, callback, x0, lo, hi, tol, rho0, args,
         # below rounding): no step can reduce L, the FAILED status
         L0 = jnp.where(reset, Le, st["L0"])           # L where this inner solve started
         fresh0 = jnp.where(reset, st["fresh"], st["fresh0"])
-        by_eps = ok & (_pg(x, grad, lo, hi) <= st["eps"])
         stalled = (inner_done & ~by_eps & (fresh0 | ~give_up)
                    & (L0 - L <= _STALL * jnp.maximum(1.0, jnp.abs(L)))
                    & jnp.all(lam_new == lam) & ~done)

@@ -4,7 +4,6 @@ refusals of bad input that must come before any JAX work."""
 
 import contextlib
 import io
-import json
 import os
 import re
 
@@ -14,6 +13,7 @@ import pytest
 import gearjax
 from gearjax.cli import main
 from gearjax.commands.efficiency import EFFICIENCY_KEYS_DOC
+from strict_json import strict_json
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DESIGN = "involute:z1=20,z2=40,m=4,alpha=20,b=30"
@@ -21,10 +21,7 @@ BASE = [DESIGN, "--torque-Nm", "200", "--rpm", "1500", "--oil", "mineral_vg100",
         "--sigma-um", "0.4"]
 
 
-def _strict(text):
-    def no_constant(name):
-        raise AssertionError(f"non-strict JSON constant {name}")
-    return json.loads(text, parse_constant=no_constant)
+_strict = strict_json
 
 
 @pytest.fixture(scope="module")

@@ -10,7 +10,6 @@ before any JAX work.  Each test's docstring names the planted bug it catches."""
 import contextlib
 import copy
 import io
-import json
 import os
 import re
 
@@ -21,6 +20,7 @@ import gearjax as gj
 from gearjax.cli import build_parser, main
 from gearjax.commands.loaded import JSON_KEYS_DOC, parse_torques
 from gearjax.gears.involute.design_file import read_involute
+from strict_json import strict_json
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 EXAMPLE = "example:helical_microgeometry"
@@ -38,10 +38,7 @@ def _call(argv):
     return rc, out.getvalue(), err.getvalue()
 
 
-def _strict(text):
-    def no_constant(name):
-        raise AssertionError(f"non-strict JSON constant {name}")
-    return json.loads(text, parse_constant=no_constant)
+_strict = strict_json
 
 
 @pytest.fixture(scope="module")

@@ -115,8 +115,8 @@ class InvoluteFile(DesignFileMixin):
 
     data: dict = field(compare=True)
     design: InvoluteTCA = field(compare=False)
-    #: the ``[microgeometry]`` tables (:class:`~gearjax.gears.involute.microgeometry.MicroGeometry`),
-    #: or None without them
+    #: the ``[microgeometry]`` tables (a
+    #: :class:`~gearjax.gears.involute.microgeometry.MicroGeometry`), or None without them
     micro: object = field(default=None, compare=False)
 
     def defaults_lines(self) -> list:

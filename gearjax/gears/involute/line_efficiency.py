@@ -93,17 +93,14 @@ def line_efficiency_traced(pair, face_width, mods, torque_Nmm, misalignment_um_,
     r = line_load_traced(pair, face_width, mods, torque_Nmm, misalignment_um_, opts, E, nu,
                          drive, s0)
     geo = pair_geometry(pair)
-    cb = jnp.cos(geo["beta_b"])
     g = geo["a_w"] * jnp.sin(geo["alpha_wt"])
-    on = r.length > 0.0
-    s = jnp.where(on, r.s, 0.0)
-    xi1 = jnp.clip(geo["rho_P"] + s, geo["rho_A"], geo["rho_E"])
+    xi1 = geo["rho_P"] + r.contact_s             # where each slice's load acts
     xi2 = g - xi1
     w1 = jnp.asarray(pinion_rpm, float) * (math.pi / 30.0)
     w2 = w1 * pair.z1 / pair.z2
     u_e = 0.5 * (w1 * xi1 + w2 * xi2)
     u_s = w1 * xi1 - w2 * xi2
-    r_x = xi1 * xi2 / ((xi1 + xi2) * cb)
+    r_x = r.r_x
     loaded = r.load > 0.0
     L_line = jnp.sum(r.length, axis=2, keepdims=True)             # (K, M, 1)
     F_eq = jnp.where(loaded, r.line_load * L_line, 1.0)

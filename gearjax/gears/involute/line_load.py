@@ -153,7 +153,12 @@ class LineLoad(NamedTuple):
     Shapes: (K, M, N) per pair, position and slice; (M,) per position; (N,) per slice.
 
     s0 : (M,) mesh positions (mm, path coordinate of pair 0 at the face centre).
-    y : (N,) slice centres (mm).  s : (K, M, N) path coordinates of the slice points.
+    y : (N,) slice centres (mm).  s : (K, M, N) path coordinates of the slice centres.
+    contact_s : (K, M, N) path coordinate where each slice's load acts: its centre, or
+        for a piece crossing an end of the path the middle of the part on the path
+        (the middle of the path off it).
+    r_x : (K, M, N) reduced radius of the normal section there,
+        ``xi1 xi2 / ((xi1 + xi2) cos(beta_b))`` (mm; Hertz, contact compliance, friction).
     length : (K, M, N) contact-line length carried by each slice (mm, 0 off the path).
     separation_um : (K, M, N) unloaded separations (µm; NaN off the path).
     load : (K, M, N) normal loads (N).  line_load : (K, M, N) normal load per unit
@@ -179,6 +184,8 @@ class LineLoad(NamedTuple):
     s0: jax.Array
     y: jax.Array
     s: jax.Array
+    contact_s: jax.Array
+    r_x: jax.Array
     length: jax.Array
     separation_um: jax.Array
     load: jax.Array
@@ -264,8 +271,9 @@ def line_load_traced(pair: InvolutePair, face_width, mods: PairModification, tor
     unit = jnp.ones(s.size)
     teeth = virtual_teeth(pair, jnp.sqrt(rb1 ** 2 + xi1 ** 2).ravel(),
                           jnp.sqrt(rb2 ** 2 + xi2 ** 2).ravel(), unit, unit, drive)
-    r_n = (xi1 * xi2 / (xi1 + xi2) / cb).ravel()
-    q_unit = pair_compliance(teeth, r_n, w_nom, opts.compliance, E=E, nu=nu).reshape(s.shape)
+    r_n = xi1 * xi2 / ((xi1 + xi2) * cb)          # reduced radius of the normal section
+    q_unit = pair_compliance(teeth, r_n.ravel(), w_nom, opts.compliance, E=E,
+                             nu=nu).reshape(s.shape)
     k = jnp.where(on, length / q_unit, 0.0)
     W = T1 / (rb1 * cb ** 2)
     # per position: points of all pairs and slices together
@@ -279,15 +287,14 @@ def line_load_traced(pair: InvolutePair, face_width, mods: PairModification, tor
     w_line = jnp.where(on, F / jnp.where(on, length, 1.0), 0.0)
     E_prime = E / (1.0 - nu ** 2)
     loaded = F > 0.0
-    half_w, p = hertz_line_traced(jnp.where(loaded, w_line, 1.0),
-                                  (xi1 * xi2 / (xi1 + xi2)) / cb, E_prime)
+    half_w, p = hertz_line_traced(jnp.where(loaded, w_line, 1.0), r_n, E_prime)
     p_max = jnp.where(loaded, p, 0.0)
     stiff = cb ** 2 * jnp.sum(jnp.where(loaded, k, 0.0), axis=(0, 2)) / b * 1e-3
     face = jnp.sum(F, axis=0) / dy                    # (M, N) normal load per face width
     mean_face = jnp.mean(face, axis=1)
     k_hb = jnp.max(face, axis=1) / mean_face
     cyc = jnp.mean(face, axis=0)
-    return LineLoad(s0=s0, y=y, s=sc, length=length,
+    return LineLoad(s0=s0, y=y, s=sc, contact_s=s, r_x=r_n, length=length,
                     separation_um=jnp.where(on, e_um, jnp.nan), load=F, line_load=w_line,
                     p_max=p_max, pair_load=jnp.sum(F, axis=2), te_loaded_um=1e3 * delta,
                     te_unloaded_um=1e3 * jnp.min(e_pos, axis=1), mesh_stiffness=stiff,

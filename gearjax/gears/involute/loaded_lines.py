@@ -67,7 +67,8 @@ def line_design(design, mods=None, side: str = "drive"):
         mods = (micro if micro is not None else MicroGeometry.none()).flanks(side)
     if not isinstance(mods, PairModification):
         raise TypeError(f"mods must be a PairModification, not a {type(mods).__name__}")
-    check_modification(mods.pinion, "pinion."), check_modification(mods.gear, "gear.")
+    check_modification(mods.pinion, "pinion.")
+    check_modification(mods.gear, "gear.")
     return des.pair, des.face_width, mods, pair_material(design)
 
 
@@ -144,7 +145,8 @@ class LoadedTEMap(NamedTuple):
         at ``temperature_um``), the one to differentiate.
     te_mean_um : mean loaded TE (µm).
     te_unloaded_ptp_um : peak-to-peak of the unloaded TE (the separation closed first,
-        the approach at zero load; µm): the TCA of the modified line contact.  p_max : highest Hertz pressure (MPa).
+        the approach at zero load; µm): the TCA of the modified line contact.
+    p_max : highest Hertz pressure (MPa).
     k_hbeta : face load factor of the cycle-mean distribution.  end_load : end-slice
         load per unit face width over the mean, of the cycle-mean distribution.
     converged : every position of the cycle converged (and, with efficiency, every
@@ -186,7 +188,8 @@ def te_map_traced(pair, b, mods, torques_Nmm, f_ma, E, nu, opts, drive, temperat
         te = r.te_loaded_um
         te0 = r.te_unloaded_um
         return (jnp.max(te) - jnp.min(te), smooth_ptp(te, temperature_um), jnp.mean(te),
-                jnp.max(te0) - jnp.min(te0), jnp.max(r.p_max), r.k_hbeta_mean, r.end_load_mean, ok, loss, eff)
+                jnp.max(te0) - jnp.min(te0), jnp.max(r.p_max), r.k_hbeta_mean, r.end_load_mean,
+                ok, loss, eff)
 
     return jax.vmap(lambda T: jax.vmap(lambda f: one(T, f))(f_ma))(torques_Nmm)
 
@@ -228,7 +231,7 @@ def loaded_te_map(design, torques_Nm, misalignments_um=(0.0,), *, mods=None, sid
         rpm = float(pinion_rpm)
         oil = dataclasses.replace(oil, name="")     # the label is not part of the program
     opts = _options(pair, b, positions, slices, compliance)
-    out = call(_map, *_split(pair), b, mods, jnp.asarray(1e3 * T), jnp.asarray(A), mat.youngs_modulus_MPa,
-               mat.poisson, float(temperature_um), rpm, oil, surface, opts=opts,
+    out = call(_map, *_split(pair), b, mods, jnp.asarray(1e3 * T), jnp.asarray(A),
+               mat.youngs_modulus_MPa, mat.poisson, float(temperature_um), rpm, oil, surface, opts=opts,
                drive=side == "drive", vm=viscosity_model, fm=film_method)
     return LoadedTEMap(jnp.asarray(T), jnp.asarray(A), *out)

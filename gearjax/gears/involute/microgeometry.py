@@ -173,9 +173,9 @@ class MicroGeometry:
         return self.drive if side == "drive" else self.coast
 
 
-def _relief(amount, t, length, exponent):
+def _relief(amount, t, exponent):
     """``amount * max(t, 0)^exponent`` with a safe power at ``t <= 0`` (zero value and
-    zero gradient there) and a safe length (any relief of zero amount)."""
+    zero gradient there)."""
     pos = t > 0.0
     ts = jnp.where(pos, t, 1.0)
     return jnp.where(pos, amount * ts ** exponent, 0.0)
@@ -196,14 +196,13 @@ def flank_removal_um(mod: FlankModification, xi, y, xi_sap, xi_tip, face_width):
     v = y / face_width
     La, Lf = _safe(mod.tip_relief_length), _safe(mod.root_relief_length)
     LI, LII = _safe(mod.end_relief_I_length), _safe(mod.end_relief_II_length)
-    profile = (_relief(mod.tip_relief, (xi - (xi_tip - La)) / La, La, mod.tip_relief_exponent)
-               + _relief(mod.root_relief, ((xi_sap + Lf) - xi) / Lf, Lf,
-                         mod.root_relief_exponent)
+    profile = (_relief(mod.tip_relief, (xi - (xi_tip - La)) / La, mod.tip_relief_exponent)
+               + _relief(mod.root_relief, ((xi_sap + Lf) - xi) / Lf, mod.root_relief_exponent)
                + mod.profile_crowning * (2.0 * u) ** 2 + mod.profile_slope * u)
     half = 0.5 * face_width
     lead = (mod.lead_crowning * (2.0 * v) ** 2 + mod.helix_slope * v
-            + _relief(mod.end_relief_I, (-half + LI - y) / LI, LI, mod.end_relief_exponent)
-            + _relief(mod.end_relief_II, (y - half + LII) / LII, LII, mod.end_relief_exponent))
+            + _relief(mod.end_relief_I, (-half + LI - y) / LI, mod.end_relief_exponent)
+            + _relief(mod.end_relief_II, (y - half + LII) / LII, mod.end_relief_exponent))
     return profile + lead + mod.bias * u * v
 
 
