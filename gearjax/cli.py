@@ -23,6 +23,7 @@ COMMANDS = [
     "gearjax.commands.blank",
     "gearjax.commands.surface",
     "gearjax.commands.correct",
+    "gearjax.commands.ease_off",
     "gearjax.commands.friction",
     "gearjax.commands.kinematics",
     "gearjax.commands.tca",

@@ -361,16 +361,28 @@ def test_cli_writes_the_corrected_design(sb, tmp_path, capsys):
     assert new.data["gear"] == sb.data["gear"] and new.data["blank"] == sb.data["blank"]
 
 
-def test_ease_off_target_reached_where_one_exists(sb):
+EASE_CHANGE = {"modified_roll_2c": 0.01, "ratio_of_roll": 0.001, "blade_angle": 0.05}
+EASE_SETTINGS = ["blade_angle", "ratio_of_roll", "modified_roll_2c", "modified_roll_6d",
+                 "axis_rotation"]
+
+
+@pytest.fixture(scope="module")
+def ease_case(sb):
+    """The spiral-bevel pinion with known drive-flank setting changes, and its ease-off:
+    a target that a known set of settings reaches."""
+    from gearjax.gears.hypoid import ease_off as eo
+    bent = fc.with_setting_errors(sb, "pinion",
+                                  {f"concave.{k}": v for k, v in EASE_CHANGE.items()})
+    return bent, eo.ease_off(eo.ease_off_problem(bent, "drive", settings=EASE_SETTINGS))
+
+
+def test_ease_off_target_reached_where_one_exists(sb, ease_case):
     """Item 4 (target ease-off): the ease-off of the spiral-bevel pinion with known
     setting changes is the target; fitted from the shipped pinion, the settings come back
     and the written design's ease-off, evaluated anew from its file, is the target."""
     from gearjax.gears.hypoid import ease_off as eo
-    change = {"modified_roll_2c": 0.01, "ratio_of_roll": 0.001, "blade_angle": 0.05}
-    bent = fc.with_setting_errors(sb, "pinion", {f"concave.{k}": v for k, v in change.items()})
-    settings = ["blade_angle", "ratio_of_roll", "modified_roll_2c", "modified_roll_6d",
-                "axis_rotation"]
-    target = eo.ease_off(eo.ease_off_problem(bent, "drive", settings=settings))
+    change, settings = EASE_CHANGE, EASE_SETTINGS
+    target = ease_case[1]
     p0 = eo.ease_off_problem(sb, "drive", target, settings=settings)
     e0 = eo.ease_off(p0)
     i, j = 4, 2
@@ -385,6 +397,76 @@ def test_ease_off_target_reached_where_one_exists(sb):
     assert new.data["pinion"]["convex"] == sb.data["pinion"]["convex"]
     again = eo.ease_off(eo.ease_off_problem(new, "drive", settings=settings))
     assert np.nanmax(np.abs(again - target)) < 0.05
+
+
+def test_ease_off_command_reaches_the_target_and_runs_the_tca(sb, ease_case, tmp_path, capsys):
+    """``gearjax ease-off --target FILE``: the known changes come back (2 %), the written
+    design meets the target when evaluated anew, the design's ease-off in the report is
+    the library's, and the TCA of the written design is that of the design cut with the
+    known changes (a second route to the same pair: a wrong design written, or the TCA of
+    the given design reported for the written one, fails here)."""
+    from gearjax.gears.hypoid import ease_off as eo
+    bent, target = ease_case
+    tgt = tmp_path / "target.csv"
+    tgt.write_text("# ease-off target, um: rows toe -> heel, columns root -> tip\n"
+                   + "\n".join(",".join(f"{v:.9f}" for v in row) for row in target) + "\n")
+    out, fig = tmp_path / "eased.toml", tmp_path / "eased.png"
+    rc = main(["ease-off", SB, "--target", str(tgt), "--settings", ",".join(EASE_SETTINGS),
+               "--out", str(out), "--plot", str(fig), "--json"])
+    rep = json.loads(capsys.readouterr().out)
+    assert rc == 0 and rep["converged"] and rep["files"] == [str(out), str(fig)]
+    assert fig.stat().st_size > 10_000
+    for k, v in EASE_CHANGE.items():
+        assert abs(rep["change"][k] - v) < 0.02 * abs(v), (k, rep["change"][k], v)
+    assert rep["written_vs_target_rms_um"] < 0.05 and rep["fit_max_um"] < 0.05
+    e0 = eo.ease_off(eo.ease_off_problem(sb, "drive", settings=EASE_SETTINGS))
+    np.testing.assert_allclose(np.array(rep["ease_off_design_um"], float), e0, atol=1e-6)
+    np.testing.assert_allclose(np.array(rep["target_um"]), target, atol=1e-8)
+    again = gearjax.load_design(str(out))
+    assert again.data["pinion"]["convex"] == sb.data["pinion"]["convex"]
+    assert again.data["gear"] == sb.data["gear"]
+    ptp = lambda d: float(gearjax.run_tca(d, side="drive", kinematics=False).multi.ptp)
+    t = rep["tca"]
+    assert abs(t["written"]["ptp_arcsec"] - ptp(bent) / gearjax.ARCSEC) < 0.02
+    assert abs(t["design"]["ptp_arcsec"] - ptp(sb) / gearjax.ARCSEC) < 1e-9
+    assert abs(t["written"]["ptp_arcsec"] - t["design"]["ptp_arcsec"]) > 0.1
+    for c in t.values():
+        assert set(c["quality"]) >= {"converged", "edge_contact", "large_te"}
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (["--grid", "9x2"], "--grid = '9x2'"),
+    (["--grid", "nine"], "--grid = 'nine'"),
+    (["--crowning-um", "250"], "--crowning-um"),
+    (["--bias-um", "nan"], "--bias-um"),
+    (["--target", "T", "--bias-um", "5"], "--target replaces"),
+    (["--target", "T", "--grid", "9x4"], "must hold 9 rows of 4 values"),
+    (["--target", "BAD"], "value nan um at row 1, column 2"),
+    (["--target", "MISSING"], "cannot be read"),
+    (["--plot", "OUT"], "extension must be .png, .pdf or .svg"),
+    (["--regularisation", "2"], "--regularisation"),
+])
+def test_ease_off_command_refuses_bad_input(argv, needle, tmp_path, capsys):
+    """One line naming the flag and value, exit status 2, before any work (no file)."""
+    good = tmp_path / "t.csv"
+    good.write_text("\n".join(",".join(["1.0"] * 5) for _ in range(9)) + "\n")
+    bad = tmp_path / "bad.csv"
+    bad.write_text("\n".join(",".join(["nan" if (i, j) == (1, 2) else "0"
+                                      for j in range(5)]) for i in range(9)) + "\n")
+    out = tmp_path / "o.toml"
+    names = {"T": str(good), "BAD": str(bad), "MISSING": str(tmp_path / "none.csv"),
+             "OUT": str(out)}
+    argv = [names.get(a, a) for a in argv]
+    rc = main(["ease-off", SB, "--out", str(out)] + argv)
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1 and needle in err[0], err
+    assert not out.exists()
+
+
+def test_ease_off_command_refuses_a_family_without_machine_settings(tmp_path, capsys):
+    rc = main(["ease-off", "example:khk_spur_12x24", "--out", str(tmp_path / "o.toml")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1 and "hypoid and spiral-bevel designs only" in err[0]
 
 
 def test_measurement_rotation_is_recovered_with_its_sign(sb, tmp_path):

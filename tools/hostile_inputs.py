@@ -737,6 +737,47 @@ def build_cases() -> list[Case]:
         "--settings", "ratio_of_roll"]), "refuse", "roll setting of a formate gear",
         setup=measured_file(lambda ls: [ln.replace("member = pinion", "member = gear")
                                         for ln in ls]))
+    # ---------------------------------------------------------------- ease-off
+    HYX = "example:hypoid_iso_10x41_synthesised"
+
+    def eo(design=HYX, out="{tmp}/eased.toml", extra=()):
+        return ["ease-off", design] + (["--out", out] if out is not None else []) + list(extra)
+
+    add("ease-off.ok.crowning_bias", eo(extra=["--crowning-um", "30", "--bias-um", "10",
+                                              "--plot", "{tmp}/e.png"]),
+        "flag", "a reachable target: written, TCA before/after; the conjugate's rotation ~ "
+        "point radius and the written pair's tip contact are warned", also={"ok"})
+    add("ease-off.ok.json_no_tca", eo(extra=["--crowning-um", "30", "--json", "--no-tca"]),
+        "flag", "strict JSON (lines left out are null), no TCA", also={"ok"})
+    add("ease-off.profile_out_of_reach", eo(extra=["--crowning-um", "30", "--profile-um", "15",
+                                                  "--bias-um", "10"]),
+        "flag", "profile crowning out of the straight blade's reach: the written pair's "
+        "TCA is flagged (large TE) or fails (exit 3)")
+    for flag, v in (("--crowning-um", "nan"), ("--profile-um", "1e6"), ("--bias-um", "-inf"),
+                    ("--crowning-um", "abc"), ("--grid", "2x5"), ("--grid", "9x5x3"),
+                    ("--grid", "100x5"), ("--regularisation", "-1"), ("--max-iter", "0"),
+                    ("--settings", "frobnicate"), ("--settings", ","), ("--side", "both")):
+        add(f"ease-off{flag[1:]}={_slug(v)}", eo(extra=[flag, v]), "refuse", f"{flag} {v}")
+    for key, content in (("empty", b""), ("binary", b"\x89PNG\r\n\x1a\n\x00\xff"),
+                         ("short_rows", b"1,2,3\n" * 9),
+                         ("text", b"a,b,c,d,e\n" * 9),
+                         ("nan", b"0,0,0,0,0\n" * 4 + b"0,0,nan,0,0\n" + b"0,0,0,0,0\n" * 4),
+                         ("huge", b"0,0,0,0,0\n" * 4 + b"0,0,5000,0,0\n" + b"0,0,0,0,0\n" * 4)):
+        add(f"ease-off.target.{key}", eo(extra=["--target", "{design}"]), "refuse",
+            f"--target file: {key}", setup=raw_file(content, name="t.csv"))
+    add("ease-off.target.with_terms", eo(extra=["--target", "{design}", "--bias-um", "3"]),
+        "refuse", "--target together with a term", setup=raw_file(b"0,0,0,0,0\n" * 9, "t.csv"))
+    add("ease-off.target.missing", eo(extra=["--target", "{tmp}/none.csv"]), "refuse",
+        "--target does not exist")
+    add("ease-off.missing_out", eo(out=None), "refuse", "--out missing")
+    add("ease-off.out.bad_extension", eo(out="{tmp}/e.txt"), "refuse", "--out .txt")
+    add("ease-off.plot.bad_extension", eo(extra=["--plot", "{tmp}/e.toml"]), "refuse",
+        "--plot .toml")
+    add("ease-off.example.involute", eo(design="example:khk_spur_12x24"), "refuse",
+        "a family without machine settings")
+    add("ease-off.example.hft_not_converged", eo(design="example:hft_8x43"), "flag",
+        "the dial-set pair's conjugate is far from its pinion: the fit stops at its step "
+        "limit (exit 3, no design) and the given pair's TCA warnings are shown")
     # reference grids of gearjax surface
     add("surface.ok.reference_grid", ["surface", SBX, "--member", "gear", "--reference-grid",
                                       "--out", "{tmp}/grid.csv"], "ok", "measuring grid")

@@ -86,7 +86,8 @@ def register(sub):
     p.set_defaults(func=run)
 
 
-def _settings(text):
+def settings_list(text):
+    """The ``--settings`` list (None: the default set; ``ValueError`` for an empty name)."""
     if text is None:
         return None
     names = [s.strip() for s in text.split(",")]
@@ -101,7 +102,7 @@ def run(args) -> int:
     from gearjax.errors import check_int, check_range
     from gearjax.io import check_output_path, read_measured_grid
 
-    names = _settings(args.settings)
+    names = settings_list(args.settings)
     alpha = check_range("--regularisation", args.regularisation, 0.0, 1.0)
     max_iter = check_int("--max-iter", args.max_iter, 1, 200)
     out = check_output_path(args.out, "--out", (".toml",))
