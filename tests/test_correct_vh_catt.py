@@ -145,6 +145,24 @@ def test_model_deviations_match_the_perturbed_design(design, problems, member):
                                    atol=0.02)
 
 
+def test_second_loop_on_a_design_with_member_blade_settings(design):
+    """A design that already carries per-member blade settings (a corrected one) is the
+    nominal of the next loop: zero deviation at zero correction, and the model matches
+    the second route (each flank's own blade angle and the member's own offset are used
+    as the start of the increments)."""
+    data = design.to_dict()
+    data["gear"] = {"convex_blade_angle_deg": 20.3, "concave_blade_angle_deg": 19.8,
+                    "blade_offset_mm": 3.6}
+    d2 = design_from_dict(data)
+    prob = vc.correction_problem(d2, _measured(d2, "gear", np.zeros((2,) + GRID)))
+    dev0, _ = model_deviations(prob, {})
+    assert np.max(np.abs(dev0)) < 1e-6
+    errors = {"cutter_radius": 4.0, "blade_offset": -1.0, "convex.blade_angle": 0.02,
+              "concave.blade_angle": -0.03}
+    dev, _ = model_deviations(prob, _internal(errors))
+    np.testing.assert_allclose(dev, _second_route(d2, "gear", errors), atol=0.02)
+
+
 CASES = {
     "pinion": ({"cutter_radius": 5.0, "convex.blade_angle": 0.03, "blade_offset": 2.0}, 0.003),
     "gear": ({"cutter_radius": -6.0, "blade_offset": -1.5, "convex.blade_angle": -0.02,

@@ -27,12 +27,13 @@ point at the same grid coordinates differs from it by the in-plane shift of the 
 point times the flank's curvature (docs/correct.md gives the numbers measured).
 
 **Fit** (the family-neutral one of :mod:`gearjax.correction`, which this module feeds
-with :func:`flank_deviations` as its deviation model).  The unknowns ``u`` (the chosen settings, :data:`SETTINGS`, of each measured
-flank, or one value for both flanks where the member's two machine tables are the same
-set-up -- identical tables -- and the rotation :data:`ROTATION`) are scaled so that
-every Jacobian column has an rms of 1 um over the grid: ``u_k = c_k x_k`` with ``c_k =
-1 / rms_i(dd_i/du_k)`` (the change of setting ``k`` that moves the flank by 1 um rms).
-Levenberg-Marquardt (:func:`gearjax.optimize.least_squares_lm`) minimises
+with :func:`flank_deviations` as its deviation model).  The unknowns ``u`` (the chosen
+settings, :data:`SETTINGS`, of each measured flank, or one value for both flanks where
+the member's two machine tables are the same set-up -- identical tables -- and the
+rotation :data:`ROTATION`) are scaled so that every Jacobian column has an rms of 1 um
+over the grid: ``u_k = c_k x_k`` with ``c_k = 1 / rms_i(dd_i/du_k)`` (the change of
+setting ``k`` that moves the flank by 1 um rms).  Levenberg-Marquardt
+(:func:`gearjax.optimize.least_squares_lm`) minimises
 
     1/2 sum_i (d_i - t_i(u))^2 / (1 um)^2  +  1/2 (alpha sqrt(N))^2 |x|^2
 
