@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 
 import gearjax
+from gearjax.correction import ROTATION, correct_flanks
 from gearjax.gears.hypoid import flank_correction as fc
 from gearjax.io import MeasuredGrid, atomic_write, dumps_json
 
@@ -61,15 +62,17 @@ CASES = [
 ]
 
 
-def measure(design, member, errors, rotation_deg, rng, nominal=None):
+def measure(design, member, errors, rotation_deg, rng, nominal=None, family=fc,
+            flanks=("convex", "concave")):
     """Second route: the perturbed design's grid (turned by the measurement's rotation)
-    met by the nominal lines through tangent planes, plus noise (um)."""
-    bad = fc.with_setting_errors(design, member, errors)
+    met by the nominal lines through tangent planes, plus noise (um).  ``family``: the
+    module with the family's ``with_setting_errors``."""
+    bad = family.with_setting_errors(design, member, errors)
     nominal = design if nominal is None else nominal
     c, s = math.cos(math.radians(rotation_deg)), math.sin(math.radians(rotation_deg))
     R = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
     P, N, D = [], [], []
-    for f in ("convex", "concave"):
+    for f in flanks:
         g0 = nominal.reference_grid(member, f, *GRID, MARGIN, MARGIN)
         g1 = bad.reference_grid(member, f, *GRID, MARGIN, MARGIN)
         p, n = np.asarray(g0.points), np.asarray(g0.normals)
@@ -79,8 +82,52 @@ def measure(design, member, errors, rotation_deg, rng, nominal=None):
         N.append(n)
     dev = np.stack(D)
     noisy = dev + rng.normal(0.0, NOISE, dev.shape)
-    return MeasuredGrid(nominal.name, member, *GRID, MARGIN, MARGIN, ("convex", "concave"),
+    return MeasuredGrid(nominal.name, member, *GRID, MARGIN, MARGIN, tuple(flanks),
                         np.stack(P), np.stack(N), noisy, "synthetic"), dev
+
+
+def run_case(label, ex, d, member, errors, settings, rot, rng, family=fc,
+             flanks=("convex", "concave")) -> dict:
+    """One case (module docstring): measure by the second route, fit, recut; the row of
+    the results.  ``family``: the module with ``correction_problem``,
+    ``corrected_design`` and ``with_setting_errors``."""
+    t0 = time.perf_counter()
+    m, clean = measure(d, member, errors, rot, rng, family=family, flanks=flanks)
+    t_measure = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    res = correct_flanks(family.correction_problem(d, m, settings))
+    t_total = time.perf_counter() - t0
+    truth = {n: 0.0 for n in res.unknowns}
+    truth.update(errors)
+    if rot:
+        truth[ROTATION] = rot
+    unknowns = []
+    for n in res.unknowns:
+        sd = res.uncertainty[n]
+        unknowns.append(dict(name=n, unit=res.units[n], true=truth.get(n, 0.0),
+                             fitted=res.fitted[n], sd=sd,
+                             z=(res.fitted[n] - truth.get(n, 0.0)) / sd if sd > 0
+                             else math.inf))
+    summ = res.summary()
+    # the corrected design cut on the machine with the same errors, measured clean
+    recut = None
+    if res.converged:
+        _, left = measure(family.corrected_design(res), member, errors, 0.0,
+                          np.random.default_rng(0), nominal=d, family=family, flanks=flanks)
+        recut = float(np.sqrt(np.mean(left ** 2)))
+    row = dict(
+        case=label, design=ex, member=member, errors=errors, rotation_deg=rot,
+        unknowns=unknowns,
+        before_rms_um={f: s["before_rms_um"] for f, s in summ.items()},
+        after_rms_um={f: s["after_rms_um"] for f, s in summ.items()},
+        clean_rms_um=float(np.sqrt(np.mean(clean ** 2))), recut_rms_um=recut,
+        noise_um=res.noise_um, condition_number=res.condition_number,
+        min_relative_singular_value=float(res.singular_values[-1]),
+        indistinguishable=[t for t, _, _ in res.indistinguishable],
+        converged=res.converged, iterations=res.iterations,
+        fit_seconds=res.seconds, setup_and_fit_seconds=t_total,
+        measure_seconds=t_measure)
+    return row
 
 
 def main():
@@ -89,44 +136,11 @@ def main():
     for k, (label, ex, member, errors, settings, rot) in enumerate(CASES):
         d = designs.setdefault(ex, gearjax.load_design(ex))
         rng = np.random.default_rng(2026 + k)
-        t0 = time.perf_counter()
-        m, clean = measure(d, member, errors, rot, rng)
-        t_measure = time.perf_counter() - t0
-        t0 = time.perf_counter()
-        res = fc.correct_flanks(fc.correction_problem(d, m, settings))
-        t_total = time.perf_counter() - t0
-        truth = {n: 0.0 for n in res.unknowns}
-        truth.update(errors)
-        if rot:
-            truth[fc.ROTATION] = rot
-        unknowns = []
-        for n in res.unknowns:
-            sd = res.uncertainty[n]
-            unknowns.append(dict(name=n, unit=res.units[n], true=truth.get(n, 0.0),
-                                 fitted=res.fitted[n], sd=sd,
-                                 z=(res.fitted[n] - truth.get(n, 0.0)) / sd if sd > 0
-                                 else math.inf))
-        summ = res.summary()
-        # the corrected design cut on the machine with the same errors, measured clean
-        recut = None
-        if res.converged:
-            _, left = measure(fc.corrected_design(res), member, errors, 0.0,
-                              np.random.default_rng(0), nominal=d)
-            recut = float(np.sqrt(np.mean(left ** 2)))
-        rows.append(dict(
-            case=label, design=ex, member=member, errors=errors, rotation_deg=rot,
-            unknowns=unknowns,
-            before_rms_um={f: s["before_rms_um"] for f, s in summ.items()},
-            after_rms_um={f: s["after_rms_um"] for f, s in summ.items()},
-            clean_rms_um=float(np.sqrt(np.mean(clean ** 2))), recut_rms_um=recut,
-            noise_um=res.noise_um, condition_number=res.condition_number,
-            min_relative_singular_value=float(res.singular_values[-1]),
-            indistinguishable=[t for t, _, _ in res.indistinguishable],
-            converged=res.converged, iterations=res.iterations,
-            fit_seconds=res.seconds, setup_and_fit_seconds=t_total,
-            measure_seconds=t_measure))
-        print(f"{label}: cond {res.condition_number:.3g}, noise {res.noise_um:.3f} um, "
-              f"{res.iterations} steps, {t_total:.2f} s", flush=True)
+        rows.append(run_case(label, ex, d, member, errors, settings, rot, rng))
+        res = rows[-1]
+        print(f"{label}: cond {res['condition_number']:.3g}, noise {res['noise_um']:.3f} "
+              f"um, {res['iterations']} steps, {res['setup_and_fit_seconds']:.2f} s",
+              flush=True)
     # repeated fit (compiled): the last case again
     d = designs[CASES[0][1]]
     m, _ = measure(d, CASES[0][2], CASES[0][3], 0.0, np.random.default_rng(1))

@@ -12,7 +12,7 @@ import gearjax
 PKG = Path(gearjax.__file__).resolve().parent
 BACKBONE = {"frames", "newton", "surfaces", "kinematics", "tca", "contact", "loading",
             "optimize", "augmented_lagrangian", "io", "errors", "progress", "fields",
-            "compile_ahead", "program_store"}
+            "compile_ahead", "program_store", "correction"}
 #: the loaded chain (loading/) stands on tribology/; the rest of the backbone below it
 ABOVE_TRIBOLOGY = {"loading"}
 

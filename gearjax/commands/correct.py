@@ -1,6 +1,9 @@
 """``gearjax correct DESIGN --measured FILE``: corrective machine settings from a measured
-flank (hypoid / spiral bevel; :mod:`gearjax.gears.hypoid.flank_correction`,
-docs/correct.md).
+flank (hypoid / spiral bevel: :mod:`gearjax.gears.hypoid.flank_correction`; VH-CATT:
+cutter radius and blade settings, :mod:`gearjax.gears.vh_catt.flank_correction`; the fit
+of both: :mod:`gearjax.correction`; docs/correct.md).  The design object supplies
+``correction_problem`` and ``corrected_design``: the command does not branch on the
+family.
 
 Reads the measured grid (:mod:`gearjax.io.measured_grid`: the nominal points and
 normals that ``gearjax surface --reference-grid`` wrote, with the measured normal
@@ -22,7 +25,8 @@ JSON report keys (--json):
   flanks, grid, points         measured flanks, [n_xi, n_s], grid points in all
   face_margin, height_margin   the grid's margins (fractions)
   unknowns                     fitted unknowns: 'name' (shared by both flanks: one
-                               machine set-up), 'convex.name' / 'concave.name' (one
+                               machine set-up; VH-CATT: the head's cutter_radius and
+                               blade_offset), 'convex.name' / 'concave.name' (one
                                flank's own), 'axis_rotation' (the measurement's)
   units                        unknown -> unit (mm, deg, -, 1/rad, 1/rad^2)
   fitted_error                 unknown -> fitted setting error delta (what the machine
@@ -45,6 +49,9 @@ JSON report keys (--json):
   seconds                      wall time of the fit (the first run compiles)
   corrected_design             the design file written (null when not converged)
   files                        every file written (--out, --plot)
+VH-CATT: the corrected design writes [pair] cutter_radius1_mm / cutter_radius2_mm of the
+measured member and its own [pinion] / [gear] blade_offset_mm, convex_blade_angle_deg,
+concave_blade_angle_deg (the fitted ones; the other member is not changed).
 Sign: deviation > 0 = material added (the measured flank lies outside the nominal one,
 along the nominal normal that points out of the tooth).  Format and method:
 docs/correct.md."""
@@ -54,7 +61,8 @@ def register(sub):
     import argparse
     p = sub.add_parser(
         "correct", help="corrective machine settings from a measured flank",
-        description="Corrective machine settings of a hypoid / spiral-bevel member from the "
+        description="Corrective machine settings of a hypoid / spiral-bevel member (or the "
+                    "cutter radius and blade settings of a VH-CATT member) from the "
                     "normal deviations measured on its reference grid (write the grid with "
                     "`gearjax surface DESIGN --member M --reference-grid --out grid.csv`, "
                     "fill in deviation_um): Levenberg-Marquardt with exact Jacobians, "
@@ -72,7 +80,9 @@ def register(sub):
                         "blank_offset, machine_root_angle, sliding_base, center_to_back, "
                         "ratio_of_roll, modified_roll_2c, modified_roll_6d; cutter "
                         "point_radius, blade_angle; axis_rotation (the measurement's "
-                        "rotation about the member's axis)")
+                        "rotation about the member's axis).  VH-CATT member: "
+                        "cutter_radius, blade_offset (the member's head, both flanks), "
+                        "blade_angle (per flank), axis_rotation (default: all four)")
     p.add_argument("--regularisation", type=float, default=0.003,
                    help="Tikhonov alpha in [0, 1] (default 0.003): a combination of settings "
                         "whose relative singular value is alpha is halved")
@@ -116,22 +126,21 @@ def run(args) -> int:
             raise ValueError(f"{flag} = {str(path)!r} is the same file as {seen[key]}")
         seen[key] = flag
     design = load_design(args.design)
-    if not hasattr(design, "reference_grid"):
-        raise ValueError(f"{args.design!r}: corrections are defined for hypoid and "
-                         f"spiral-bevel designs only, not for [design] kind = "
+    if not hasattr(design, "correction_problem"):
+        raise ValueError(f"{args.design!r}: corrections are defined for hypoid, "
+                         f"spiral-bevel and VH-CATT designs only, not for [design] kind = "
                          f"{design.data['design']['kind']!r}")
     measured = read_measured_grid(args.measured)
-    from gearjax.hypoid import correct_flanks, corrected_design, correction_problem
-    problem = correction_problem(design, measured, names)
-    res = correct_flanks(problem, regularisation=alpha, max_iter=max_iter)
+    problem = design.correction_problem(measured, names)
+    res = problem.fit(regularisation=alpha, max_iter=max_iter)
     rep = report(res, args.measured)
     files = []
     if res.converged:
-        from gearjax.hypoid import save_design
-        new = corrected_design(res, description=(
+        from gearjax.io import atomic_write, dumps_toml
+        new = design.corrected_design(res, description=(
             f"{design.data['design'].get('description', design.name)}; {measured.member} "
             f"corrected from {args.measured} by gearjax correct"))
-        save_design(new, out)
+        atomic_write(out, dumps_toml(new.data))
         rep["corrected_design"] = str(out)
         files.append(str(out))
     if args.plot is not None and res.converged:

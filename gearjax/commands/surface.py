@@ -9,7 +9,8 @@ and STL, with one ``gearjax: error:`` line naming the flank, the number of such 
 and the largest residual, status 3, and nothing is written
 (:func:`gearjax.io.check_grid_converged`; an existing file is left unchanged).
 
-``--reference-grid`` writes the measuring grid of a hypoid / spiral-bevel member instead:
+``--reference-grid`` writes the measuring grid of a hypoid / spiral-bevel or VH-CATT member
+instead:
 the nominal points and normals (both flanks unless ``--flank`` is given) inside a border
 (``--face-margin``, ``--height-margin``), as the measured-grid CSV that ``gearjax correct``
 reads back with the deviations filled in (docs/correct.md)."""
@@ -46,7 +47,8 @@ def register(sub):
     p.add_argument("--out", required=True, help="output file: .csv, .xyz or .stl "
                                                 "(.csv with --reference-grid)")
     p.add_argument("--reference-grid", action="store_true",
-                   help="write the measuring grid instead (hypoid / spiral bevel): nominal "
+                   help="write the measuring grid instead (hypoid / spiral bevel, VH-CATT): "
+                        "nominal "
                         "points and normals to measure at, inside the margins, in the "
                         "measured-grid CSV format of `gearjax correct` (docs/correct.md)")
     p.add_argument("--face-margin", type=float, default=None,
@@ -141,8 +143,8 @@ def _reference_grid(args) -> int:
     out = check_output_path(args.out, "--out", (".csv",))
     design = load_design(args.design)
     if not hasattr(design, "reference_grid"):
-        raise ValueError(f"--reference-grid: measuring grids are defined for hypoid and "
-                         f"spiral-bevel designs only, not for [design] kind = "
+        raise ValueError(f"--reference-grid: measuring grids are defined for hypoid, "
+                         f"spiral-bevel and VH-CATT designs only, not for [design] kind = "
                          f"{design.data['design']['kind']!r}")
     flanks = [args.flank] if args.flank else [f for m, f in design.flanks()
                                               if m == args.member]
@@ -152,7 +154,8 @@ def _reference_grid(args) -> int:
     for f, g in grids.items():
         check_grid_converged(g, f"{design.name} {args.member} {f} flank")
     write_reference_grid(out, design=design.name, member=args.member, grids=grids,
-                         face_margin=fm, height_margin=hm)
+                         face_margin=fm, height_margin=hm,
+                         frame=getattr(design, "reference_frame", None))
     sys.stdout.write(f"{args.member} reference grid ({', '.join(flanks)}): {n_xi}x{n_s} points "
                      f"per flank, margins {fm:g} of the face width and {hm:g} of the blade, "
                      f"written to {out}\n")

@@ -72,6 +72,8 @@ MM_SUSPECT_UM = 0.05
 POSITION_TOL_MM = 0.01
 #: a normal differing by more than this (|n - n_ref|, ~ rad) from the nominal one
 NORMAL_TOL = 2e-3
+#: the frame of the positions of a bevel / hypoid member's grid (a header comment)
+WORK_FRAME = "work frame: origin at the pitch-cone apex, z the axis towards the heel"
 _MAX_POINTS = 101
 _HEADER_REQUIRED = ("member", "grid", "face_margin", "height_margin")
 
@@ -120,11 +122,13 @@ def grid_heights(n_s: int, height_margin: float) -> np.ndarray:
 
 def write_reference_grid(path, *, design: str, member: str, grids: dict, face_margin: float,
                          height_margin: float, deviation_um: dict | None = None,
-                         comments=()) -> Path:
+                         comments=(), frame: str | None = None) -> Path:
     """Write the grid(s) ``grids`` (flank name -> :class:`gearjax.io.FlankGrid` of the
     reference grid) as a measured-grid CSV (module docstring), atomically.  Without
     ``deviation_um`` (flank -> (n_xi, n_s) um) the deviation column is left empty;
-    ``comments``: extra free-text comment lines (without ``key = value``)."""
+    ``comments``: extra free-text comment lines (without ``key = value``); ``frame``: the
+    family's description of the positions' frame (default: the bevel/hypoid work frame,
+    :data:`WORK_FRAME`)."""
     flanks = [f for f in FLANK_NAMES if f in grids]
     if not flanks:
         raise ValueError("write_reference_grid: no flank grid given")
@@ -135,9 +139,8 @@ def write_reference_grid(path, *, design: str, member: str, grids: dict, face_ma
            f"# design = {design}", f"# member = {member}", f"# grid = {n_xi}x{n_s}",
            f"# face_margin = {float(face_margin):.6g}",
            f"# height_margin = {float(height_margin):.6g}",
-           "# units: positions mm (work frame: origin at the pitch-cone apex, z the axis "
-           "towards the heel); normals out of the material; deviation_um in um, positive = "
-           "material added",
+           f"# units: positions mm ({WORK_FRAME if frame is None else frame}); normals out of "
+           "the material; deviation_um in um, positive = material added",
            *(f"# {c}" for c in comments), ",".join(COLUMNS)]
     for f in flanks:
         g = grids[f]

@@ -215,7 +215,14 @@ class GearFamily:
         new = get_fields(pair)
         old = get_fields(self.user_pair(self.setup(design, side)[0]))
         for name, value in new.items():
-            v, v0 = float(np.asarray(value)), float(np.asarray(old[name]))
+            a, a0 = np.asarray(value), np.asarray(old[name])
+            if a.ndim or a0.ndim:            # an array field (e.g. per-member blade settings)
+                if np.array_equal(a, a0):
+                    continue
+                raise ValueError(f"field {name!r} of a {self.name} pair (an array) has no "
+                                 f"design-file key (writable: "
+                                 f"{', '.join(self.file_fields) or 'none'})")
+            v, v0 = float(a), float(a0)
             if v == v0:
                 continue
             if name not in self.file_fields:

@@ -278,6 +278,19 @@ class HypoidDesign:
         return flank_surface(self.flank(member, flank), n_u, n_v, face_margin=face_margin,
                              height_margin=height_margin)
 
+    def correction_problem(self, measured, settings=None):
+        """The closed-loop correction of the measured member (a
+        :class:`gearjax.correction.CorrectionProblem`;
+        :func:`gearjax.gears.hypoid.flank_correction.correction_problem`)."""
+        from gearjax.correction import correction_family
+        return correction_family(self).correction_problem(self, measured, settings)
+
+    def corrected_design(self, result, *, description: str | None = None):
+        """This design with the fitted corrections written
+        (:func:`gearjax.gears.hypoid.flank_correction.corrected_design`)."""
+        from gearjax.correction import correction_family
+        return correction_family(self).corrected_design(result, description=description)
+
     def teeth(self, member: str) -> int:
         """Number of teeth of ``member``."""
         return int(self.member_blank(member).teeth)

@@ -4,10 +4,13 @@
 The pair (:class:`VHCattPair`: flanks as envelopes of the dual-blade cutter carried by
 the generating roll) and its design file (``[design] kind = "vh_catt"``,
 :class:`VHCattDesign`, with its ``[material]``).  Its TCA and mesh efficiency run
-through :func:`gearjax.run_tca` and :func:`gearjax.mesh_efficiency` like every family.
+through :func:`gearjax.run_tca` and :func:`gearjax.mesh_efficiency` like every family;
+its closed-loop flank correction (cutter radius and blade settings from a measured flank)
+is :mod:`~gearjax.gears.vh_catt.flank_correction` (``gearjax correct``).
 """
 
 from gearjax.gears.vh_catt.geometry import VHCattPair
 from gearjax.gears.vh_catt.design_file import VHCattDesign
+from gearjax.gears.vh_catt import flank_correction
 
-__all__ = ["VHCattPair", "VHCattDesign"]
+__all__ = ["VHCattPair", "VHCattDesign", "flank_correction"]

@@ -72,7 +72,8 @@ __all__ = ["VHCattPair", "ToolData", "tool_data", "tool_point", "tool_family", "
            "section_point", "pitch_trace_point", "involute_polar_angle", "tooth_form",
            "flank_grid", "MODULE_RANGE_MM", "CUTTER_RADIUS_RANGE_MM", "MAX_TEETH",
            "ADDENDUM", "DEDENDUM", "BLADE_DEPTH", "envelope_point", "radius_point",
-           "envelope_point_np"]
+           "envelope_point_np", "member_tool", "BLADE_ANGLE_CORRECTION_DEG",
+           "MEMBER_BLADE_KEYS", "check_pair_fields", "member_blade_range"]
 
 #: members and their hands (h = +1 pinion, -1 gear: head centres mirrored)
 MEMBERS = ("pinion", "gear")
@@ -84,6 +85,11 @@ MAX_TEETH = 400
 MODULE_RANGE_MM = (0.1, 50.0)
 #: cutter radius range (mm); the lower limit also needs R_T > 10 w (checked)
 CUTTER_RADIUS_RANGE_MM = (10.0, 1e5)
+#: largest per-blade correction of the blade angle from the pair's pressure angle (deg):
+#: the middle-section closed forms (:func:`pair_geometry`) keep the pair's angle
+BLADE_ANGLE_CORRECTION_DEG = 2.0
+#: the per-member blade keys of :meth:`VHCattPair.create` (``member_blades``)
+MEMBER_BLADE_KEYS = ("blade_offset", "convex_blade_angle", "concave_blade_angle")
 #: addendum, dedendum (full depth) and straight-blade depth below the pitch plane,
 #: in modules (the blade tip round cuts the root below the straight part)
 ADDENDUM, DEDENDUM, BLADE_DEPTH = 1.0, 1.25, 1.0
@@ -103,6 +109,13 @@ class VHCattPair:
         that every flank keeps its middle-section point (tooth thickness unchanged).
     face_width : b (mm), symmetric about the middle section.
     z1, z2 : tooth numbers (static).
+    blade_angle_delta : (2, 2) rad, [member (0 pinion, 1 gear), flank (0 convex,
+        1 concave)]: the blade of that flank ground at ``pressure_angle + delta`` (a
+        per-blade correction; default 0, the pair's angle).  Only the generated flank
+        honours it (:func:`member_tool`); the middle-section closed forms of
+        :func:`pair_geometry` keep the pair's angle.
+    blade_offset_delta : (2,) mm, [member]: that member's head cut with the blade offset
+        ``blade_offset + delta`` (default 0, the pair's offset).
 
     Use :meth:`create` (degrees, validated) from user code.
     """
@@ -115,16 +128,25 @@ class VHCattPair:
     face_width: jnp.ndarray
     z1: int = field(metadata=dict(static=True))
     z2: int = field(metadata=dict(static=True))
+    blade_angle_delta: jnp.ndarray = field(default_factory=lambda: float64_array(
+        np.zeros((2, 2))))
+    blade_offset_delta: jnp.ndarray = field(default_factory=lambda: float64_array(np.zeros(2)))
 
     @classmethod
     def create(cls, z1, z2, module, pressure_angle_deg, face_width, cutter_radius1,
-               cutter_radius2=None, blade_offset=0.0, check_form: bool = True):
+               cutter_radius2=None, blade_offset=0.0, check_form: bool = True,
+               member_blades: dict | None = None):
         """Validated constructor (mm, degrees); ``ValueError`` names the parameter.
 
         Ranges: tooth numbers 8..400, module 0.1..50 mm, pressure angle [10, 30] deg,
         face width (0, min(20 m, R_T))  mm, cutter radii 10..1e5 mm and above 10 blade
         spacings ``10 w = 5 pi m``, blade offset [0, 5 m] mm.  ``cutter_radius2`` defaults to ``cutter_radius1``
-        (one head cuts both members, as in [VH-CATT] Table 1).  With ``check_form``
+        (one head cuts both members, as in [VH-CATT] Table 1).  ``member_blades``:
+        optional per-member blade settings ``{"pinion": {"blade_offset": mm,
+        "convex_blade_angle": deg, "concave_blade_angle": deg}, "gear": {...}}`` (any key
+        may be left out: the pair's value), each blade angle within
+        :data:`BLADE_ANGLE_CORRECTION_DEG` of the pressure angle and in [10, 30] deg, each
+        offset in [0, 5 m] mm.  With ``check_form``
         the tooth form is checked (:func:`tooth_form`): pointed teeth, undercut
         reaching the active profile, and involute (tip) interference are refused.
         """
@@ -146,7 +168,9 @@ class VHCattPair:
         bmax = min(20.0 * m, min(rt))
         b = check_range("face_width", face_width, 0.0, bmax, lo_open=True, unit="mm")
         f = float64_array
-        pair = cls(f(m), f(a * math.pi / 180.0), f(rt[0]), f(rt[1]), f(e), f(b), z1, z2)
+        da, de = _member_blade_deltas(member_blades or {}, m, a, e)
+        pair = cls(f(m), f(a * math.pi / 180.0), f(rt[0]), f(rt[1]), f(e), f(b), z1, z2,
+                   f(da), f(de))
         if check_form:
             form = tooth_form(pair)
             for mem in MEMBERS:
@@ -176,6 +200,39 @@ class VHCattPair:
 
     def teeth(self, member: str) -> int:
         return self.z1 if member == "pinion" else self.z2
+
+
+def member_blade_range(key: str, m: float, alpha_deg: float, e: float | None = None):
+    """``(lo, hi, unit)`` of a per-member blade setting ``key`` (:data:`MEMBER_BLADE_KEYS`)
+    of a pair of module ``m`` (mm) and pressure angle ``alpha_deg``: the blade offset in
+    [0, 5 m] mm; a blade angle within :data:`BLADE_ANGLE_CORRECTION_DEG` of the pressure
+    angle and in [10, 30] deg."""
+    if key == "blade_offset":
+        return 0.0, 5.0 * m, "mm"
+    return (max(10.0, alpha_deg - BLADE_ANGLE_CORRECTION_DEG),
+            min(30.0, alpha_deg + BLADE_ANGLE_CORRECTION_DEG), "deg")
+
+
+def _member_blade_deltas(member_blades: dict, m: float, alpha_deg: float, e: float):
+    """``(blade_angle_delta (2, 2) rad, blade_offset_delta (2,) mm)`` of the validated
+    per-member blade settings ``member_blades`` (:meth:`VHCattPair.create`; absolute
+    values, mm and deg; one-line ``ValueError`` naming member, key, value and range)."""
+    da, de = np.zeros((2, 2)), np.zeros(2)
+    for mem, blades in member_blades.items():
+        if mem not in MEMBERS:
+            raise ValueError(f"member_blades: {mem!r} must be 'pinion' or 'gear'")
+        i = MEMBERS.index(mem)
+        for key, v in blades.items():
+            if key not in MEMBER_BLADE_KEYS:
+                raise ValueError(f"member_blades: {mem}.{key} is not a blade setting "
+                                 f"(allowed: {', '.join(MEMBER_BLADE_KEYS)})")
+            lo, hi, unit = member_blade_range(key, m, alpha_deg)
+            x = check_range(f"{mem}.{key}", v, lo, hi, unit=unit)
+            if key == "blade_offset":
+                de[i] = x - e
+            else:
+                da[i, 0 if key.startswith("convex") else 1] = math.radians(x - alpha_deg)
+    return da, de
 
 
 class ToolData(NamedTuple):
@@ -212,6 +269,21 @@ def tool_data(module, alpha, cutter_radius, z, hand, sigma, blade_offset=0.0,
     return ToolData(r, xc, rho0, h * s, h, s, xp.sin(alpha), xp.cos(alpha))
 
 
+def member_tool(pair: VHCattPair, member: str, sigma, xp=jnp) -> ToolData:
+    """:class:`ToolData` of flank ``sigma`` (+-1, may be traced or an array) of ``member``
+    with the member's own blade settings: the blade angle ``alpha + blade_angle_delta[i,
+    f]`` (``f`` = 0 for the convex flank, ``h sigma = +1``; 1 for the concave) and the
+    blade offset ``e + blade_offset_delta[i]`` (``i`` = 0 pinion, 1 gear)."""
+    i = 0 if member == "pinion" else 1
+    h = HANDS[member]
+    c = 0.5 * (1.0 + h * xp.asarray(sigma, float))          # 1 convex, 0 concave
+    da = xp.asarray(pair.blade_angle_delta)[i]
+    alpha = pair.pressure_angle + c * da[0] + (1.0 - c) * da[1]
+    e = pair.blade_offset + xp.asarray(pair.blade_offset_delta)[i]
+    return tool_data(pair.module, alpha, pair.cutter_radius(member), pair.teeth(member), h,
+                     sigma, e, xp=xp)
+
+
 def tool_point(k: ToolData, uv):
     """Point of the blade cone in the rack frame at psi = 0 (mm; module docstring)."""
     u, v = uv[0], uv[1]
@@ -240,8 +312,7 @@ def tool_psi0(k: ToolData, uv):
 def generated_flank(pair: VHCattPair, member: str, sigma) -> GeneratedSurface:
     """The flank ``sigma`` (+-1, may be a traced float) of tooth 0 of ``member``
     ("pinion"/"gear"), enveloped by its blade cone (body frame of the member)."""
-    k = tool_data(pair.module, pair.pressure_angle, pair.cutter_radius(member),
-                  pair.teeth(member), HANDS[member], sigma, pair.blade_offset)
+    k = member_tool(pair, member, sigma)
     P = jax.tree_util.Partial
     return GeneratedSurface(P(tool_family, k), P(tool_psi0, k))
 
@@ -312,8 +383,7 @@ def _v_of(k: ToolData, u, z):
 def section_point(pair: VHCattPair, member: str, sigma, u, z):
     """Generated point (body frame) at blade coordinate ``u`` in the transverse section
     ``z`` (traceable): ``flank(u, v(u, z))``."""
-    k = tool_data(pair.module, pair.pressure_angle, pair.cutter_radius(member),
-                  pair.teeth(member), HANDS[member], sigma, pair.blade_offset)
+    k = member_tool(pair, member, sigma)
     fl = generated_flank(pair, member, sigma)
     return fl(jnp.stack([u, _v_of(k, u, z)]))
 
@@ -452,8 +522,7 @@ def _form_arrays(pair: VHCattPair) -> dict:
     roll = {"pinion": geo["rho_A"], "gear": g_line - geo["rho_E"]}
     for mem, ra, sap in (("pinion", geo["ra1"], geo["start_radius1"]),
                          ("gear", geo["ra2"], geo["start_radius2"])):
-        k = tool_data(m, al, pn.cutter_radius(mem), pn.teeth(mem), HANDS[mem], sig,
-                      pn.blade_offset, xp=np)
+        k = member_tool(pn, mem, sig, xp=np)
 
         def rad(u):
             q, _ = envelope_point_np(k, u, zs)
@@ -492,7 +561,9 @@ def check_pair_fields(pair: VHCattPair) -> None:
     the radian field -- is refused).  Traced or batched fields skip it."""
     vals = (pair.module, pair.pressure_angle, pair.cutter_radius1, pair.cutter_radius2,
             pair.blade_offset, pair.face_width)
-    if any(is_traced(v) or np.ndim(v) for v in vals):
+    if any(is_traced(v) or np.ndim(v) for v in vals) or any(
+            is_traced(v) or np.shape(v) != sh for v, sh in
+            ((pair.blade_angle_delta, (2, 2)), (pair.blade_offset_delta, (2,)))):
         return
     check_int("z1", pair.z1, lo=8, hi=MAX_TEETH)
     check_int("z2", pair.z2, lo=8, hi=MAX_TEETH)
@@ -502,6 +573,13 @@ def check_pair_fields(pair: VHCattPair) -> None:
     rt = [check_range(name, getattr(pair, name), *CUTTER_RADIUS_RANGE_MM, unit="mm")
           for name in ("cutter_radius1", "cutter_radius2")]
     check_range("blade_offset", pair.blade_offset, 0.0, 5.0 * m, unit="mm")
+    dmax = math.radians(BLADE_ANGLE_CORRECTION_DEG)
+    for i, mem in enumerate(MEMBERS):
+        check_range(f"{mem} blade_offset", pair.blade_offset + pair.blade_offset_delta[i],
+                    0.0, 5.0 * m, unit="mm")
+        for f, fl in enumerate(("convex", "concave")):
+            check_range(f"{mem} {fl} blade_angle_delta", pair.blade_angle_delta[i, f], -dmax,
+                        dmax, unit="rad")
     check_range("face_width", pair.face_width, 0.0, min(20.0 * m, min(rt)), lo_open=True,
                 unit="mm")
 
@@ -544,27 +622,33 @@ def tooth_form(pair: VHCattPair) -> dict:
     return out
 
 
-def flank_grid(pair: VHCattPair, member: str, sigma: int, n_z: int, n_u: int):
+def flank_grid(pair: VHCattPair, member: str, sigma: int, n_z: int, n_u: int,
+               face_margin: float = 0.0, height_margin: float = 0.0):
     """Point grid of flank ``sigma`` of ``member``: ``n_z`` sections from z = -b/2 to b/2
-    by ``n_u`` blade coordinates from the form circle (straight blade end) to the tip
-    circle (the middle-section radii; concrete).  Returns a dict with ``points``,
-    ``normals`` (n_z, n_u, 3), ``params`` (n_z, n_u, 2) = (u, v), ``xi`` (n_z,) the
-    axial positions, ``residual`` and ``converged`` (n_z, n_u)."""
-    return _flank_grid_jit(pair, member == "gear", float(sigma), int(n_z), int(n_u))
+    by ``n_u`` blade coordinates from the form circle (straight blade end, ``u_lo = -m
+    / cos(alpha)``) to the tip circle (``u_hi``: the middle-section radii; concrete),
+    inside a border of ``face_margin`` of the face width at each end (``z`` from ``-b/2
+    + f_m b`` to ``b/2 - f_m b``) and ``height_margin`` of the blade range at each end
+    (``u = u_lo + (u_hi - u_lo) h``, ``h`` from ``h_m`` to ``1 - h_m``; the margins are
+    traced: one program for all).  Returns a dict with ``points``, ``normals`` (n_z,
+    n_u, 3), ``params`` (n_z, n_u, 2) = (u, v), ``psi`` (n_z, n_u) the roll angle of
+    each point, ``xi`` (n_z,) the axial positions, ``residual`` and ``converged`` (n_z,
+    n_u)."""
+    return _flank_grid_jit(pair, member == "gear", float(sigma), int(n_z), int(n_u),
+                           float(face_margin), float(height_margin))
 
 
-def _flank_grid_impl(pair, is_gear, sigma, n_z, n_u):
+def _flank_grid_impl(pair, is_gear, sigma, n_z, n_u, face_margin, height_margin):
     mem = "gear" if is_gear else "pinion"
     geo = pair_geometry(pair)
-    k = tool_data(pair.module, pair.pressure_angle, pair.cutter_radius(mem),
-                  pair.teeth(mem), HANDS[mem], sigma, pair.blade_offset)
+    k = member_tool(pair, mem, sigma)
     fl = generated_flank(pair, mem, sigma)
     ra = geo["ra2"] if is_gear else geo["ra1"]
     al, m = pair.pressure_angle, pair.module
     u_lo = -BLADE_DEPTH * m / jnp.cos(al)
     u_hi = _u_guess(pair, mem, ra)
-    us = jnp.linspace(u_lo, u_hi, n_u)
-    hb = 0.5 * pair.face_width
+    us = u_lo + (u_hi - u_lo) * jnp.linspace(height_margin, 1.0 - height_margin, n_u)
+    hb = 0.5 * pair.face_width - face_margin * pair.face_width
     zs = jnp.linspace(-hb, hb, n_z)
 
     def pt(z, u):
@@ -572,10 +656,10 @@ def _flank_grid_impl(pair, is_gear, sigma, n_z, n_u):
         sol = fl.solve(uv)
         q = fl.family(uv, sol.x)
         n = fl.tool_normal(uv)
-        return q, n, uv, sol.residual, sol.converged
+        return q, n, uv, sol.x, sol.residual, sol.converged
 
-    q, n, uv, res, ok = jax.vmap(lambda z: jax.vmap(lambda u: pt(z, u))(us))(zs)
-    return dict(points=q, normals=n, params=uv, xi=zs, residual=res, converged=ok)
+    q, n, uv, psi, res, ok = jax.vmap(lambda z: jax.vmap(lambda u: pt(z, u))(us))(zs)
+    return dict(points=q, normals=n, params=uv, psi=psi, xi=zs, residual=res, converged=ok)
 
 
 _flank_grid_jit = jax.jit(_flank_grid_impl, static_argnums=(1, 3, 4))
