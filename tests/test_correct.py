@@ -495,8 +495,12 @@ def test_ease_off_command_refuses_bad_input(argv, needle, tmp_path, capsys):
     assert not out.exists()
 
 
-def test_ease_off_command_refuses_a_family_without_machine_settings(tmp_path, capsys):
-    rc = main(["ease-off", "example:khk_spur_12x24", "--out", str(tmp_path / "o.toml")])
+@pytest.mark.parametrize("example", ["khk_spur_12x24", "vh_catt_17x23"])
+def test_ease_off_command_refuses_a_family_without_machine_settings(example, tmp_path,
+                                                                    capsys):
+    """Involute and VH-CATT pairs (the latter correctable from measurements, but with no
+    conjugate pinion of machine settings here) are refused in one line."""
+    rc = main(["ease-off", f"example:{example}", "--out", str(tmp_path / "o.toml")])
     err = capsys.readouterr().err.strip().splitlines()
     assert rc == 2 and len(err) == 1 and "hypoid and spiral-bevel designs only" in err[0]
 

@@ -209,7 +209,8 @@ def run(args) -> int:
         target = read_target(args.target, grid)
         spec = {"file": str(args.target)}
     design = load_design(args.design)
-    if not hasattr(design, "reference_grid"):
+    from gearjax.gears.hypoid.design_file import HypoidDesign
+    if not isinstance(design, HypoidDesign):
         raise ValueError(f"{args.design!r}: the target ease-off is defined for hypoid and "
                          f"spiral-bevel designs only, not for [design] kind = "
                          f"{design.data['design']['kind']!r}")
