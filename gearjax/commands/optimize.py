@@ -11,7 +11,9 @@ files to ``--out`` (default ``./NAME_results``):
   the loader refuses it;
 * ``NAME_history.json`` -- the report (keys below);
 * ``NAME.png`` -- objective and constraint history, TE before/after, loss per position
-  (loaded studies) or |SRR| along the path, and the variables (``--no-plot``: none).
+  (loaded studies) or |SRR| along the path, and the variables; a line-contact study:
+  history, loaded TE p-t-p against torque before/after, the optimised pinion flank's
+  modification map and the variables (``--no-plot``: none).
 
 Exit status: 0 the end design is accepted (optimiser converged, constraints hold, the
 design file round-trips, no new edge contact or non-converged TCA, no fewer valid
@@ -31,7 +33,9 @@ HISTORY_KEYS_DOC = """JSON keys of NAME_history.json:
   study, description, design, family, side   the study's [study] table (design as given)
   variables         per variable: field, unit ("field": the field's own mm/rad/-, or
                     "deg"), lower, upper, start, end (in that unit)
+  route             "tca" or "line" (the loaded line contact, micro-geometry variables)
   scenarios         per scenario: torque_Nm, pinion_rpm, dE_mm, dP_mm, dG_mm, dSigma_deg
+                    (a line-contact study: torque_Nm, pinion_rpm, f_ma_um)
   edge_softening_mm the soft active set of the loaded chain (mm; 0: none)
   quantities        per quantity: unit, start and end (one value per scenario); loaded
                     quantities of a study with edge softening also start_hard_model and
@@ -88,7 +92,7 @@ def _list(args) -> int:
             print(f"{name:34s} {st.description}")
     if args.quantities:
         for q, d in QUANTITIES.items():
-            kind = "loaded" if d.loaded else "TCA"
+            kind = "line" if d.route == "line" else ("loaded" if d.loaded else "TCA")
             t = "" if d.temperature is None else f" [smooth, T = {d.temperature:g}]"
             print(f"{q:22s} {d.unit or '-':7s} {kind:6s} {d.description}{t}")
     return 0
@@ -99,8 +103,12 @@ def _fields(study) -> int:
 
     import gearjax as gj
     design = gj.load_design(study.design)
-    f = gj.tca_function(design, side=study.side)
-    for name, v in gj.get_fields(f.pair).items():
+    if study.route == "line":
+        from gearjax.studies.line_route import line_chain
+        pair = line_chain(design, study).pair
+    else:
+        pair = gj.tca_function(design, side=study.side).pair
+    for name, v in gj.get_fields(pair).items():
         a = np.asarray(v)
         if a.ndim == 0:
             print(f"{name:44s} {float(a):.10g}")
@@ -143,6 +151,21 @@ def _table(rep) -> str:
     ok = rep["checks"]["accepted"]
     lines.append("end design: " + ("accepted" if ok else "NOT accepted (see the warnings)"))
     return "\n".join(lines)
+
+
+def _figure(prob, rep, result):
+    """The study's figure (:mod:`gearjax.plot.study`): that of the TCA route, or for a
+    line-contact study the loaded TE against torque and the end pinion flank's
+    modification map."""
+    from gearjax.plot import study as plot
+    if prob.route != "line":
+        return plot.study_figure(rep, result.start, result.end, prob.data.mask[0])
+    flank = None
+    if result.end_data is not None:
+        from gearjax.io import design_from_dict
+        from gearjax.plot.microgeometry import removal_map
+        flank = removal_map(design_from_dict(result.end_data), "pinion", prob.study.side)
+    return plot.line_study_figure(rep, flank, f"pinion {prob.study.side} flank")
 
 
 def run(args) -> int:
@@ -194,8 +217,7 @@ def _run(study, out, args) -> int:
         atomic_write(path, head + dumps_toml(data))
         files["design"] = path
     if not args.no_plot:
-        from gearjax.plot.study import study_figure
-        fig = study_figure(rep, result.start, result.end, prob.data.mask[0])
+        fig = _figure(prob, rep, result)
         files["figure"] = os.path.join(out, f"{name}.png")
         atomic_write_figure(fig, files["figure"])
     rep["files"] = files
