@@ -22,7 +22,6 @@ from gearjax.gears.involute.design_file import microgeometry_tables, read_microg
 from gearjax.gears.involute.loaded_lines import loaded_te_map
 from gearjax.gears.involute.microgeometry import (FlankModification, MicroGeometry,
                                                   PairModification)
-from gearjax.io import design_from_dict
 from gearjax.studies import study_run as sr
 from gearjax.studies.quantities import QUANTITIES
 from gearjax.studies.study_file import read_study

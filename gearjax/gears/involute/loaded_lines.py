@@ -237,6 +237,6 @@ def loaded_te_map(design, torques_Nm, misalignments_um=(0.0,), *, mods=None, sid
         oil = dataclasses.replace(oil, name="")     # the label is not part of the program
     opts = line_options(pair, b, positions, slices, compliance)
     out = call(_map, *_split(pair), b, mods, jnp.asarray(1e3 * T), jnp.asarray(A),
-               mat.youngs_modulus_MPa, mat.poisson, float(temperature_um), rpm, oil, surface, opts=opts,
-               drive=side == "drive", vm=viscosity_model, fm=film_method)
+               mat.youngs_modulus_MPa, mat.poisson, float(temperature_um), rpm, oil, surface,
+               opts=opts, drive=side == "drive", vm=viscosity_model, fm=film_method)
     return LoadedTEMap(jnp.asarray(T), jnp.asarray(A), *out)
