@@ -308,3 +308,43 @@ def test_cli_refusal_is_one_line(tmp_path, capsys):
     assert main(["optimize", path]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "[[variables]] 4" in err and "crowning_um" in err
+
+
+def test_efficiency_quantities_agree_with_the_loaded_map(tmp_path):
+    """``line_power_loss_W`` and ``line_mesh_efficiency`` of a study against the loaded
+    map with ``pinion_rpm`` (the friction along the contact lines, ``gearjax loaded
+    --rpm``) at one scenario."""
+    text = _replace(STUDY, "[scenarios]", '[operating]\npinion_rpm = 3000.0\noil = '
+                    '"mineral_vg100"\nsigma_um = 0.4\ntorque_Nm = 300.0\n\n[scenarios]')
+    text = _replace(text, f"torque_Nm = {list(TORQUES)}\nf_ma_um = {list(MISALIGNMENTS)}",
+                    "f_ma_um = 5.0")
+    text = _replace(text, '[[constraints]]\nquantity = "line_end_load"',
+                    '[[constraints]]\nquantity = "line_mesh_efficiency"\nlower = 0.9\n\n'
+                    '[[constraints]]\nquantity = "line_power_loss_W"\nupper = 1e4\n\n'
+                    '[[constraints]]\nquantity = "line_end_load"')
+    prob = sr.set_up(read_study(_write(tmp_path, text)))
+    Q = np.asarray(sr.start_point(prob)[0])[0]
+    qi = {q: i for i, q in enumerate(prob.study.quantities)}
+    m = loaded_te_map(prob.design, [300.0], [5.0], positions=POSITIONS, slices=SLICES,
+                      pinion_rpm=3000.0, oil=gj.tribology.get_oil("mineral_vg100"),
+                      surface=gj.tribology.make_surface(0.4))
+    assert Q[qi["line_power_loss_W"]] == pytest.approx(float(m.power_loss_W[0, 0]), rel=1e-10)
+    assert Q[qi["line_mesh_efficiency"]] == pytest.approx(float(m.efficiency[0, 0]), rel=1e-12)
+    assert 0.0 < Q[qi["line_power_loss_W"]] and 0.9 < Q[qi["line_mesh_efficiency"]] < 1.0
+
+
+def test_efficiency_needs_the_operating_point(tmp_path):
+    text = _replace(STUDY, 'quantity = "line_end_load"\nupper = 1.2',
+                    'quantity = "line_power_loss_W"\nupper = 1e4')
+    with pytest.raises(ValueError, match=r"\[operating\]: the loaded quantity "
+                                         r"'line_power_loss_W' needs the operating point"):
+        read_study(_write(tmp_path, text))
+
+
+def test_sweep_and_sensitivity_refuse_the_line_route(tmp_path, capsys):
+    path = _write(tmp_path, STUDY)
+    assert main(["sweep", path, "--out", str(tmp_path / "sw")]) == 2
+    assert "gearjax sweep runs TCA-route studies" in capsys.readouterr().err
+    assert main(["sensitivity", "example:helical_microgeometry", "--outputs",
+                 "line_te_ptp_um", "--params", "microgeometry.pinion.tip_relief_um"]) == 2
+    assert "a quantity of the loaded line contact" in capsys.readouterr().err

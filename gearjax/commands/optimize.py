@@ -53,7 +53,8 @@ HISTORY_KEYS_DOC = """JSON keys of NAME_history.json:
   history           objective, feasibility (and stationarity) per iteration
   checks            accepted, reasons (why not), round_trip_difference (largest
                     |field| difference of the design file read back), flags_start and
-                    flags_end (TCA quality flags per scenario; n_valid for loaded studies)
+                    flags_end (TCA quality flags per scenario; n_valid for loaded studies;
+                    a line-contact study: converged, n_valid of the mesh positions)
   seconds           wall time of the run
   files             design, history, figure: the paths written (null: not written)
 """
