@@ -296,6 +296,9 @@ def test_micro_variables_need_the_line_route(tmp_path):
      r"\[\[variables\]\] 2 .*outside the field's range \[> 0"),
     ("f_ma_um = [-10.0, 10.0]", "f_ma_um = [-10.0, 2000.0]",
      r"\[scenarios\] scenario 2: f_ma_um = 2000"),
+    ("microgeometry.gear_drive.tip_relief_um", "microgeometry.pinion_drive.tip_relief_um",
+     r"\[\[variables\]\] 3: field 'microgeometry.pinion_drive.tip_relief_um' is the field "
+     r"of \[\[variables\]\] 1 again"),
 ])
 def test_bad_study_refused_at_set_up(tmp_path, old, new, match):
     with pytest.raises(ValueError, match=match):

@@ -161,12 +161,35 @@ def _figure(prob, rep, result):
     from gearjax.plot import study as plot
     if prob.route != "line":
         return plot.study_figure(rep, result.start, result.end, prob.data.mask[0])
-    flank = None
+    flank = sweep = None
     if result.end_data is not None:
         from gearjax.io import design_from_dict
         from gearjax.plot.microgeometry import removal_map
-        flank = removal_map(design_from_dict(result.end_data), "pinion", prob.study.side)
-    return plot.line_study_figure(rep, flank, f"pinion {prob.study.side} flank")
+        end = design_from_dict(result.end_data)
+        flank = removal_map(end, "pinion", prob.study.side)
+        sweep = _torque_sweep(prob, end)
+    return plot.line_study_figure(rep, flank, f"pinion {prob.study.side} flank", sweep)
+
+
+#: torque sweep of a line-contact study's figure: points, and the range as factors of
+#: the smallest and the largest scenario torque
+SWEEP_POINTS, SWEEP_RANGE = 25, (0.25, 1.3)
+
+
+def _torque_sweep(prob, end):
+    """``(T, A, ptp_start, ptp_end)``: the loaded TE p-t-p (µm) of the start and the end
+    design over :data:`SWEEP_POINTS` torques (the scenarios' range widened by
+    :data:`SWEEP_RANGE`) at each misalignment of the scenarios, by the map of
+    ``gearjax loaded`` (one compiled program for both designs)."""
+    import numpy as np
+
+    from gearjax.involute import loaded_te_map
+    T = [s["torque_Nm"] for s in prob.scenarios]
+    A = sorted({s["f_ma_um"] for s in prob.scenarios})
+    Ts = np.linspace(SWEEP_RANGE[0] * min(T), SWEEP_RANGE[1] * max(T), SWEEP_POINTS)
+    kw = dict(side=prob.study.side, **prob.chain.options)
+    p0, p1 = (np.asarray(loaded_te_map(d, Ts, A, **kw).te_ptp_um) for d in (prob.design, end))
+    return Ts, np.asarray(A), p0, p1
 
 
 def run(args) -> int:

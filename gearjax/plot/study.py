@@ -129,33 +129,45 @@ def study_figure(report: dict, start: tuple, end: tuple, mask=None):
     return fig
 
 
-def _te_vs_torque(ax, report):
-    """Loaded TE p-t-p (hard, µm) at the study's scenarios against the torque, one line
-    per mesh misalignment, start dashed and end solid."""
+def _te_vs_torque(ax, report, sweep=None):
+    """Loaded TE p-t-p (hard, µm) against the torque, one colour per mesh misalignment,
+    start dashed and end solid: at the study's scenarios (markers) and, with ``sweep =
+    (T (n,), A (m,), ptp_start (n, m), ptp_end (n, m))``, over a torque sweep (lines)."""
     q = report["quantities"]["line_te_ptp_hard_um"]
     sc = report["scenarios"]
     T = np.array([s["torque_Nm"] for s in sc], float)
     A = np.array([s["f_ma_um"] for s in sc], float)
-    for j, a in enumerate(sorted(set(A.tolist()))):
+    levels = sorted(set(A.tolist()))
+    for j, a in enumerate(levels):
         sel = A == a
         order = np.argsort(T[sel])
         for key, ls, lab in (("start", "--", "start"), ("end", "-", "optimised")):
             v = np.asarray(q[key], float)[sel][order]
-            ax.plot(T[sel][order], v, ls, marker="o", ms=3.5, color=f"C{j}",
-                    label=f"{lab}, f_ma = {a:g} µm")
+            ax.plot(T[sel][order], v, "o" if sweep is not None else ls + "o", ms=4,
+                    color=f"C{j}", mfc="none" if key == "start" else None,
+                    label=None if sweep is not None else f"{lab}, f_ma = {a:g} µm")
+    if sweep is not None:
+        Ts, As, p0, p1 = (np.asarray(v, float) for v in sweep)
+        for j, a in enumerate(As):
+            c = f"C{levels.index(a)}" if a in levels else f"C{j}"
+            ax.plot(Ts, p0[:, j], "--", color=c, lw=1.0, label=f"start, f_ma = {a:g} µm")
+            ax.plot(Ts, p1[:, j], "-", color=c, lw=1.5, label=f"optimised, f_ma = {a:g} µm")
     ax.set_xlabel("pinion torque (N m)")
     ax.set_ylabel("loaded TE peak-to-peak (µm)")
     ax.set_ylim(bottom=0.0)
-    ax.set_title("loaded TE at the study's scenarios")
+    ax.set_title("loaded TE against torque" + (" (markers: the study's scenarios)"
+                                               if sweep is not None else ""))
     ax.grid(True, lw=0.3, alpha=0.6)
     ax.legend(loc="best", fontsize=7)
 
 
-def line_study_figure(report: dict, flank_map=None, flank_label: str = "pinion flank"):
+def line_study_figure(report: dict, flank_map=None, flank_label: str = "pinion flank",
+                      sweep=None):
     """The figure of a line-contact study (:mod:`gearjax.studies.line_route`): history,
-    loaded TE p-t-p against torque before and after (the scenarios' values), the end
-    design's modification map (``flank_map``, :func:`gearjax.plot.microgeometry.
-    removal_map`'s triple; None: left empty) and the variables."""
+    loaded TE p-t-p against torque before and after (the scenarios' values; ``sweep``
+    as :func:`_te_vs_torque` adds a torque sweep of both designs), the end design's
+    modification map (``flank_map``, :func:`gearjax.plot.microgeometry.removal_map`'s
+    triple; None: left empty) and the variables."""
     from gearjax.plot import headless
     from gearjax.plot.microgeometry import map_panel
     headless()
@@ -165,10 +177,10 @@ def line_study_figure(report: dict, flank_map=None, flank_label: str = "pinion f
         fig, ax = plt.subplots(2, 2, figsize=(max(MIN_WIDTH_IN, 12.0), 9.0))
         opt = report["optimizer"]
         _history(ax[0, 0], report["history"],
-                 f"{report['study']}: {opt['method']}, {opt['iterations']} iterations, "
+                 f"{report['study']}\n{opt['method']}, {opt['iterations']} iterations, "
                  f"{opt['evaluations']} evaluations",
                  (report["objective"]["start"], report["max_violation"]["start"]))
-        _te_vs_torque(ax[0, 1], report)
+        _te_vs_torque(ax[0, 1], report, sweep)
         if flank_map is not None:
             map_panel(fig, ax[1, 0], flank_map, f"{flank_label} (optimised)")
         else:

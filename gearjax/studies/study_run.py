@@ -31,6 +31,12 @@ file round-trips, and at every scenario the TCA converged without edge contact a
 loaded study) no fewer positions of the cycle are valid than at the start; with edge
 softening, the hard model's objective may not rise by more than the softened one's
 (:func:`acceptance_reasons`).
+
+**The line-contact route** (a study of the ``line_*`` quantities,
+:mod:`gearjax.studies.line_route`): the variables are micro-geometry fields, each
+scenario one loaded line contact (torque, mesh misalignment f_ma), the same scaled
+problem, optimisers and acceptance, with the line contact's own flags (every mesh
+position converged) and design-file write-back (the ``[microgeometry]`` tables).
 """
 
 from __future__ import annotations
