@@ -12,8 +12,9 @@ files to ``--out`` (default ``./NAME_results``):
 * ``NAME_history.json`` -- the report (keys below);
 * ``NAME.png`` -- objective and constraint history, TE before/after, loss per position
   (loaded studies) or |SRR| along the path, and the variables; a line-contact study:
-  history, loaded TE p-t-p against torque before/after, the optimised pinion flank's
-  modification map and the variables (``--no-plot``: none).
+  history, loaded TE p-t-p against torque before/after (a sweep of both designs by the
+  map of ``gearjax loaded``), the optimised pinion flank's modification map and the
+  variables (``--no-plot``: none).
 
 Exit status: 0 the end design is accepted (optimiser converged, constraints hold, the
 design file round-trips, no new edge contact or non-converged TCA, no fewer valid
