@@ -204,12 +204,12 @@ def line_evaluator(prob):
     """``(u, data) -> (Q (S, nq), res, eff, Q)``: the study's quantities at every
     scenario (one ``vmap``; the same form as the TCA route's evaluator, the hard model
     being the model itself)."""
+    from gearjax.fields import with_scaled_fields
     from gearjax.studies.quantities import quantity_values
-    from gearjax.studies.study_run import fields_at
-    chain, qnames = prob.chain, prob.study.quantities
+    chain, qnames, names = prob.chain, prob.study.quantities, list(prob.fields)
 
     def ev(u, data):
-        tree = fields_at(u, data, prob.fields)
+        tree = with_scaled_fields(data.pair0, names, data.x0, data.scale, u)
 
         def one(T, n, f):
             res, eff = chain(tree, T, n, f, data.oil, data.surface)
@@ -231,7 +231,7 @@ def line_flags(res, eff, k: int) -> dict:
 def line_round_trip(prob, end_tree):
     """The end design as a design file (the start's with its ``[microgeometry]`` tables
     rewritten) read back through the involute loader; ``(data, error or None, max
-    |field difference|)`` as :func:`gearjax.studies.study_run._round_trip`."""
+    |field difference|)`` as :func:`gearjax.studies.study_run.run_study`'s check."""
     from gearjax.fields import get_fields
     from gearjax.gears.involute.design_file import (MICRO_KEYS, MICRO_TABLES,
                                                     microgeometry_tables)

@@ -52,7 +52,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from gearjax.compile_ahead import FAST_COMPILE_OPTIONS
-from gearjax.fields import field_names, get_fields, with_fields
+from gearjax.fields import field_names, get_fields, with_fields, with_scaled_fields
 from gearjax.studies.quantities import QUANTITIES, quantity_values, smooth_max
 from gearjax.studies.study_file import Constraint, Study
 from gearjax.tca.assembly import Misalignment
@@ -235,13 +235,6 @@ def _set_up_line(study: Study, design) -> Problem:
     return _finish(prob, chain.pair, sc, col, col["f_ma_um"], oil, surface)
 
 
-def fields_at(u, data, names):
-    """The variables' pytree (``data.pair0``) with the fields ``names`` at the scaled
-    point ``u``: ``x = x0 + scale u`` (traceable)."""
-    x = data.x0 + data.scale * u
-    return with_fields(data.pair0, {n: x[i] for i, n in enumerate(names)})
-
-
 def evaluator(prob: Problem, hard: bool = False, own_mask: bool = False):
     """``(u, data) -> (Q (S, nq), res, eff, Q_hard)``: the quantities at every scenario;
     with ``hard`` (a loaded study) ``Q_hard`` are the loaded quantities again with the
@@ -255,7 +248,7 @@ def evaluator(prob: Problem, hard: bool = False, own_mask: bool = False):
     qnames = prob.study.quantities
 
     def ev(u, data):
-        pair = fields_at(u, data, names)
+        pair = with_scaled_fields(data.pair0, names, data.x0, data.scale, u)
 
         def one(T, n, mis, mask):
             if loaded:
