@@ -22,6 +22,7 @@ from gearjax.gears.involute.design_file import microgeometry_tables, read_microg
 from gearjax.gears.involute.loaded_lines import loaded_te_map
 from gearjax.gears.involute.microgeometry import (FlankModification, MicroGeometry,
                                                   PairModification)
+from gearjax.io import dumps_toml, read_toml
 from gearjax.studies import study_run as sr
 from gearjax.studies.quantities import QUANTITIES
 from gearjax.studies.study_file import read_study
@@ -351,3 +352,18 @@ def test_sweep_and_sensitivity_refuse_the_line_route(tmp_path, capsys):
     assert main(["sensitivity", "example:helical_microgeometry", "--outputs",
                  "line_te_ptp_um", "--params", "microgeometry.pinion.tip_relief_um"]) == 2
     assert "a quantity of the loaded line contact" in capsys.readouterr().err
+
+
+def test_member_variable_of_a_design_whose_flanks_differ_is_refused(tmp_path):
+    """``microgeometry.pinion.KEY`` moves both pinion flanks; where the design's two
+    flanks differ in KEY the start is ambiguous: refused, naming the flank to give."""
+    design = read_toml("example:helical_microgeometry")
+    mg = design["microgeometry"]
+    mg["pinion_drive"] = dict(mg.pop("pinion"))
+    mg["pinion_coast"] = dict(mg["pinion_drive"], tip_relief_um=5.0)
+    (tmp_path / "d.toml").write_text(dumps_toml(design))
+    text = _replace(STUDY, 'design = "example:helical_microgeometry"', 'design = "d.toml"')
+    with pytest.raises(ValueError, match=r"\[\[variables\]\] 1 \(microgeometry.pinion."
+                                         r"tip_relief_um\): the design's pinion flanks differ "
+                                         r"in tip_relief_um .*microgeometry.pinion_drive"):
+        sr.set_up(read_study(_write(tmp_path, text)))

@@ -113,6 +113,9 @@ class LineChain:
                                        MICRO_KEYS.items()}) for m in ("pinion", "gear")))
 
     def __call__(self, tree, torque_Nm, rpm, f_ma_um, oil, surface):
+        """One scenario: pinion torque ``torque_Nm`` (N m; the model takes N mm), speed
+        ``rpm`` and ``oil``/``surface`` (used with the efficiency only), mesh
+        misalignment ``f_ma_um`` (µm); traceable in all but the options."""
         from gearjax.gears.involute.line_efficiency import line_efficiency_traced
         from gearjax.gears.involute.line_load import line_load_traced
         mat, drive = self.material, self.side == "drive"
