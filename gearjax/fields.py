@@ -14,7 +14,8 @@ from __future__ import annotations
 import jax
 import jax.numpy as jnp
 
-__all__ = ["field_names", "get_fields", "with_fields", "strong_float64", "float64_array"]
+__all__ = ["field_names", "get_fields", "with_fields", "with_scaled_fields", "strong_float64",
+           "float64_array"]
 
 
 def _name(path) -> str:
@@ -55,6 +56,14 @@ def with_fields(tree, values: dict):
         raise KeyError(f"unknown field(s) {sorted(unknown)} (known: {', '.join(names)})")
     return jax.tree_util.tree_unflatten(treedef, [values.get(n, leaf)
                                                   for n, (_, leaf) in zip(names, flat)])
+
+
+def with_scaled_fields(tree, names, x0, scale, u):
+    """``tree`` with the fields ``names`` at ``x = x0 + scale * u`` (arrays of
+    ``len(names)``: start values, scales in field units, the scaled point of an
+    optimiser; traceable)."""
+    x = x0 + scale * u
+    return with_fields(tree, {n: x[i] for i, n in enumerate(names)})
 
 
 def float64_array(v):

@@ -133,7 +133,8 @@ def test_packaged_studies_read():
     names = list_studies()
     assert {"spur_efficiency", "hypoid_efficiency_te", "preset_bevel_robust_kappa",
             "vh_catt_cutter_radius"} <= set(names)
-    scenarios = {"preset_bevel_robust_kappa": 4, "vh_catt_cutter_radius": 2}
+    scenarios = {"preset_bevel_robust_kappa": 4, "vh_catt_cutter_radius": 2,
+                 "helical_microgeometry_robust": 12}
     for n in names:
         st = read_study(f"example:{n}")
         assert st.name == n and st.variables and st.objective

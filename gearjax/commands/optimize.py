@@ -11,7 +11,10 @@ files to ``--out`` (default ``./NAME_results``):
   the loader refuses it;
 * ``NAME_history.json`` -- the report (keys below);
 * ``NAME.png`` -- objective and constraint history, TE before/after, loss per position
-  (loaded studies) or |SRR| along the path, and the variables (``--no-plot``: none).
+  (loaded studies) or |SRR| along the path, and the variables; a line-contact study:
+  history, loaded TE p-t-p against torque before/after (a sweep of both designs by the
+  map of ``gearjax loaded``), the optimised pinion flank's modification map and the
+  variables (``--no-plot``: none).
 
 Exit status: 0 the end design is accepted (optimiser converged, constraints hold, the
 design file round-trips, no new edge contact or non-converged TCA, no fewer valid
@@ -31,7 +34,9 @@ HISTORY_KEYS_DOC = """JSON keys of NAME_history.json:
   study, description, design, family, side   the study's [study] table (design as given)
   variables         per variable: field, unit ("field": the field's own mm/rad/-, or
                     "deg"), lower, upper, start, end (in that unit)
+  route             "tca" or "line" (the loaded line contact, micro-geometry variables)
   scenarios         per scenario: torque_Nm, pinion_rpm, dE_mm, dP_mm, dG_mm, dSigma_deg
+                    (a line-contact study: torque_Nm, pinion_rpm, f_ma_um)
   edge_softening_mm the soft active set of the loaded chain (mm; 0: none)
   quantities        per quantity: unit, start and end (one value per scenario); loaded
                     quantities of a study with edge softening also start_hard_model and
@@ -49,7 +54,8 @@ HISTORY_KEYS_DOC = """JSON keys of NAME_history.json:
   history           objective, feasibility (and stationarity) per iteration
   checks            accepted, reasons (why not), round_trip_difference (largest
                     |field| difference of the design file read back), flags_start and
-                    flags_end (TCA quality flags per scenario; n_valid for loaded studies)
+                    flags_end (TCA quality flags per scenario; n_valid for loaded studies;
+                    a line-contact study: converged, n_valid of the mesh positions)
   seconds           wall time of the run
   files             design, history, figure: the paths written (null: not written)
 """
@@ -88,7 +94,7 @@ def _list(args) -> int:
             print(f"{name:34s} {st.description}")
     if args.quantities:
         for q, d in QUANTITIES.items():
-            kind = "loaded" if d.loaded else "TCA"
+            kind = "line" if d.route == "line" else ("loaded" if d.loaded else "TCA")
             t = "" if d.temperature is None else f" [smooth, T = {d.temperature:g}]"
             print(f"{q:22s} {d.unit or '-':7s} {kind:6s} {d.description}{t}")
     return 0
@@ -99,8 +105,12 @@ def _fields(study) -> int:
 
     import gearjax as gj
     design = gj.load_design(study.design)
-    f = gj.tca_function(design, side=study.side)
-    for name, v in gj.get_fields(f.pair).items():
+    if study.route == "line":
+        from gearjax.studies.line_route import line_chain
+        pair = line_chain(design, study).pair
+    else:
+        pair = gj.tca_function(design, side=study.side).pair
+    for name, v in gj.get_fields(pair).items():
         a = np.asarray(v)
         if a.ndim == 0:
             print(f"{name:44s} {float(a):.10g}")
@@ -143,6 +153,44 @@ def _table(rep) -> str:
     ok = rep["checks"]["accepted"]
     lines.append("end design: " + ("accepted" if ok else "NOT accepted (see the warnings)"))
     return "\n".join(lines)
+
+
+def _figure(prob, rep, result):
+    """The study's figure (:mod:`gearjax.plot.study`): that of the TCA route, or for a
+    line-contact study the loaded TE against torque and the end pinion flank's
+    modification map."""
+    from gearjax.plot import study as plot
+    if prob.route != "line":
+        return plot.study_figure(rep, result.start, result.end, prob.data.mask[0])
+    flank = sweep = None
+    if result.end_data is not None:
+        from gearjax.io import design_from_dict
+        from gearjax.plot.microgeometry import removal_map
+        end = design_from_dict(result.end_data)
+        flank = removal_map(end, "pinion", prob.study.side)
+        sweep = _torque_sweep(prob, end)
+    return plot.line_study_figure(rep, flank, f"pinion {prob.study.side} flank", sweep)
+
+
+#: torque sweep of a line-contact study's figure: points, and the range as factors of
+#: the smallest and the largest scenario torque
+SWEEP_POINTS, SWEEP_RANGE = 25, (0.25, 1.3)
+
+
+def _torque_sweep(prob, end):
+    """``(T, A, ptp_start, ptp_end)``: the loaded TE p-t-p (µm) of the start and the end
+    design over :data:`SWEEP_POINTS` torques (the scenarios' range widened by
+    :data:`SWEEP_RANGE`) at each misalignment of the scenarios, by the map of
+    ``gearjax loaded`` (one compiled program for both designs)."""
+    import numpy as np
+
+    from gearjax.involute import loaded_te_map
+    T = [s["torque_Nm"] for s in prob.scenarios]
+    A = sorted({s["f_ma_um"] for s in prob.scenarios})
+    Ts = np.linspace(SWEEP_RANGE[0] * min(T), SWEEP_RANGE[1] * max(T), SWEEP_POINTS)
+    kw = dict(side=prob.study.side, **prob.chain.options)
+    p0, p1 = (np.asarray(loaded_te_map(d, Ts, A, **kw).te_ptp_um) for d in (prob.design, end))
+    return Ts, np.asarray(A), p0, p1
 
 
 def run(args) -> int:
@@ -194,8 +242,7 @@ def _run(study, out, args) -> int:
         atomic_write(path, head + dumps_toml(data))
         files["design"] = path
     if not args.no_plot:
-        from gearjax.plot.study import study_figure
-        fig = study_figure(rep, result.start, result.end, prob.data.mask[0])
+        fig = _figure(prob, rep, result)
         files["figure"] = os.path.join(out, f"{name}.png")
         atomic_write_figure(fig, files["figure"])
     rep["files"] = files

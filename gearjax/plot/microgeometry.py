@@ -18,7 +18,7 @@ import numpy as np
 
 from gearjax.plot.style import DPI, MIN_WIDTH_IN, report_style
 
-__all__ = ["removal_map", "loaded_figure", "save_loaded_plot"]
+__all__ = ["removal_map", "loaded_figure", "save_loaded_plot", "map_panel"]
 
 
 def removal_map(design, member: str = "pinion", side: str = "drive", n_xi: int = 41,
@@ -62,20 +62,7 @@ def _figure(flank_map, te_map, title, flank_label):
     fig = Figure(figsize=(MIN_WIDTH_IN + 3.0, 4.2), layout="constrained")
     FigureCanvasAgg(fig)
     ax_m, ax_t = fig.subplots(1, 2)
-    xi, y, rem = flank_map
-    span = float(np.nanmax(rem) - np.nanmin(rem)) if rem.size else 0.0
-    if span > 1e-9:
-        cs = ax_m.contourf(xi, y, rem, levels=16, cmap="viridis")
-        ax_m.contour(xi, y, rem, levels=cs.levels[1:-1], colors="k", linewidths=0.3, alpha=0.5)
-        fig.colorbar(cs, ax=ax_m, label="material removed (µm)")
-    else:
-        ax_m.text(0.5, 0.5, "unmodified flank", ha="center", va="center",
-                  transform=ax_m.transAxes)
-        ax_m.set_xlim(xi[0], xi[-1])
-        ax_m.set_ylim(y[0], y[-1])
-    ax_m.set_xlabel("roll length ξ (mm): SAP → tip")
-    ax_m.set_ylabel("face position y (mm): end I → end II")
-    ax_m.set_title(f"modification map, {flank_label}")
+    map_panel(fig, ax_m, flank_map, flank_label)
     T = np.asarray(te_map.torque_Nm, float)
     A = np.asarray(te_map.misalignment_um, float)
     ptp = np.asarray(te_map.te_ptp_um, float)
@@ -94,6 +81,25 @@ def _figure(flank_map, te_map, title, flank_label):
     if title:
         fig.suptitle(title)
     return fig
+
+
+def map_panel(fig, ax, flank_map, flank_label: str) -> None:
+    """Draw :func:`removal_map`'s ``(xi, y, removal)`` on ``ax`` of ``fig``: filled
+    contours of the material removed (µm) with a colour bar, or "unmodified flank"."""
+    xi, y, rem = flank_map
+    span = float(np.nanmax(rem) - np.nanmin(rem)) if rem.size else 0.0
+    if span > 1e-9:
+        cs = ax.contourf(xi, y, rem, levels=16, cmap="viridis")
+        ax.contour(xi, y, rem, levels=cs.levels[1:-1], colors="k", linewidths=0.3, alpha=0.5)
+        fig.colorbar(cs, ax=ax, label="material removed (µm)")
+    else:
+        ax.text(0.5, 0.5, "unmodified flank", ha="center", va="center",
+                transform=ax.transAxes)
+        ax.set_xlim(xi[0], xi[-1])
+        ax.set_ylim(y[0], y[-1])
+    ax.set_xlabel("roll length ξ (mm): SAP → tip")
+    ax.set_ylabel("face position y (mm): end I → end II")
+    ax.set_title(f"modification map, {flank_label}")
 
 
 def save_loaded_plot(path, flank_map, te_map, title=None, dpi: int = DPI) -> None:

@@ -11,18 +11,23 @@ import numpy as np
 from gearjax.plot.style import MIN_WIDTH_IN, report_style, te_axis_limits
 from gearjax.tca.path import ARCSEC
 
-__all__ = ["study_figure", "sweep_figure"]
+__all__ = ["study_figure", "line_study_figure", "sweep_figure"]
 
 
-def _history(ax, hist, title):
+def _history(ax, hist, title, start=None):
+    """Objective and largest violation per iteration; ``start = (J0, violation0)``
+    drawn as iteration 0 (None: not drawn)."""
     v = np.asarray(hist.get("objective", []), float)
-    ax.plot(np.arange(1, v.size + 1), v, "o-", color="C0", label="objective J")
-    ax.set_xlabel("iteration")
-    ax.set_ylabel("objective J (scaled)", color="C0")
     f = np.asarray(hist.get("feasibility", []), float)
+    k0 = 1
+    if start is not None:
+        v, f, k0 = np.r_[start[0], v], np.r_[start[1], f], 0
+    ax.plot(np.arange(k0, k0 + v.size), v, "o-", color="C0", label="objective J")
+    ax.set_xlabel("iteration (0: the start)" if start is not None else "iteration")
+    ax.set_ylabel("objective J (scaled)", color="C0")
     if f.size and np.any(f > 0):
         ax2 = ax.twinx()
-        ax2.semilogy(np.arange(1, f.size + 1), np.maximum(f, 1e-16), "s--", color="C3",
+        ax2.semilogy(np.arange(k0, k0 + f.size), np.maximum(f, 1e-16), "s--", color="C3",
                      label="largest violation")
         ax2.set_ylabel("largest constraint violation (scaled)", color="C3")
     ax.set_title(title)
@@ -85,7 +90,10 @@ def _variables(ax, variables):
     y = np.arange(len(names))
     ax.barh(y, rel1 - rel0, left=rel0, color="C0", height=0.5, label="start -> end")
     ax.plot(rel0, y, "k|", ms=12, label="start")
-    ax.set_yticks(y, [n.split(".")[-1] for n in names])
+    short = [n.split(".")[-1] for n in names]
+    if len(set(short)) < len(short):          # e.g. the same key of pinion and gear
+        short = [".".join(n.split(".")[-2:]) for n in names]
+    ax.set_yticks(y, short)
     ax.set_xlim(0.0, 1.0)
     ax.set_xlabel("position in the bounds (0 = lower, 1 = upper)")
     ax.set_title("variables")
@@ -116,6 +124,67 @@ def study_figure(report: dict, start: tuple, end: tuple, mask=None):
         else:
             m = np.ones(np.shape(res0.path.phi1), bool) if mask is None else np.asarray(mask)
             _srr(ax[1, 0], res0, res1, m)
+        _variables(ax[1, 1], report["variables"])
+        fig.tight_layout()
+    return fig
+
+
+def _te_vs_torque(ax, report, sweep=None):
+    """Loaded TE p-t-p (hard, µm) against the torque, one colour per mesh misalignment,
+    start dashed and end solid: at the study's scenarios (markers) and, with ``sweep =
+    (T (n,), A (m,), ptp_start (n, m), ptp_end (n, m))``, over a torque sweep (lines)."""
+    q = report["quantities"]["line_te_ptp_hard_um"]
+    sc = report["scenarios"]
+    T = np.array([s["torque_Nm"] for s in sc], float)
+    A = np.array([s["f_ma_um"] for s in sc], float)
+    levels = sorted(set(A.tolist()))
+    for j, a in enumerate(levels):
+        sel = A == a
+        order = np.argsort(T[sel])
+        for key, ls, lab in (("start", "--", "start"), ("end", "-", "optimised")):
+            v = np.asarray(q[key], float)[sel][order]
+            ax.plot(T[sel][order], v, "o" if sweep is not None else ls + "o", ms=4,
+                    color=f"C{j}", mfc="none" if key == "start" else None,
+                    label=None if sweep is not None else f"{lab}, f_ma = {a:g} µm")
+    if sweep is not None:
+        Ts, As, p0, p1 = (np.asarray(v, float) for v in sweep)
+        for j, a in enumerate(As):
+            c = f"C{levels.index(a)}" if a in levels else f"C{j}"
+            ax.plot(Ts, p0[:, j], "--", color=c, lw=1.0, label=f"start, f_ma = {a:g} µm")
+            ax.plot(Ts, p1[:, j], "-", color=c, lw=1.5, label=f"optimised, f_ma = {a:g} µm")
+    ax.set_xlabel("pinion torque (N m)")
+    ax.set_ylabel("loaded TE peak-to-peak (µm)")
+    ax.set_ylim(bottom=0.0)
+    ax.set_title("loaded TE against torque" + (" (markers: the study's scenarios)"
+                                               if sweep is not None else ""))
+    ax.grid(True, lw=0.3, alpha=0.6)
+    ax.legend(loc="best", fontsize=7)
+
+
+def line_study_figure(report: dict, flank_map=None, flank_label: str = "pinion flank",
+                      sweep=None):
+    """The figure of a line-contact study (:mod:`gearjax.studies.line_route`): history,
+    loaded TE p-t-p against torque before and after (the scenarios' values; ``sweep``
+    as :func:`_te_vs_torque` adds a torque sweep of both designs), the end design's
+    modification map (``flank_map``, :func:`gearjax.plot.microgeometry.removal_map`'s
+    triple; None: left empty) and the variables."""
+    from gearjax.plot import headless
+    from gearjax.plot.microgeometry import map_panel
+    headless()
+    import matplotlib.pyplot as plt
+
+    with report_style():
+        fig, ax = plt.subplots(2, 2, figsize=(max(MIN_WIDTH_IN, 12.0), 9.0))
+        opt = report["optimizer"]
+        _history(ax[0, 0], report["history"],
+                 f"{report['study']}\n{opt['method']}, {opt['iterations']} iterations, "
+                 f"{opt['evaluations']} evaluations",
+                 (report["objective"]["start"], report["max_violation"]["start"]))
+        _te_vs_torque(ax[0, 1], report, sweep)
+        if flank_map is not None:
+            map_panel(fig, ax[1, 0], flank_map, f"{flank_label} (optimised)")
+        else:
+            ax[1, 0].set_visible(False)
         _variables(ax[1, 1], report["variables"])
         fig.tight_layout()
     return fig

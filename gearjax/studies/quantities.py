@@ -50,7 +50,7 @@ from gearjax.tca.path import ARCSEC
 
 __all__ = ["Quantity", "QUANTITIES", "smooth_max", "smooth_min", "te_ptp_continuous",
            "quantity_values",
-           "needs_loaded", "uses_mask", "start_mask"]
+           "needs_loaded", "uses_mask", "start_mask", "route_of", "LINE_QUANTITIES"]
 
 
 def smooth_max(q, mask, temperature):
@@ -75,7 +75,12 @@ class Quantity(NamedTuple):
     of its smooth extremum (None: no extremum taken here), a one-line ``description``
     and ``fn(res, eff, mask, pair) -> scalar`` (``eff`` None for unloaded studies;
     ``pair`` the differentiable pair); ``families``: the families that have it (empty:
-    every family)."""
+    every family); ``route``: the chain it is a quantity of, ``"tca"`` (the unloaded
+    TCA and the point-contact loaded chain) or ``"line"`` (the loaded line contact of
+    involute pairs with micro-geometry, :mod:`gearjax.studies.line_route`: ``res`` a
+    :class:`~gearjax.gears.involute.line_load.LineLoad`, ``eff`` a
+    :class:`~gearjax.gears.involute.line_efficiency.LineEfficiency` or None); a study
+    uses one route."""
 
     unit: str
     loaded: bool
@@ -84,6 +89,7 @@ class Quantity(NamedTuple):
     description: str
     fn: Callable
     families: tuple = ()
+    route: str = "tca"
 
 
 def _mid(res):
@@ -303,6 +309,96 @@ QUANTITIES["bearing_reach_mm"] = Quantity(
     "the bearing on the face (docs/vh_catt.md, section 6)",
     lambda res, eff, mask, pair: jnp.abs(res.path.axial1[_mid(res)])
     + res.path.semi_major[_mid(res)], ("vh_catt",))
+
+
+#: temperatures of the line route's smooth extrema: loaded TE p-t-p (um), peak pressure
+#: (MPa), face-load ratios (dimensionless)
+LINE_TE_TEMPERATURE_UM = 0.02
+LINE_P_TEMPERATURE_MPA = 3.0
+LINE_RATIO_TEMPERATURE = 0.005
+
+
+def _line_te_ptp(res, eff, mask, pair):
+    from gearjax.gears.involute.line_load import smooth_ptp
+    return smooth_ptp(res.te_loaded_um, LINE_TE_TEMPERATURE_UM)
+
+
+def _cycle_face_ratio(res):
+    """Load per unit face width of the cycle-mean distribution over its mean (N,): the
+    ratios whose maximum is K_Hbeta ([ISO6336-1])."""
+    cyc = jnp.mean(res.face_load, axis=0)
+    return cyc / jnp.mean(cyc)
+
+
+def _line_end_load(res, eff, mask, pair):
+    r = _cycle_face_ratio(res)
+    return smooth_max(jnp.stack([r[0], r[-1]]), jnp.ones(2, bool), LINE_RATIO_TEMPERATURE)
+
+
+def _line_k_hbeta(res, eff, mask, pair):
+    r = _cycle_face_ratio(res)
+    return smooth_max(r, jnp.ones(r.shape, bool), LINE_RATIO_TEMPERATURE)
+
+
+def _line_eff(eff):
+    if eff is None:          # set-up refuses this: the efficiency needs rpm, oil, sigma
+        raise ValueError("the line-route efficiency needs [operating] pinion_rpm, oil and "
+                         "sigma_um")
+    return eff
+
+
+#: the quantities of the loaded line contact (route "line"): one scenario is a torque, a
+#: mesh misalignment f_ma (and, for the efficiency, a speed)
+LINE_QUANTITIES = {
+    "line_te_ptp_um": Quantity(
+        "um", False, False, LINE_TE_TEMPERATURE_UM,
+        "line contact: smooth peak-to-peak of the loaded TE over the mesh cycle "
+        "(T logsumexp(te/T) + T logsumexp(-te/T), above the hard p-t-p by <= 2 T ln M)",
+        _line_te_ptp, route="line"),
+    "line_te_ptp_hard_um": Quantity(
+        "um", False, False, None,
+        "line contact: peak-to-peak of the loaded TE over the mesh cycle (max - min; "
+        "a kink where the extreme position changes: report or constrain, do not minimise)",
+        lambda res, eff, mask, pair: jnp.max(res.te_loaded_um) - jnp.min(res.te_loaded_um),
+        route="line"),
+    "line_te_mean_um": Quantity(
+        "um", False, False, None, "line contact: mean loaded TE over the mesh cycle (the "
+        "mean approach along the line of action)",
+        lambda res, eff, mask, pair: jnp.mean(res.te_loaded_um), route="line"),
+    "line_p_max_MPa": Quantity(
+        "MPa", False, False, LINE_P_TEMPERATURE_MPA,
+        "line contact: highest Hertz pressure over the loaded slice points and positions "
+        "(smooth max)",
+        lambda res, eff, mask, pair: smooth_max(res.p_max, res.load > 0.0,
+                                                LINE_P_TEMPERATURE_MPA), route="line"),
+    "line_k_hbeta": Quantity(
+        "", False, False, LINE_RATIO_TEMPERATURE,
+        "line contact: face load factor K_Hbeta of the cycle-mean face-load distribution "
+        "(largest load per unit face width over the mean; smooth max)",
+        _line_k_hbeta, route="line"),
+    "line_end_load": Quantity(
+        "", False, False, LINE_RATIO_TEMPERATURE,
+        "line contact: load per unit face width in the end slices over the mean, of the "
+        "cycle-mean distribution (the larger end, smooth max; > 1 edge loading)",
+        _line_end_load, route="line"),
+    "line_power_loss_W": Quantity(
+        "W", True, False, None,
+        "line contact: mean sliding power loss over the mesh cycle (needs pinion_rpm, oil, "
+        "sigma_um)",
+        lambda res, eff, mask, pair: jnp.mean(_line_eff(eff).power_loss), route="line"),
+    "line_mesh_efficiency": Quantity(
+        "", True, False, None,
+        "line contact: mesh efficiency over the mesh cycle (fraction; needs pinion_rpm, "
+        "oil, sigma_um)",
+        lambda res, eff, mask, pair: _line_eff(eff).mean_efficiency, route="line"),
+}
+QUANTITIES.update(LINE_QUANTITIES)
+
+
+def route_of(names) -> str:
+    """The route of the quantities ``names`` (``"tca"`` or ``"line"``; all of one route,
+    which :func:`gearjax.studies.study_file.read_study` has checked)."""
+    return "line" if any(QUANTITIES[n].route == "line" for n in names) else "tca"
 
 
 def needs_loaded(names) -> bool:

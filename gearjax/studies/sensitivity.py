@@ -34,7 +34,7 @@ def sensitivities(design_source: str, outputs, params, *, side: str = "drive",
     dE_mm, dP_mm, dG_mm, dSigma_deg.  Returns ``{"outputs", "params", "values" (n_out,),
     "fields" (n_par,), "jacobian" (n_out, n_par), "elasticity" (n_out, n_par; NaN where
     undefined)}`` (NumPy arrays)."""
-    from gearjax.studies.quantities import uses_mask
+    from gearjax.studies.quantities import QUANTITIES, uses_mask
     from gearjax.studies.study_run import grid_size, quantity_jacobian, set_up, start_point
 
     outputs, params = list(outputs), list(params)
@@ -53,6 +53,11 @@ def sensitivities(design_source: str, outputs, params, *, side: str = "drive",
                   operating=dict(operating or {}),
                   scenarios={k: (float(v),) for k, v in sc.items()}, tca=dict(tca or {}))
     check_quantities(outputs, "--outputs", study.operating)
+    if study.route == "line":
+        q = next(q for q in outputs if QUANTITIES[q].route == "line")
+        raise ValueError(f"--outputs: {q!r} is a quantity of the loaded line contact; "
+                         "gearjax sensitivity runs the TCA route (a line-contact study: "
+                         "gearjax optimize, docs/optimize.md)")
     prob = set_up(study)
     if uses_mask(outputs):      # the fixed on-flank mask needs a first evaluation
         start_point(prob)

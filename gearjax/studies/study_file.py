@@ -10,10 +10,15 @@ full text with examples)::
     [operating]    torque_Nm, pinion_rpm, oil (a known oil), sigma_um -- required when a
                    loaded quantity is used; compliance ("weber" | "iso6336")
     [scenarios]    optional; torque_Nm, pinion_rpm, dE_mm, dP_mm, dG_mm, dSigma_deg as a
-                   number or a list: every combination is a scenario (one vmapped run)
+                   number or a list: every combination is a scenario (one vmapped run);
+                   a line-contact study: torque_Nm, pinion_rpm, f_ma_um
     [tca]          optional TCA grid: steps_per_pitch, half_pitches, n_pairs
+    [line]         optional, a line-contact study: positions (per base pitch, default
+                   24), slices (face-width slices, default 12)
     [[variables]]  field (a field of the design's pair, ``gearjax optimize STUDY
-                   --fields`` lists them), lower/upper (absolute) or change = [lo, hi]
+                   --fields`` lists them; a line-contact study: a micro-geometry field
+                   ``microgeometry.TABLE.KEY`` as in the design file's tables,
+                   :mod:`gearjax.studies.line_route`), lower/upper (absolute) or change = [lo, hi]
                    (relative to the design's value); unit "" (the field's own: mm, rad,
                    -) or "deg" for a field in rad; scale (default (upper - lower)/2)
     [[objective]]  quantity, weight (> 0), sense ("minimize" | "maximize"),
@@ -25,6 +30,12 @@ full text with examples)::
                    tolerance (on the scaled KKT measures), starts (multi-start), seed
     [sweep]        optional, for ``gearjax sweep``: method ("random": Latin hypercube |
                    "grid"), samples (random), points (grid, per variable), seed, chunk
+
+**Routes.**  The quantities of a study are of one route (``Quantity.route``): the
+unloaded TCA and its point-contact loaded chain (``"tca"``), or the loaded line contact
+of an involute pair with micro-geometry (``"line"``: the ``line_*`` quantities,
+micro-geometry variables, the ``f_ma_um`` scenarios); a study that mixes them, or whose
+variables do not belong to its route, is refused naming the entry.
 
 Every entry is checked before any work; a bad one is a one-line ``ValueError`` naming
 it (``[[variables]] 2: field 'pair.x3' is not a field of ...``).  Fields are checked
@@ -45,11 +56,17 @@ from gearjax.io.toml import (check_integer, check_keys, check_number, check_stri
 from gearjax.studies.quantities import QUANTITIES, uses_mask
 
 __all__ = ["Variable", "Term", "Constraint", "Study", "read_study", "list_studies",
-           "study_path", "check_quantities", "SCENARIO_KEYS", "METHODS"]
+           "study_path", "check_quantities", "SCENARIO_KEYS", "LINE_SCENARIO_KEYS", "METHODS",
+           "LINE_DEFAULTS"]
 
 #: scenario key -> unit (misalignment keys in mm and degrees, as ``--misalign``)
 SCENARIO_KEYS = {"torque_Nm": "N m", "pinion_rpm": "rpm", "dE_mm": "mm", "dP_mm": "mm",
                  "dG_mm": "mm", "dSigma_deg": "deg"}
+#: scenario key -> unit of a line-contact study (``f_ma_um``: the mesh misalignment of
+#: ISO 6336-1 across the face width, as ``gearjax loaded --misalignment-um``)
+LINE_SCENARIO_KEYS = {"torque_Nm": "N m", "pinion_rpm": "rpm", "f_ma_um": "um"}
+#: the ``[line]`` table's keys and defaults (mesh positions per base pitch, face slices)
+LINE_DEFAULTS = {"positions": 24, "slices": 12}
 METHODS = ("augmented_lagrangian", "slsqp")
 SWEEP_METHODS = ("random", "grid")
 #: the ``[sweep]`` table's keys and defaults (``gearjax sweep``)
@@ -124,6 +141,15 @@ class Study:
     reported: tuple = ()
     #: the ``[sweep]`` table (``gearjax sweep``): method, points, samples, seed, chunk
     sweep: dict = field(default_factory=dict)
+    #: the ``[line]`` table of a line-contact study (positions, slices; defaults filled)
+    line: dict = field(default_factory=dict)
+
+    @property
+    def route(self) -> str:
+        """``"tca"`` or ``"line"`` (module docstring)."""
+        from gearjax.studies.quantities import route_of
+        return route_of([t.quantity for t in self.objective]
+                        + [c.quantity for c in self.constraints])
 
     @property
     def quantities(self) -> list:
@@ -286,15 +312,86 @@ def _operating(op) -> dict:
     return out
 
 
-def _scenarios(sc) -> dict:
-    check_keys("scenarios", sc, set(SCENARIO_KEYS))
+def _scenarios(sc, route: str) -> dict:
+    keys = LINE_SCENARIO_KEYS if route == "line" else SCENARIO_KEYS
+    other = set(SCENARIO_KEYS if route == "line" else LINE_SCENARIO_KEYS) - set(keys)
+    for k in sc:
+        if k in other:
+            raise ValueError(f"[scenarios] {k}: a scenario key of the "
+                             f"{'TCA' if route == 'line' else 'line-contact'} route; this "
+                             f"study's quantities are of the {route} route (keys: "
+                             f"{', '.join(keys)})")
+    check_keys("scenarios", sc, set(keys))
     out = {}
     for k, v in sc.items():
         vals = v if isinstance(v, list) else [v]
         if not vals:
             raise ValueError(f"[scenarios] {k} = [] is empty (give a number or a list)")
-        out[k] = tuple(check_number("scenarios", k, x, SCENARIO_KEYS[k]) for x in vals)
+        out[k] = tuple(check_number("scenarios", k, x, keys[k]) for x in vals)
     return out
+
+
+def _one_route(objective, constraints) -> str:
+    """The route of the study's quantities; one line naming the first entry whose route
+    differs from the objective's first term's (module docstring)."""
+    from gearjax.studies.quantities import QUANTITIES
+    entries = ([(f"[[objective]] {i + 1}", t.quantity) for i, t in enumerate(objective)]
+               + [(f"[[constraints]] {i + 1}", c.quantity) for i, c in enumerate(constraints)])
+    first = QUANTITIES[entries[0][1]].route
+    for where, q in entries[1:]:
+        if QUANTITIES[q].route != first:
+            names = {"tca": "TCA", "line": "loaded line-contact"}
+            raise ValueError(f"{where}: quantity {q!r} is of the {names[QUANTITIES[q].route]} "
+                             f"route, [[objective]] 1 ({entries[0][1]!r}) of the "
+                             f"{names[first]} route: a study uses one route")
+    return first
+
+
+def _check_variable_routes(variables, route: str, side: str) -> None:
+    """Micro-geometry fields in a line-contact study only, and only those there (their
+    form checked: :func:`gearjax.studies.line_route.micro_field`)."""
+    from gearjax.studies.line_route import MICRO_PREFIX, micro_field
+    for i, v in enumerate(variables):
+        w = f"[[variables]] {i + 1}"
+        micro = v.field.startswith(MICRO_PREFIX)
+        if micro and route != "line":
+            raise ValueError(f"{w}: the micro-geometry field {v.field!r} is analysed by the "
+                             "loaded line contact: use its quantities (line_*, gearjax "
+                             "optimize --quantities)")
+        if route == "line" and not micro:
+            raise ValueError(f"{w}: field {v.field!r}: a line-contact study varies "
+                             f"micro-geometry fields ({MICRO_PREFIX}TABLE.KEY)")
+        if micro:
+            try:
+                micro_field(v.field, side)
+            except ValueError as exc:
+                raise ValueError(f"{w}: {exc}") from None
+            if v.unit:
+                raise ValueError(f"{w} ({v.field}): unit = {v.unit!r}: a micro-geometry "
+                                 "field is in the unit of its key (um or mm)")
+
+
+def _line_table(data, route: str, op: dict, scenarios: dict) -> dict:
+    """The ``[line]`` table (defaults :data:`LINE_DEFAULTS`); a line-contact study needs a
+    torque and takes no ``[tca]`` table nor edge softening; a TCA study no ``[line]``."""
+    if route != "line":
+        if "line" in data:
+            raise ValueError("[line]: the line-contact model's options, but the study's "
+                             "quantities are of the TCA route")
+        return {}
+    if "tca" in data:
+        raise ValueError("[tca]: the TCA grid, but the study's quantities are of the "
+                         "line-contact route (its options: [line] positions, slices)")
+    if "edge_softening_mm" in op:
+        raise ValueError("[operating] edge_softening_mm: the soft active set of the TCA "
+                         "route's loaded chain; the line contact has none")
+    if "torque_Nm" not in op and "torque_Nm" not in scenarios:
+        raise ValueError("[operating] torque_Nm: a line-contact study needs the torque "
+                         "([operating] torque_Nm or [scenarios] torque_Nm)")
+    ln = data.get("line", {})
+    check_keys("line", ln, set(LINE_DEFAULTS))
+    return {k: check_integer("line", k, ln.get(k, d), 4 if k == "positions" else 1)
+            for k, d in LINE_DEFAULTS.items()}
 
 
 def _design_source(design: str, base) -> str:
@@ -314,7 +411,7 @@ def read_study(source) -> Study:
     except ValueError as exc:      # the reader speaks of design files
         raise ValueError(str(exc).replace("design file", "study file")) from None
     check_keys("", data, {"study", "operating", "scenarios", "tca", "variables", "objective",
-                          "constraints", "optimizer", "sweep"})
+                          "constraints", "optimizer", "sweep", "line"})
     st = require_key("", data, "study")
     check_keys("study", st, {"name", "description", "design", "side"})
     name = check_string("study", "name", require_key("study", st, "name"))
@@ -335,6 +432,8 @@ def read_study(source) -> Study:
     if not objective:
         raise ValueError("the study has no [[objective]] term (name at least one quantity)")
     constraints = [_constraint(i + 1, e) for i, e in enumerate(_entries(data, "constraints"))]
+    route = _one_route(objective, constraints)
+    _check_variable_routes(variables, route, side)
     names = [t.quantity for t in objective] + [c.quantity for c in constraints]
     if uses_mask(names) and not any(c.quantity == "min_margin_mm" and c.lower is not None
                                     for c in constraints):
@@ -342,6 +441,8 @@ def read_study(source) -> Study:
         constraints.append(Constraint("min_margin_mm", 0.0, None, 1.0, added=True))
     op = _operating(data.get("operating", {}))
     check_quantities(names, "[operating]", op)
+    scenarios = _scenarios(data.get("scenarios", {}), route)
+    line = _line_table(data, route, op, scenarios)
     opt = data.get("optimizer", {})
     check_keys("optimizer", opt, {"method", "max_iterations", "tolerance", "starts", "seed"})
     method = check_string("optimizer", "method", opt.get("method", METHODS[0]), METHODS)
@@ -358,7 +459,7 @@ def read_study(source) -> Study:
     return Study(name=name, design=design, side=side, variables=variables,
                  objective=objective, constraints=tuple(constraints),
                  description=check_string("study", "description", st.get("description", "")),
-                 operating=op, scenarios=_scenarios(data.get("scenarios", {})),
+                 operating=op, scenarios=scenarios, line=line,
                  tca={k: check_number("tca", k, v) for k, v in tca.items()}, method=method,
                  max_iterations=max_it, tolerance=tol, starts=starts,
                  seed=check_integer("optimizer", "seed", opt.get("seed", 0), 0),

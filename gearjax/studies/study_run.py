@@ -31,6 +31,12 @@ file round-trips, and at every scenario the TCA converged without edge contact a
 loaded study) no fewer positions of the cycle are valid than at the start; with edge
 softening, the hard model's objective may not rise by more than the softened one's
 (:func:`acceptance_reasons`).
+
+**The line-contact route** (a study of the ``line_*`` quantities,
+:mod:`gearjax.studies.line_route`): the variables are micro-geometry fields, each
+scenario one loaded line contact (torque, mesh misalignment f_ma), the same scaled
+problem, optimisers and acceptance, with the line contact's own flags (every mesh
+position converged) and design-file write-back (the ``[microgeometry]`` tables).
 """
 
 from __future__ import annotations
@@ -46,7 +52,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from gearjax.compile_ahead import FAST_COMPILE_OPTIONS
-from gearjax.fields import field_names, get_fields, with_fields
+from gearjax.fields import field_names, get_fields, with_fields, with_scaled_fields
 from gearjax.studies.quantities import QUANTITIES, quantity_values, smooth_max
 from gearjax.studies.study_file import Constraint, Study
 from gearjax.tca.assembly import Misalignment
@@ -92,6 +98,8 @@ class Problem:
     scenarios: list            # one dict per scenario (file units)
     loaded: bool
     soft: float = 0.0          # edge softening of the loaded chain (mm)
+    family: str = ""
+    route: str = "tca"         # "line": the loaded line contact (gearjax.studies.line_route)
     data: Data = None
     evaluate_program: object = None
     fun: object = None
@@ -101,8 +109,9 @@ class Problem:
 def _scenario_list(study: Study) -> list:
     op = study.operating
     base = {"torque_Nm": float(op.get("torque_Nm", 0.0)),
-            "pinion_rpm": float(op.get("pinion_rpm", 0.0)),
-            "dE_mm": 0.0, "dP_mm": 0.0, "dG_mm": 0.0, "dSigma_deg": 0.0}
+            "pinion_rpm": float(op.get("pinion_rpm", 0.0))}
+    base.update({"f_ma_um": 0.0} if study.route == "line" else
+                {"dE_mm": 0.0, "dP_mm": 0.0, "dG_mm": 0.0, "dSigma_deg": 0.0})
     keys = list(study.scenarios)
     out = []
     for combo in itertools.product(*(study.scenarios[k] for k in keys)):
@@ -130,6 +139,8 @@ def set_up(study: Study) -> Problem:
     from gearjax.tca.result import family_of
 
     design = gj.load_design(study.design)
+    if study.route == "line":
+        return _set_up_line(study, design)
     loaded = needs_loaded(study.quantities)
     tca = {k: (int(v) if k != "half_pitches" else float(v)) for k, v in study.tca.items()}
     if loaded:
@@ -156,24 +167,11 @@ def set_up(study: Study) -> Problem:
     if soft > 0.0 and "edge_load_share" not in study.quantities:
         # reported: how much of the mesh stiffness the softening takes (docs/optimize.md)
         study = dataclasses.replace(study, reported=study.reported + ("edge_load_share",))
-    known = field_names(pair0)
-    x0, lo, hi, sc = [], [], [], []
-    for i, v in enumerate(study.variables):
-        if v.field not in known:
-            raise ValueError(f"[[variables]] {i + 1}: field {v.field!r} is not a field of the "
-                             f"design's pair (fields: {', '.join(known)})")
-        val = float(np.asarray(get_fields(pair0, [v.field])[v.field]))
-        a, b = v.bounds(val)
-        if not a <= val <= b:
-            raise ValueError(f"[[variables]] {i + 1} ({v.field}): the design's value "
-                             f"{val / v.factor:.6g} is outside [{a / v.factor:.6g}, "
-                             f"{b / v.factor:.6g}]")
-        s = (b - a) / 2.0 if v.scale is None else v.scale * v.factor
-        x0.append(val), sc.append(s), lo.append((a - val) / s), hi.append((b - val) / s)
+    fields, x0, lo, hi, sc = _variables(study, pair0)
     scen = _scenario_list(study)
     _check_scenarios(scen, loaded)
-    prob = Problem(study, design, chain, [v.field for v in study.variables], np.array(x0),
-                   np.array(lo), np.array(hi), scen, loaded, soft=soft)
+    prob = Problem(study, design, chain, fields, x0, lo, hi, scen, loaded, soft=soft,
+                   family=family_of(design).family)
     oil = surface = None
     if loaded:
         oil = dataclasses.replace(gj.tribology.get_oil(str(study.operating["oil"])), name="")
@@ -181,7 +179,13 @@ def set_up(study: Study) -> Problem:
     col = {k: jnp.array([s[k] for s in scen]) for k in scen[0]}
     mis = Misalignment(col["dE_mm"], col["dP_mm"], col["dG_mm"],
                        col["dSigma_deg"] * (math.pi / 180.0))
-    prob.data = Data(pair0, jnp.asarray(x0), jnp.asarray(sc), col["torque_Nm"],
+    return _finish(prob, pair0, sc, col, mis, oil, surface)
+
+
+def _finish(prob, pair0, sc, col, mis, oil, surface) -> Problem:
+    """The traced inputs and the programs of a set-up problem (both routes)."""
+    study = prob.study
+    prob.data = Data(pair0, jnp.asarray(prob.x0), jnp.asarray(sc), col["torque_Nm"],
                      col["pinion_rpm"], mis, oil, surface, None,
                      jnp.ones(len(study.objective)), jnp.ones(len(study.constraints)))
     prob.evaluate_program = jax.jit(evaluator(prob, hard=True),
@@ -190,18 +194,61 @@ def set_up(study: Study) -> Problem:
     return prob
 
 
+def _variables(study: Study, pair0, canonical=None):
+    """``(fields, x0, lower, upper, scale)`` of the study's variables on the pytree
+    ``pair0``: the fields' names there (``canonical(name)``, default the name itself),
+    start values, scaled bounds and scales (one-line ValueError naming the entry)."""
+    known = field_names(pair0)
+    fields, x0, lo, hi, sc = [], [], [], [], []
+    for i, v in enumerate(study.variables):
+        name = v.field if canonical is None else canonical(v.field)
+        if name not in known:
+            raise ValueError(f"[[variables]] {i + 1}: field {v.field!r} is not a field of the "
+                             f"design's pair (fields: {', '.join(known)})")
+        if name in fields:
+            raise ValueError(f"[[variables]] {i + 1}: field {v.field!r} is the field of "
+                             f"[[variables]] {fields.index(name) + 1} again")
+        val = float(np.asarray(get_fields(pair0, [name])[name]))
+        a, b = v.bounds(val)
+        if not a <= val <= b:
+            raise ValueError(f"[[variables]] {i + 1} ({v.field}): the design's value "
+                             f"{val / v.factor:.6g} is outside [{a / v.factor:.6g}, "
+                             f"{b / v.factor:.6g}]")
+        s = (b - a) / 2.0 if v.scale is None else v.scale * v.factor
+        fields.append(name), x0.append(val), sc.append(s)
+        lo.append((a - val) / s), hi.append((b - val) / s)
+    return fields, np.array(x0), np.array(lo), np.array(hi), sc
+
+
+def _set_up_line(study: Study, design) -> Problem:
+    """:func:`set_up` of a line-contact study (:mod:`gearjax.studies.line_route`)."""
+    from gearjax.studies.line_route import REPORTED, check_line_scenarios, line_chain
+    study = dataclasses.replace(study, reported=study.reported + tuple(
+        q for q in REPORTED if q not in study.quantities))
+    chain = line_chain(design, study)
+    fields, x0, lo, hi, sc = _variables(study, chain.pair, chain.canonical)
+    scen = _scenario_list(study)
+    oil, surface = check_line_scenarios(chain, study, scen)
+    prob = Problem(study, design, chain, fields, x0, lo, hi, scen, False, family="involute",
+                   route="line")
+    col = {k: jnp.array([s[k] for s in scen]) for k in scen[0]}
+    return _finish(prob, chain.pair, sc, col, col["f_ma_um"], oil, surface)
+
+
 def evaluator(prob: Problem, hard: bool = False, own_mask: bool = False):
     """``(u, data) -> (Q (S, nq), res, eff, Q_hard)``: the quantities at every scenario;
     with ``hard`` (a loaded study) ``Q_hard`` are the loaded quantities again with the
     hard model (no edge softening: that of ``gearjax efficiency``) on the same TCA, else
     ``Q``.  ``own_mask``: the path quantities over the evaluated design's own on-flank
     points instead of ``data.mask`` (a sweep, where no optimiser moves the points)."""
+    if prob.route == "line":
+        from gearjax.studies.line_route import line_evaluator
+        return line_evaluator(prob)
     chain, names, loaded = prob.chain, list(prob.fields), prob.loaded
     qnames = prob.study.quantities
 
     def ev(u, data):
-        x = data.x0 + data.scale * u
-        pair = with_fields(data.pair0, {n: x[i] for i, n in enumerate(names)})
+        pair = with_scaled_fields(data.pair0, names, data.x0, data.scale, u)
 
         def one(T, n, mis, mask):
             if loaded:
@@ -319,9 +366,10 @@ def start_point(prob: Problem):
     """The start: the fixed masks of the path quantities (the start design's on-flank
     points at each scenario) from a first evaluation, then the quantities there and
     the default scales.  Both calls run one compiled program (same shapes)."""
-    S, N = len(prob.scenarios), grid_size(prob)
     u0 = np.zeros(len(prob.fields))
-    prob.data = prob.data._replace(mask=jnp.ones((S, N), bool))
+    if prob.route == "tca":      # the line route has no path mask
+        prob.data = prob.data._replace(mask=jnp.ones((len(prob.scenarios), grid_size(prob)),
+                                                     bool))
     out = evaluate(prob, u0)
     if any(QUANTITIES[q].path for q in prob.study.quantities):
         prob.data = prob.data._replace(mask=jnp.asarray(np.asarray(out[1].on_flank)))
@@ -336,6 +384,9 @@ def scenario_of(tree, k):
 
 def scenario_flags(prob: Problem, res, eff) -> list:
     """Per scenario: the TCA's quality flags and (loaded) the number of valid positions."""
+    if prob.route == "line":
+        from gearjax.studies.line_route import line_flags
+        return [line_flags(res, eff, k) for k in range(len(prob.scenarios))]
     out = []
     for k in range(len(prob.scenarios)):
         fl = scenario_of(res, k).flags()
@@ -510,7 +561,7 @@ def acceptance_reasons(opt: dict, feasibility: float, tol: float, file_error, di
         where = f"scenario {k + 1}"
         if not b["converged"]:
             reasons.append(f"{where}: the end design's TCA did not converge")
-        if b["edge_contact"] and not a["edge_contact"]:
+        if b.get("edge_contact") and not a.get("edge_contact"):
             reasons.append(f"{where}: the end design has edge contact")
         if "n_valid" in b and b["n_valid"] < a["n_valid"]:
             reasons.append(f"{where}: fewer valid positions of the cycle at the end "
@@ -523,6 +574,9 @@ def _round_trip(prob: Problem, end_pair):
     validating loader; ``(data, error or None, max |field difference|)``."""
     from gearjax.io import design_from_dict
     from gearjax.tca.result import family_of
+    if prob.route == "line":
+        from gearjax.studies.line_route import line_round_trip
+        return line_round_trip(prob, end_pair)
     ad = family_of(prob.design)
     try:
         data = ad.design_data(prob.design, end_pair, prob.study.side)
@@ -592,7 +646,8 @@ def run_study(prob: Problem, callback=None, phase=None) -> StudyResult:
                   "start": prob.x0[i] / v.factor, "end": x[i] / v.factor}
                  for i, v in enumerate(st.variables)]
     report = {"study": st.name, "description": st.description, "design": st.design,
-              "family": res0.family, "side": st.side, "variables": variables,
+              "family": prob.family, "route": prob.route, "side": st.side,
+              "variables": variables,
               "scenarios": prob.scenarios,
               "edge_softening_mm": prob.soft,
               "quantities": _quantities_report(prob, Q0, Q1, H0, H1),

@@ -69,6 +69,11 @@ def set_up_sweep(study) -> Problem:
     the hard model (``edge_softening_mm = 0``, that of ``gearjax efficiency``) -- the
     soft active set exists for an optimiser's gradients, which a sweep does not take."""
     from gearjax.studies.study_run import set_up
+    if study.route == "line":
+        raise ValueError(f"[[objective]] 1 ({study.objective[0].quantity}): gearjax sweep "
+                         "runs TCA-route studies; a line-contact study is optimised by "
+                         "gearjax optimize (gearjax loaded maps one design over torques "
+                         "and misalignments)")
     return set_up(dataclasses.replace(study, operating={**study.operating,
                                                         "edge_softening_mm": 0.0}))
 

@@ -69,7 +69,7 @@ from gearjax.io import (DesignFileMixin, check_integer, check_keys, check_number
 from gearjax.tca.result import register_family
 
 __all__ = ["InvoluteFile", "read_involute", "KIND", "PAIR_KEYS", "MODIFICATION_KEYS",
-           "MICRO_KEYS", "MICRO_SHAPES", "MICRO_TABLES"]
+           "MICRO_KEYS", "MICRO_SHAPES", "MICRO_TABLES", "microgeometry_tables"]
 
 KIND = "involute"
 #: [pair] key -> (unit, default or None when required)
@@ -256,6 +256,40 @@ def read_microgeometry(micro) -> MicroGeometry:
                                  flanks.get(("gear", side), none))
           for side in ("drive", "coast")}
     return MicroGeometry(pm["drive"], pm["coast"])
+
+
+def _flank_data(mod: FlankModification) -> dict:
+    """The ``[microgeometry.*]`` keys of one flank (the inverse of :func:`_flank_table`):
+    the values that differ from the unmodified flank, a relief's length and shape with
+    its amount; an exponent other than those of :data:`MICRO_SHAPES` is refused."""
+    none = FlankModification.none()
+    out = {k: float(getattr(mod, f)) for k, f in MICRO_KEYS.items()
+           if float(getattr(mod, f)) != float(getattr(none, f))}
+    shapes = {v: k for k, v in MICRO_SHAPES.items()}
+    for amount, (length, shape) in MICRO_RELIEFS.items():
+        e = float(getattr(mod, MICRO_SHAPE_KEYS[shape]))
+        if e not in shapes:
+            raise ValueError(f"{MICRO_SHAPE_KEYS[shape]} = {e:g}: a design file writes the "
+                             f"relief shapes {', '.join(MICRO_SHAPES)} (exponents 1, 2)")
+        if amount in out:
+            out[length] = float(getattr(mod, MICRO_KEYS[length]))
+        if amount in out or e != MICRO_SHAPES["linear"]:
+            out[shape] = shapes[e]
+    return out
+
+
+def microgeometry_tables(micro: MicroGeometry) -> dict:
+    """The ``[microgeometry]`` table of ``micro`` (read back by :func:`read_microgeometry`
+    to the same fields): a member table where its drive and coast flanks are equal, else
+    its flank tables; unmodified flanks are left out."""
+    out = {}
+    for member in ("pinion", "gear"):
+        d, c = (_flank_data(getattr(micro.flanks(side), member)) for side in ("drive", "coast"))
+        if d == c:
+            out.update({member: d} if d else {})
+        else:
+            out.update({f"{member}_{side}": t for side, t in (("drive", d), ("coast", c)) if t})
+    return out
 
 
 register_design_kind(KIND, read_involute)

@@ -35,6 +35,7 @@ from gearjax.loading.loaded_contact import COMPLIANCE_MODELS
 from gearjax.loading.materials import pair_material
 
 __all__ = ["line_contact", "loaded_te_map", "LoadedTEMap", "line_design", "resolution_warnings",
+           "line_options",
            "TORQUE_RANGE_NM", "MISALIGNMENT_RANGE_UM"]
 
 #: accepted pinion torques (N m)
@@ -95,7 +96,11 @@ def resolution_warnings(design, slices) -> list:
             f"lines is coarsely resolved; use at least {need} slices"]
 
 
-def _options(pair, b, positions, slices, compliance):
+def line_options(pair, b, positions, slices, compliance) -> LineLoadOptions:
+    """The static :class:`~gearjax.gears.involute.line_load.LineLoadOptions` of ``pair``
+    (concrete; face width ``b`` mm): the checked resolution and compliance model, the
+    tooth pairs of :func:`~gearjax.gears.involute.line_load.pair_range` and the bound of
+    the points on the path."""
     check_int("positions", positions, lo=4, hi=1024)
     check_int("slices", slices, lo=1, hi=400)
     if compliance not in COMPLIANCE_MODELS:
@@ -131,7 +136,7 @@ def line_contact(design, torque_Nm, *, mods=None, misalignment_um=0.0, side="dri
     T = check_range("torque_Nm", torque_Nm, *TORQUE_RANGE_NM, unit="N m")
     f = check_range("misalignment_um", misalignment_um, *MISALIGNMENT_RANGE_UM, unit="um")
     pair, b, mods, mat = line_design(design, mods, side)
-    opts = _options(pair, b, positions, slices, compliance)
+    opts = line_options(pair, b, positions, slices, compliance)
     return _one(*_split(pair), b, mods, 1e3 * T, f, mat.youngs_modulus_MPa, mat.poisson,
                 opts, side == "drive")
 
@@ -230,8 +235,8 @@ def loaded_te_map(design, torques_Nm, misalignments_um=(0.0,), *, mods=None, sid
                                 film_method)
         rpm = float(pinion_rpm)
         oil = dataclasses.replace(oil, name="")     # the label is not part of the program
-    opts = _options(pair, b, positions, slices, compliance)
+    opts = line_options(pair, b, positions, slices, compliance)
     out = call(_map, *_split(pair), b, mods, jnp.asarray(1e3 * T), jnp.asarray(A),
-               mat.youngs_modulus_MPa, mat.poisson, float(temperature_um), rpm, oil, surface, opts=opts,
-               drive=side == "drive", vm=viscosity_model, fm=film_method)
+               mat.youngs_modulus_MPa, mat.poisson, float(temperature_um), rpm, oil, surface,
+               opts=opts, drive=side == "drive", vm=viscosity_model, fm=film_method)
     return LoadedTEMap(jnp.asarray(T), jnp.asarray(A), *out)
