@@ -796,10 +796,19 @@ def build_cases() -> list[Case]:
         "--height-margin nan")
     add("surface.reference_grid.margin_without", srf(extra=["--face-margin", "0.1"]), "refuse",
         "--face-margin without --reference-grid")
-    add("surface.reference_grid.vh_catt", ["surface", "example:vh_catt_17x23", "--member",
-                                           "gear", "--reference-grid", "--out",
-                                           "{tmp}/grid.csv"], "refuse",
+    add("surface.ok.reference_grid_vh_catt", ["surface", "example:vh_catt_17x23", "--member",
+                                              "gear", "--reference-grid", "--out",
+                                              "{tmp}/grid.csv"], "ok",
+        "the VH-CATT gear's measuring grid (issue #33 item 5)")
+    add("surface.reference_grid.involute", ["surface", "example:khk_spur_12x24", "--member",
+                                            "gear", "--reference-grid", "--out",
+                                            "{tmp}/grid.csv"], "refuse",
         "a family without a measuring grid")
+    add("correct.vh_catt.spiral_bevel_measurement", cor(design="example:vh_catt_17x23"),
+        "refuse", "the spiral-bevel sample measured against a VH-CATT design", setup=sample)
+    add("correct.vh_catt.hypoid_setting", cor(design="example:vh_catt_17x23", extra=[
+        "--settings", "ratio_of_roll"]), "refuse", "a hypoid setting for a VH-CATT member",
+        setup=sample)
     add("surface.missing_flank", srf(flank=None), "refuse", "--flank missing")
 
     # ---------------------------------------------------------------- friction

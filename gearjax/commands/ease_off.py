@@ -164,8 +164,8 @@ def tca_summary(design, side) -> dict:
     import time
 
     import gearjax
+    from gearjax import ARCSEC
     from gearjax.errors import ConvergenceError
-    from gearjax.tca.path import ARCSEC
     t0 = time.perf_counter()
     try:
         r = gearjax.run_tca(design, side=side, kinematics=False)
@@ -209,12 +209,12 @@ def run(args) -> int:
         target = read_target(args.target, grid)
         spec = {"file": str(args.target)}
     design = load_design(args.design)
-    from gearjax.gears.hypoid.design_file import HypoidDesign
+    from gearjax.hypoid import HypoidDesign
     if not isinstance(design, HypoidDesign):
         raise ValueError(f"{args.design!r}: the target ease-off is defined for hypoid and "
                          f"spiral-bevel designs only, not for [design] kind = "
                          f"{design.data['design']['kind']!r}")
-    from gearjax.gears.hypoid import ease_off as eo
+    from gearjax.hypoid import ease_off as eo
     if args.target is None:
         target = eo.target_ease_off(*grid, terms["crowning_um"], terms["profile_um"],
                                     terms["bias_um"])
