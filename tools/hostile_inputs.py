@@ -757,7 +757,7 @@ def build_cases() -> list[Case]:
                     ("--crowning-um", "abc"), ("--grid", "2x5"), ("--grid", "9x5x3"),
                     ("--grid", "100x5"), ("--regularisation", "-1"), ("--max-iter", "0"),
                     ("--settings", "frobnicate"), ("--settings", ","), ("--side", "both")):
-        add(f"ease-off{flag[1:]}={_slug(v)}", eo(extra=[flag, v]), "refuse", f"{flag} {v}")
+        add(f"ease-off.{flag[2:]}={_slug(v)}", eo(extra=[flag, v]), "refuse", f"{flag} {v}")
     for key, content in (("empty", b""), ("binary", b"\x89PNG\r\n\x1a\n\x00\xff"),
                          ("short_rows", b"1,2,3\n" * 9),
                          ("text", b"a,b,c,d,e\n" * 9),
