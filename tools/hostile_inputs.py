@@ -747,8 +747,11 @@ def build_cases() -> list[Case]:
                                               "--plot", "{tmp}/e.png"]),
         "flag", "a reachable target: written, TCA before/after; the conjugate's rotation ~ "
         "point radius and the written pair's tip contact are warned", also={"ok"})
-    add("ease-off.ok.json_no_tca", eo(extra=["--crowning-um", "30", "--json", "--no-tca"]),
-        "flag", "strict JSON (lines left out are null), no TCA", also={"ok"})
+    add("ease-off.ok.json_no_tca", eo(extra=["--crowning-um", "30", "--bias-um", "10",
+                                            "--json", "--no-tca", "--settings",
+                                            "blade_angle,ratio_of_roll,modified_roll_2c,"
+                                            "modified_roll_6d,axis_rotation"]),
+        "ok", "strict JSON (lines left out are null), no TCA, settings told apart")
     add("ease-off.profile_out_of_reach", eo(extra=["--crowning-um", "30", "--profile-um", "15",
                                                   "--bias-um", "10"]),
         "flag", "profile crowning out of the straight blade's reach: the written pair's "
