@@ -53,7 +53,7 @@ import numpy as np
 from gearjax import optimize
 from gearjax.errors import ConvergenceError, check_int, check_range
 
-__all__ = ["ROTATION", "INDISTINCT", "DEFAULT_REGULARISATION", "UM", "CorrectionProblem",
+__all__ = ["checked_settings", "measured_reference_grids", "ROTATION", "INDISTINCT", "DEFAULT_REGULARISATION", "UM", "CorrectionProblem",
            "CorrectionResult", "unknown_columns", "model_deviations", "correct_flanks",
            "flank_increments", "register_correction", "correction_family"]
 
@@ -183,6 +183,33 @@ class CorrectionProblem:
                 jnp.asarray(self.rot_unit * scale), st("points"), st("normals"), st("params"),
                 jnp.asarray(np.nan_to_num(np.asarray(deviation_um, float)) * UM),
                 jnp.asarray(self.mask.astype(float)), jnp.asarray(float(reg)))
+
+
+def checked_settings(names, allowed, what: str) -> list:
+    """``names`` (the ``--settings`` list) checked against ``allowed``: one-line
+    ``ValueError`` naming an unknown setting (of ``what``, e.g. "the generated pinion"),
+    a repeated one, or an empty list."""
+    names = [s.strip() for s in names]
+    for n in names:
+        if n not in allowed:
+            raise ValueError(f"--settings: {n!r} is not a correctable setting of {what}; "
+                             f"allowed: {', '.join(allowed)}")
+    if len(set(names)) != len(names) or not names:
+        raise ValueError(f"--settings = {','.join(names)!r}: give each setting once, at least one")
+    return names
+
+
+def measured_reference_grids(design, measured, flanks) -> dict:
+    """flank -> the design's reference grid of the measured member at the measurement's
+    grid and margins, after :func:`gearjax.io.check_on_reference` found the measured
+    points and normals on it (one-line ``ValueError`` otherwise)."""
+    from gearjax.io import check_on_reference
+    grids = {f: design.reference_grid(measured.member, f, measured.n_xi, measured.n_s,
+                                      measured.face_margin, measured.height_margin)
+             for f in flanks}
+    check_on_reference(measured, np.stack([np.asarray(grids[f].points) for f in flanks]),
+                       np.stack([np.asarray(grids[f].normals) for f in flanks]))
+    return grids
 
 
 def unknown_columns(flanks, fields, names, shared) -> tuple:

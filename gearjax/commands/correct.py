@@ -159,16 +159,21 @@ def run(args) -> int:
     else:
         sys.stdout.write(table(rep) + "\n")
         sys.stdout.write(f"files: {', '.join(files) if files else 'none'}\n")
-    for c in rep["indistinguishable"]:
-        sys.stderr.write(f"gearjax: warning: settings that cannot be told apart (relative "
-                         f"singular value {c['relative_singular_value']:.2g}): "
-                         f"{c['combination']}; the regularised fit keeps their "
-                         f"combination small\n")
+    warn_indistinguishable(rep)
     if not res.converged:
         sys.stderr.write(f"gearjax: error: the correction did not converge ({res.message}) "
                          f"after {res.iterations} steps; no corrected design written\n")
         return 3
     return 0
+
+
+def warn_indistinguishable(rep: dict) -> None:
+    """One stderr warning line per combination of settings the fit cannot tell apart."""
+    for c in rep["indistinguishable"]:
+        sys.stderr.write(f"gearjax: warning: settings that cannot be told apart (relative "
+                         f"singular value {c['relative_singular_value']:.2g}): "
+                         f"{c['combination']}; the regularised fit keeps their "
+                         f"combination small\n")
 
 
 def report(res, measured_path) -> dict:

@@ -187,7 +187,7 @@ def run(args) -> int:
     import time
 
     from gearjax import load_design
-    from gearjax.commands.correct import settings_list
+    from gearjax.commands.correct import settings_list, warn_indistinguishable
     from gearjax.errors import check_int, check_range
     from gearjax.io import check_output_path
     from gearjax.progress import Progress
@@ -299,11 +299,7 @@ def run(args) -> int:
     else:
         sys.stdout.write(table(rep) + "\n")
         sys.stdout.write(f"files: {', '.join(files) if files else 'none'}\n")
-    for c in rep["indistinguishable"]:
-        sys.stderr.write(f"gearjax: warning: settings that cannot be told apart (relative "
-                         f"singular value {c['relative_singular_value']:.2g}): "
-                         f"{c['combination']}; the regularised fit keeps their "
-                         f"combination small\n")
+    warn_indistinguishable(rep)
     for which, t in tca.items():
         for w in (t or {}).get("warnings", []):
             sys.stderr.write(f"gearjax: warning: TCA of the "

@@ -70,14 +70,13 @@ import numpy as np
 
 from gearjax import frames
 from gearjax.correction import (DEFAULT_REGULARISATION, INDISTINCT, ROTATION,
-                                CorrectionProblem, CorrectionResult, correct_flanks,
-                                flank_increments, model_deviations, register_correction,
-                                unknown_columns)
+                                CorrectionProblem, CorrectionResult, checked_settings,
+                                correct_flanks, flank_increments, measured_reference_grids,
+                                model_deviations, register_correction, unknown_columns)
 from gearjax.gears.hypoid.design_file import (HypoidDesign, design_from_dict,
                                              flank_settings_table)
 from gearjax.gears.hypoid.flank import machine_chain, point_and_first_equation
 from gearjax.gears.hypoid.pair import program_pair
-from gearjax.io import check_on_reference
 from gearjax.newton import newton_solve
 
 __all__ = ["SETTINGS", "ROTATION", "DEFAULT_GENERATED", "DEFAULT_FORMATE", "INDISTINCT",
@@ -186,20 +185,11 @@ def correction_problem(design, measured, settings=None) -> CorrectionProblem:
                          f"and correct them one at a time")
     generated = gen.pop()
     allowed = _choices(generated)
-    names = list(DEFAULT_GENERATED if generated else DEFAULT_FORMATE) if settings is None \
-        else [s.strip() for s in settings]
-    for n in names:
-        if n not in allowed:
-            kind = "generated" if generated else "formate (no roll)"
-            raise ValueError(f"--settings: {n!r} is not a correctable setting of the "
-                             f"{kind} {member}; allowed: {', '.join(allowed)}")
-    if len(set(names)) != len(names) or not names:
-        raise ValueError(f"--settings = {','.join(names)!r}: give each setting once, at least one")
-    grids = {f: design.reference_grid(member, f, measured.n_xi, measured.n_s,
-                                      measured.face_margin, measured.height_margin)
-             for f in flanks}
-    check_on_reference(measured, np.stack([np.asarray(grids[f].points) for f in flanks]),
-                       np.stack([np.asarray(grids[f].normals) for f in flanks]))
+    kind = "generated" if generated else "formate (no roll)"
+    names = checked_settings(
+        (DEFAULT_GENERATED if generated else DEFAULT_FORMATE) if settings is None else settings,
+        allowed, f"the {kind} {member}")
+    grids = measured_reference_grids(design, measured, flanks)
     return problem_on_lines(design, measured, grids, names, specs, generated)
 
 

@@ -57,14 +57,13 @@ from typing import NamedTuple
 
 import jax
 import jax.numpy as jnp
-import numpy as np
 
 from gearjax import frames
-from gearjax.correction import (ROTATION, CorrectionProblem, flank_increments,
-                                register_correction, unknown_columns)
+from gearjax.correction import (ROTATION, CorrectionProblem, checked_settings, flank_increments,
+                                measured_reference_grids, register_correction,
+                                unknown_columns)
 from gearjax.gears.vh_catt.design_file import VHCattDesign, design_from_dict, flank_sigma
 from gearjax.gears.vh_catt.geometry import HANDS, MEMBERS, tool_data, tool_family
-from gearjax.io import check_on_reference
 from gearjax.newton import newton_solve
 from gearjax.surfaces import meshing_function
 
@@ -155,19 +154,9 @@ def correction_problem(design, measured, settings=None) -> CorrectionProblem:
     ``ValueError`` (one line) for an unknown or duplicated setting or a grid that is not
     the design's reference grid (:func:`gearjax.io.check_on_reference`)."""
     member, flanks = measured.member, tuple(measured.flanks)
-    allowed = FIELDS + (ROTATION,)
-    names = list(DEFAULT_SETTINGS) if settings is None else [s.strip() for s in settings]
-    for n in names:
-        if n not in allowed:
-            raise ValueError(f"--settings: {n!r} is not a correctable setting of the VH-CATT "
-                             f"{member}; allowed: {', '.join(allowed)}")
-    if len(set(names)) != len(names) or not names:
-        raise ValueError(f"--settings = {','.join(names)!r}: give each setting once, at least one")
-    grids = {f: design.reference_grid(member, f, measured.n_xi, measured.n_s,
-                                      measured.face_margin, measured.height_margin)
-             for f in flanks}
-    check_on_reference(measured, np.stack([np.asarray(grids[f].points) for f in flanks]),
-                       np.stack([np.asarray(grids[f].normals) for f in flanks]))
+    names = checked_settings(DEFAULT_SETTINGS if settings is None else settings,
+                             FIELDS + (ROTATION,), f"the VH-CATT {member}")
+    grids = measured_reference_grids(design, measured, flanks)
     unknowns, index, M, rot = unknown_columns(flanks, FIELDS, names, SHARED)
     specs = [flank_setup(design.pair, member, f) for f in flanks]
     stacked = jax.tree_util.tree_map(lambda *a: jnp.stack(a), *specs)
