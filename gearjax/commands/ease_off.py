@@ -2,8 +2,8 @@
 the TCA of the result (hypoid / spiral bevel: machine settings,
 :mod:`gearjax.gears.hypoid.ease_off`; VH-CATT: the pinion's cutter radius, blade offset
 and blade angle, :mod:`gearjax.gears.vh_catt.ease_off`; docs/correct.md "Target
-ease-off").  One code path: the design's family is looked up in the registry of
-:func:`gearjax.correction.ease_off_family`.
+ease-off").  One code path: the design's ``ease_off_family()`` (the registry of
+:func:`gearjax.correction.ease_off_family`) gives the family's functions.
 
 The ease-off is the difference topography between the pinion flank of a side and the
 pinion conjugate to the gear (um, positive = relief), on the pinion's reference grid
@@ -229,16 +229,11 @@ def run(args) -> int:
         target = read_target(args.target, grid)
         spec = {"file": str(args.target)}
     design = load_design(args.design)
-    import importlib
-    for family in ("gearjax.hypoid", "gearjax.vh_catt"):   # they register their fits
-        importlib.import_module(family)
-    from gearjax.correction import ease_off_family
-    try:
-        eo = ease_off_family(design)
-    except ValueError:
+    if not hasattr(design, "ease_off_family"):
         raise ValueError(f"{args.design!r}: the target ease-off is defined for hypoid, "
                          f"spiral-bevel and VH-CATT designs only, not for [design] kind = "
-                         f"{design.data['design']['kind']!r}") from None
+                         f"{design.data['design']['kind']!r}")
+    eo = design.ease_off_family()       # the family's module: one code path below
     if args.target is None:
         target = eo.target_ease_off(*grid, terms["crowning_um"], terms["profile_um"],
                                     terms["bias_um"])

@@ -22,7 +22,7 @@ angle of the gear's mating flank).  The pinion cut with the cutter radius ``R_c`
 (its own blade offset kept) and the blade angle ``alpha_c`` on that flank is generated
 by the very rack surface that generates the gear flank, so it is in line contact with
 the gear (zero mismatch; checked in tests/test_correct_vh_catt.py: at its meshing angle
-every grid point of the conjugate pinion lies on the gear flank to < 1e-6 mm).
+every grid point of the conjugate pinion lies on the gear flank to < 1e-5 um).
 
 **Ease-off.**  As for the hypoid family (:mod:`gearjax.gears.hypoid.ease_off`): on the
 pinion's reference grid (``n_xi`` transverse sections ``z = (b/2 - f_m b) u``, ``u`` in
@@ -55,11 +55,15 @@ the fit reports them as indistinguishable and the regularisation shares the chan
 i.e. the lengthwise crowning; in the pitch plane the traces are circles through the
 common middle point, so at axial position ``z``
 
-    e(z) ~ cos(alpha) z^2/2 (1/rho_c - 1/rho_1)   (um from mm: x 1000; rho_c = R_c -/+ ...)
+    e(z) ~ cos(alpha) z^2/2 (1/rho_c - 1/rho_1)      (mm; z the axial position)
 
-(``rho_1`` the real pinion flank's trace radius, ``rho_c`` the conjugate's: a real
-trace radius larger than the conjugate's relieves the face ends).  The blade angle
-turns the profile (a term ``~ w``, linear in the height, partly taken by the
+(``rho_1`` the real pinion flank's trace radius, ``rho_c = R_c - sigma (w/2 + e_1)`` the
+conjugate's: the two trace circles through the middle point are ``z^2/2 (1/rho_c -
+1/rho_1)`` apart along the pitch line, ``cos(alpha)`` of it along the normal; a real
+trace radius larger than the conjugate's relieves the face ends).  With equal column
+scales the regularised fit splits a trace-radius change equally between ``R_T`` and
+``e``, which keeps the other pinion flank's ``rho_0 = R_T + sigma (w/2 + e)`` as it
+was.  The blade angle turns the profile (a term ``~ w``, linear in the height, partly taken by the
 rotation).  Profile crowning (``w^2``) and bias (``u w``) are not reachable with
 straight blades: the fit leaves them in the residual, which the report shows.
 
@@ -81,9 +85,9 @@ from gearjax.correction import (ROTATION, CorrectionProblem, correct_flanks, eas
                                 register_ease_off, target_ease_off, unknown_columns)
 from gearjax.errors import ConvergenceError
 from gearjax.gears.vh_catt.design_file import VHCattDesign
-from gearjax.gears.vh_catt.flank_correction import (FIELDS, SHARED, UNITS, _write,
-                                                    corrected_design, flank_deviations,
-                                                    flank_setup, member_fields)
+from gearjax.gears.vh_catt.flank_correction import (FIELDS, SHARED, UNITS, corrected_design,
+                                                    flank_deviations, flank_setup,
+                                                    member_fields, with_member_fields)
 from gearjax.io import FlankGrid, MeasuredGrid
 
 __all__ = ["SIDES", "DEFAULT_EASE_OFF_SETTINGS", "target_ease_off", "conjugate_fields",
@@ -119,7 +123,7 @@ def conjugate_design(design, side: str):
     """The design with the pinion cut as the conjugate pinion of ``side``
     (:func:`conjugate_fields`; the gear and the other pinion fields unchanged; only the
     side's pinion flank is meant)."""
-    return _write(design, "pinion", conjugate_fields(design, side))
+    return with_member_fields(design, "pinion", conjugate_fields(design, side))
 
 
 def _mid_system(spec, P, n, prm, omega):
