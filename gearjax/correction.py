@@ -55,7 +55,8 @@ from gearjax.errors import ConvergenceError, check_int, check_range
 
 __all__ = ["checked_settings", "measured_reference_grids", "ROTATION", "INDISTINCT", "DEFAULT_REGULARISATION", "UM", "CorrectionProblem",
            "CorrectionResult", "unknown_columns", "model_deviations", "correct_flanks",
-           "flank_increments", "register_correction", "correction_family"]
+           "flank_increments", "register_correction", "correction_family", "target_ease_off",
+           "ease_off_map", "register_ease_off", "ease_off_family"]
 
 #: the rotation of the measured member about its axis (deg at the boundary): an unknown of
 #: the measurement's alignment, reported, never written to the design
@@ -88,6 +89,54 @@ def correction_family(design):
         if isinstance(design, t):
             return fam
     raise ValueError(f"no flank correction is defined for {type(design).__name__} designs")
+
+
+#: design type -> the family's target ease-off module (``target_ease_off``,
+#: ``ease_off_problem``, ``ease_off``, ``fit_ease_off``, ``ease_off_design``,
+#: ``DEFAULT_EASE_OFF_SETTINGS``): filled by the families' ease-off modules
+_EASE_OFF: dict = {}
+
+
+def register_ease_off(design_type, family) -> None:
+    """Register ``family`` (a module with the functions listed at ``_EASE_OFF``) as the
+    target ease-off fit of the designs of ``design_type`` (``gearjax ease-off``)."""
+    _EASE_OFF[design_type] = family
+
+
+def ease_off_family(design):
+    """The registered ease-off family of ``design`` (:func:`register_ease_off`);
+    ``ValueError`` for a design without one."""
+    for t, fam in _EASE_OFF.items():
+        if isinstance(design, t):
+            return fam
+    raise ValueError(f"no target ease-off is defined for {type(design).__name__} designs")
+
+
+def target_ease_off(n_xi: int, n_s: int, crowning_um: float, profile_um: float,
+                    bias_um: float) -> np.ndarray:
+    """The quadratic ease-off target (um) on an ``n_xi`` x ``n_s`` reference grid:
+
+        e*(u, w) = C_L u^2 + C_P w^2 + B u w
+
+    ``u`` in [-1, 1] along the face width (the grid's ``xi`` order: toe to heel for a
+    bevel pinion, -z to +z for a VH-CATT pinion), ``w`` in [-1, 1] along the height
+    (root to tip): lengthwise crowning ``C_L`` at the grid's face ends, profile crowning
+    ``C_P`` at its root and tip rows, bias ``B`` at its corners (um; positive = relief).
+    Shared by the families' ease-off fits (:mod:`gearjax.gears.hypoid.ease_off`,
+    :mod:`gearjax.gears.vh_catt.ease_off`)."""
+    u = np.linspace(-1.0, 1.0, int(n_xi))[:, None]
+    w = np.linspace(-1.0, 1.0, int(n_s))[None, :]
+    return crowning_um * u ** 2 + profile_um * w ** 2 + bias_um * u * w
+
+
+def ease_off_map(problem, values=None) -> np.ndarray:
+    """Ease-off (um, (n_xi, n_s); positive = relief) of the one flank of an ease-off
+    problem (a :class:`CorrectionProblem` whose lines are the conjugate flank's grid
+    normals) with the changes ``values`` (unknown name -> internal units; default none:
+    the design's), the rotation included: ``e_i = -t_i``, ``t_i`` the signed distance
+    (mm -> um) along the conjugate's normal (out of the material) to the flank."""
+    dev, _ = model_deviations(problem, values or {})
+    return -dev[0]
 
 
 def _to_file(unit: str, v):

@@ -293,3 +293,159 @@ def test_member_blade_keys_validated_and_honoured_by_the_flank(design):
     np.testing.assert_allclose(d1.reference_grid("gear", "convex", 3, 3, 0.1, 0.1).points,
                                design.reference_grid("gear", "convex", 3, 3, 0.1, 0.1).points,
                                atol=1e-12)
+
+
+# ------------------------------------------------------------------ target ease-off
+# (gearjax/gears/vh_catt/ease_off.py, docs/correct.md "Target ease-off": VH-CATT)
+
+EASE_GRID = (9, 5)
+
+
+def _rz(a):
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def _gaps_at_meshing(design, pinion_design, side="drive"):
+    """Signed gaps (um, (n_xi, n_s)) between the grid points of the pinion of
+    ``pinion_design`` and the gear flank of ``design``, each point taken at the pinion
+    angle where it meets the gear's meshing condition: the TCA's mounting (pinion about
+    +z, gear about +z through (0, a, 0), ratio -z1/z2, both turned to the reference
+    pitch point), the point's normal line cut with the gear flank (the correction's line
+    solve, started from the nearest point of a fine gear grid).  A pinion conjugate to the
+    gear touches it at every grid point (zero gap): a contact line at each angle."""
+    import jax
+    import jax.numpy as jnp
+    from gearjax.gears.vh_catt.ease_off import SIDES
+    from gearjax.gears.vh_catt.geometry import pair_geometry
+    from gearjax.gears.vh_catt.tca import reference_guess
+    pf, gf, sigma = SIDES[side]
+    pair = design.pair
+    ratio = pair.z1 / pair.z2
+    c = np.array([0.0, float(pair_geometry(pair)["a"]), 0.0])
+    x, ph1r = reference_guess(pair, sigma)
+    ph1r, ph2r = float(ph1r), float(x[4])
+    g = pinion_design.reference_grid("pinion", pf, *EASE_GRID, 0.1, 0.25)
+    P, n = np.asarray(g.points).reshape(-1, 3), np.asarray(g.normals).reshape(-1, 3)
+    ez = jnp.array([0.0, 0.0, 1.0])
+
+    def mesh(ph, P1, n1):        # n . (v1 - v2), omega1 = 1, omega2 = -z1/z2
+        Rp = jnp.array([[jnp.cos(ph), -jnp.sin(ph), 0.0], [jnp.sin(ph), jnp.cos(ph), 0.0],
+                        [0.0, 0.0, 1.0]])
+        X = Rp @ P1
+        return (Rp @ n1) @ (jnp.cross(ez, X) + ratio * jnp.cross(ez, X - c))
+
+    def solve(P1, n1):
+        ph = jnp.asarray(ph1r)
+        for _ in range(12):
+            f, d = jax.jvp(lambda q: mesh(q, P1, n1), (ph,), (1.0,))
+            ph = ph - f / d
+        return ph, mesh(ph, P1, n1)
+
+    ph, res = jax.vmap(solve)(jnp.asarray(P), jnp.asarray(n))
+    ph = np.asarray(ph)
+    assert np.abs(np.asarray(res)).max() < 1e-9
+    ph2 = ph2r - ratio * (ph - ph1r)
+    Y = np.stack([_rz(-b) @ (_rz(a) @ p - c) for a, b, p in zip(ph, ph2, P)])
+    m = np.stack([_rz(-b) @ (_rz(a) @ v) for a, b, v in zip(ph, ph2, n)])
+    fine = design.reference_grid("gear", gf, 31, 21, 0.0, 0.0)
+    GP = np.asarray(fine.points).reshape(-1, 3)
+    start = np.asarray(fine.params).reshape(-1, 3)[
+        np.argmin(((Y[:, None] - GP[None]) ** 2).sum(-1), axis=1)]
+    t, conv = vc.flank_deviations(vc.flank_setup(pair, "gear", gf), jnp.zeros(3),
+                                  jnp.asarray(Y), jnp.asarray(m), jnp.asarray(start), 0.0)
+    assert bool(np.all(conv))
+    return np.asarray(t).reshape(EASE_GRID) / 1e-3
+
+
+@pytest.fixture(scope="module")
+def ease(design):
+    """The conjugate pinion of the drive side and the ease-off of the design's pinion."""
+    from gearjax.gears.vh_catt import ease_off as veo
+    conj = veo.conjugate_design(design, "drive")
+    return conj, veo.ease_off(veo.ease_off_problem(design, "drive"))
+
+
+def test_ease_off_conjugate_pinion_line_contact_and_crowning_closed_form(design, ease):
+    """The conjugate pinion (the gear flank's trace radius and blade angle) has zero
+    ease-off against itself and touches the gear at every grid point at its meshing angle
+    (a wrong R_c, e.g. the sign of w + e_1 + e_2, leaves gaps of ~10 um); the design's
+    pinion gaps against the gear agree with its ease-off (a second route through the
+    mounting), and both with the trace circles' closed form ``cos(alpha) z^2/2 (1/rho_c -
+    1/rho_1)``, rho_1 = R_T1 + w/2 + e (pinion concave), rho_c = R_T2 - w/2 - e (gear
+    convex): 4.5 um at the grid's face ends."""
+    from gearjax.gears.vh_catt import ease_off as veo
+    conj, e = ease
+    e_self = veo.ease_off(veo.ease_off_problem(conj, "drive"))
+    assert np.abs(e_self).max() < 1e-6
+    assert np.abs(_gaps_at_meshing(design, conj)).max() < 1e-5
+    gap = _gaps_at_meshing(design, design)
+    assert np.abs(gap - e).max() < 0.01, np.round(gap - e, 4)
+    pr = design.data["pair"]
+    w, e0 = math.pi * pr["module_mm"] / 2, pr["blade_offset_mm"]
+    rho1, rhoc = pr["cutter_radius1_mm"] + w / 2 + e0, pr["cutter_radius2_mm"] - w / 2 - e0
+    z = np.asarray(design.reference_grid("pinion", "concave", *EASE_GRID, 0.1, 0.25).points)[
+        ..., 2]
+    closed = math.cos(math.radians(pr["pressure_angle_deg"])) * z ** 2 / 2 * (
+        1 / rhoc - 1 / rho1) / 1e-3
+    assert closed.max() > 4.0
+    assert np.abs(e - closed).max() < 0.05, np.round(e - closed, 3)
+
+
+def test_ease_off_of_known_pinion_changes_is_recovered_and_written(design, tmp_path):
+    """The ease-off of the pinion cut with +12 mm cutter radius and +0.05 deg concave blade
+    angle, used as the target of the design, is met by the fit (residual < 0.01 um) with
+    the true changes (the blade offset left out: one flank cannot tell it from the
+    radius); the written design, read back, has that ease-off and the gear's fields."""
+    from gearjax.gears.vh_catt import ease_off as veo
+    true = {"cutter_radius": 12.0, "concave.blade_angle": 0.05}
+    target = veo.ease_off(veo.ease_off_problem(vc.with_setting_errors(design, "pinion", true),
+                                               "drive"))
+    assert np.abs(target).max() > 5.0
+    prob = veo.ease_off_problem(design, "drive", target,
+                                settings=["cutter_radius", "blade_angle", "axis_rotation"])
+    res = veo.fit_ease_off(prob)
+    assert res.converged and np.nanmax(np.abs(res.after_um)) < 0.01
+    assert res.correction["cutter_radius"] == pytest.approx(12.0, abs=0.05)
+    assert res.correction["blade_angle"] == pytest.approx(0.05, abs=5e-4)
+    new = veo.ease_off_design(res)
+    path = tmp_path / "eased.toml"
+    from gearjax.io import atomic_write, dumps_toml
+    atomic_write(path, dumps_toml(new.data))
+    back = gearjax.load_design(str(path))
+    assert back.data["pinion"]["concave_blade_angle_deg"] == pytest.approx(20.05, abs=5e-4)
+    assert "convex_blade_angle_deg" not in back.data["pinion"] and "gear" not in back.data
+    assert back.data["pair"]["cutter_radius2_mm"] == design.data["pair"]["cutter_radius2_mm"]
+    e_back = veo.ease_off(veo.ease_off_problem(back, "drive"))
+    assert np.abs(e_back - target).max() < 0.01
+
+
+def test_ease_off_command_on_vh_catt_crowning_target(design, tmp_path, capsys):
+    """``gearjax ease-off`` on the VH-CATT example with a 10 um lengthwise crowning: the
+    written design meets it (read back from the file), the trace radius it writes gives
+    the closed form's 10 um at the face ends, the regularised fit splits the radius and
+    the offset equally (so the other pinion flank, rho = R_T - w/2 - e, is unchanged),
+    the gear is unchanged, and the TCA runs before and after."""
+    out = tmp_path / "eased.toml"
+    capsys.readouterr()
+    rc = main(["ease-off", EX, "--out", str(out), "--crowning-um", "10", "--json"])
+    rep = json.loads(capsys.readouterr().out)
+    assert rc == 0 and rep["converged"]
+    assert rep["fit_rms_um"] < 0.05 and rep["written_vs_target_rms_um"] < 0.05
+    ch = rep["change"]
+    assert ch["cutter_radius"] == pytest.approx(ch["blade_offset"], rel=1e-3)
+    new = gearjax.load_design(str(out))
+    pr, pr0 = new.data["pair"], design.data["pair"]
+    assert pr["cutter_radius2_mm"] == pr0["cutter_radius2_mm"] and "gear" not in new.data
+    w = math.pi * pr0["module_mm"] / 2
+    e1 = new.data["pinion"]["blade_offset_mm"]
+    rho1 = pr["cutter_radius1_mm"] + w / 2 + e1
+    rhoc = pr0["cutter_radius2_mm"] - w / 2 - pr0["blade_offset_mm"]
+    z = 0.5 * pr0["face_width_mm"] * (1 - 2 * 0.1)
+    closed = math.cos(math.radians(20.0)) * z ** 2 / 2 * (1 / rhoc - 1 / rho1) / 1e-3
+    assert closed == pytest.approx(10.0, rel=0.02)
+    assert pr["cutter_radius1_mm"] - e1 == pytest.approx(
+        pr0["cutter_radius1_mm"] - pr0["blade_offset_mm"], abs=1e-3)
+    for k in ("design", "written"):
+        t = rep["tca"][k]
+        assert t is not None and "error" not in t and t["contact_ratio"] > 1.4

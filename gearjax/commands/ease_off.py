@@ -1,12 +1,16 @@
-"""``gearjax ease-off DESIGN --out NEW.toml``: pinion machine settings for a target
-ease-off, and the TCA of the result (hypoid / spiral bevel;
-:mod:`gearjax.gears.hypoid.ease_off`, docs/correct.md "Target ease-off").
+"""``gearjax ease-off DESIGN --out NEW.toml``: pinion settings for a target ease-off, and
+the TCA of the result (hypoid / spiral bevel: machine settings,
+:mod:`gearjax.gears.hypoid.ease_off`; VH-CATT: the pinion's cutter radius, blade offset
+and blade angle, :mod:`gearjax.gears.vh_catt.ease_off`; docs/correct.md "Target
+ease-off").  One code path: the design's ``ease_off_family()`` (the registry of
+:func:`gearjax.correction.ease_off_family`) gives the family's functions.
 
 The ease-off is the difference topography between the pinion flank of a side and the
 pinion conjugate to the gear (um, positive = relief), on the pinion's reference grid
-(face width ``u`` toe -1 .. heel +1 by height ``w`` root -1 .. tip +1).  The target is
+(face width ``u`` -1 .. +1 in the grid's ``xi`` order -- toe to heel for a bevel pinion,
+-z to +z for a VH-CATT pinion -- by height ``w`` root -1 .. tip +1).  The target is
 ``e*(u, w) = C_L u^2 + C_P w^2 + B u w`` (``--crowning-um``, ``--profile-um``,
-``--bias-um``) or a grid read from ``--target`` (CSV, ``N_XI`` rows toe -> heel of
+``--bias-um``) or a grid read from ``--target`` (CSV, ``N_XI`` rows along the face of
 ``N_S`` values root -> tip, um; ``#`` comment lines).  The pinion settings are fitted by
 Levenberg-Marquardt with exact Jacobians (the fit of ``gearjax correct`` with the target
 as ``-deviation``); the design with the changes is written; its ease-off is then
@@ -49,25 +53,35 @@ JSON report keys (--json):
   iterations, evaluations      accepted steps; residual and Jacobian evaluations
   seconds                      wall time: {fit, check, tca} (first runs compile)
   tca                          {design, written}: each null with --no-tca, else
-                               {ptp_arcsec, contact_ratio, xi1_range, h1_range_mm,
-                               on_flank_points, points, quality, warnings} or
-                               {error} when the TCA failed
+                               {ptp_arcsec, contact_ratio, xi1_range, h1_range_mm
+                               (null for a family without them: VH-CATT),
+                               axial1_range_mm (the contact's axial position on the
+                               pinion), on_flank_points, points, quality, warnings}
+                               or {error} when the TCA failed
   written_design               the design file written (null when not converged)
-  files                        every file written (--out, --plot)"""
+  files                        every file written (--out, --plot)
+VH-CATT: the fitted pinion fields are cutter_radius (mm, [pair] cutter_radius1_mm),
+blade_offset (mm, [pinion] blade_offset_mm) and blade_angle (deg, the side's pinion flank:
+[pinion] concave_blade_angle_deg on the drive side, convex_ on the coast side); the
+conjugate pinion is the pinion cut with the gear flank's trace radius and blade angle.
+With straight blades the cutter radius and the blade offset act alike on one flank
+(lengthwise crowning only: reported as indistinguishable), and profile crowning and bias
+are not reachable: they stay in the fit residual (docs/correct.md)."""
 
 
 def register(sub):
     import argparse
     p = sub.add_parser(
-        "ease-off", help="pinion machine settings for a target ease-off, and their TCA",
-        description="Fit the pinion machine settings of a hypoid / spiral-bevel design to "
+        "ease-off", help="pinion settings for a target ease-off, and their TCA",
+        description="Fit the pinion machine settings of a hypoid / spiral-bevel design (or "
+                    "the pinion's cutter radius and blade settings of a VH-CATT design) to "
                     "a target ease-off (difference topography between the pinion flank and "
                     "the pinion conjugate to the gear: lengthwise crowning, profile "
                     "crowning, bias, or a grid), write the design with the changes, and "
                     "show the unloaded TCA before and after.",
         epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("design", help="design file path or example:NAME (hypoid / spiral bevel "
-                                  "with a generated pinion)")
+                                  "with a generated pinion, or VH-CATT)")
     p.add_argument("--out", required=True, help="the design with the fitted settings (.toml)")
     p.add_argument("--side", choices=("drive", "coast"), default="drive",
                    help="the side whose pinion flank is fitted (default drive)")
@@ -82,13 +96,14 @@ def register(sub):
                         "in [-200, 200] (default 0)")
     p.add_argument("--target", default=None,
                    help="target grid CSV instead of the three terms: N_XI rows (toe -> "
-                        "heel) of N_S values (root -> tip), um, |value| <= 1000")
+                        "heel; VH-CATT -z -> +z) of N_S values (root -> tip), um, |value| <= 1000")
     p.add_argument("--grid", default="9x5",
                    help="N_XIxN_S points of the reference grid, each 3..41 (default 9x5)")
     p.add_argument("--settings", default=None,
                    help="comma-separated pinion settings to fit (default point_radius, "
                         "blade_angle,ratio_of_roll,modified_roll_2c,modified_roll_6d,"
-                        "axis_rotation; any setting `gearjax correct --settings` takes)")
+                        "axis_rotation; any setting `gearjax correct --settings` takes; "
+                        "VH-CATT: cutter_radius,blade_offset,blade_angle,axis_rotation)")
     p.add_argument("--regularisation", type=float, default=0.003,
                    help="Tikhonov alpha in [0, 1] (default 0.003)")
     p.add_argument("--max-iter", type=int, default=50,
@@ -172,12 +187,17 @@ def tca_summary(design, side) -> dict:
     except ConvergenceError as exc:
         return {"error": str(exc), "seconds": time.perf_counter() - t0}
     on = np.asarray(r.on_flank)
-    xi = np.asarray(r.coords["xi1"])[on]
-    h = np.asarray(r.coords["h1"])[on]
+
+    def extent(a):
+        a = np.asarray(a)[on]
+        return [float(a.min()), float(a.max())] if a.size else None
+    # the bearing on the pinion: the family's flank coordinates where it has them
+    # (hypoid xi1, h1), and in every family the axial position of the contact (mm)
     return {"ptp_arcsec": float(np.asarray(r.multi.ptp)) / ARCSEC,
             "contact_ratio": float(np.asarray(r.multi.contact_ratio)),
-            "xi1_range": [float(xi.min()), float(xi.max())] if xi.size else None,
-            "h1_range_mm": [float(h.min()), float(h.max())] if h.size else None,
+            "xi1_range": extent(r.coords["xi1"]) if "xi1" in r.coords else None,
+            "h1_range_mm": extent(r.coords["h1"]) if "h1" in r.coords else None,
+            "axial1_range_mm": extent(r.path.axial1),
             "on_flank_points": int(on.sum()), "points": int(on.size),
             "quality": r.flags(), "warnings": r.warnings(),
             "seconds": time.perf_counter() - t0}
@@ -209,12 +229,11 @@ def run(args) -> int:
         target = read_target(args.target, grid)
         spec = {"file": str(args.target)}
     design = load_design(args.design)
-    from gearjax.hypoid import HypoidDesign
-    if not isinstance(design, HypoidDesign):
-        raise ValueError(f"{args.design!r}: the target ease-off is defined for hypoid and "
-                         f"spiral-bevel designs only, not for [design] kind = "
+    if not hasattr(design, "ease_off_family"):
+        raise ValueError(f"{args.design!r}: the target ease-off is defined for hypoid, "
+                         f"spiral-bevel and VH-CATT designs only, not for [design] kind = "
                          f"{design.data['design']['kind']!r}")
-    from gearjax.hypoid import ease_off as eo
+    eo = design.ease_off_family()       # the family's module: one code path below
     if args.target is None:
         target = eo.target_ease_off(*grid, terms["crowning_um"], terms["profile_um"],
                                     terms["bias_um"])
@@ -233,12 +252,12 @@ def run(args) -> int:
         e_written = np.full(grid, np.nan)
         if res.converged:
             with bar.phase("written design checked"):
-                from gearjax.hypoid import save_design
+                from gearjax.io import atomic_write, dumps_toml
                 t0 = time.perf_counter()
                 new = eo.ease_off_design(res, description=(
                     f"{design.data['design'].get('description', design.name)}; {args.side} "
                     f"pinion fitted to a target ease-off by gearjax ease-off"))
-                save_design(new, outs["--out"])
+                atomic_write(outs["--out"], dumps_toml(new.data))
                 written = load_design(str(outs["--out"]))
                 e_written = eo.ease_off(eo.ease_off_problem(written, args.side, target, **kw))
                 sec["check"] = time.perf_counter() - t0
@@ -362,9 +381,10 @@ def table(rep: dict) -> str:
         if "error" in c:
             L.append(head + f"failed ({c['error']})")
             continue
-        xr = c["xi1_range"]
+        xr, zr = c["xi1_range"], c["axial1_range_mm"]
+        bearing = (f"xi {xr[0]:+.2f}..{xr[1]:+.2f}" if xr else
+                   f"z {zr[0]:+.2f}..{zr[1]:+.2f} mm" if zr else "none")
         L.append(head + f"TE p-t-p {c['ptp_arcsec']:.2f} arcsec, contact ratio "
-                 f"{c['contact_ratio']:.3f}, bearing xi "
-                 + (f"{xr[0]:+.2f}..{xr[1]:+.2f}" if xr else "none")
+                 f"{c['contact_ratio']:.3f}, bearing {bearing}"
                  + f" ({c['on_flank_points']} of {c['points']} positions on the flank)")
     return "\n".join(L)

@@ -291,6 +291,13 @@ class HypoidDesign:
         from gearjax.correction import correction_family
         return correction_family(self).corrected_design(result, description=description)
 
+    def ease_off_family(self):
+        """The target ease-off fit of this design's family, which ``gearjax ease-off``
+        runs: the module registered in :func:`gearjax.correction.ease_off_family`
+        (:mod:`gearjax.gears.hypoid.ease_off`)."""
+        from gearjax.correction import ease_off_family
+        return ease_off_family(self)
+
     def teeth(self, member: str) -> int:
         """Number of teeth of ``member``."""
         return int(self.member_blank(member).teeth)

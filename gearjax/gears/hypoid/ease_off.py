@@ -36,18 +36,20 @@ deviations, and written to the design as ``+delta``.
 from __future__ import annotations
 
 import math
+import sys
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 
 from gearjax import frames
+from gearjax.correction import ease_off_map as ease_off, register_ease_off, target_ease_off
 from gearjax.errors import ConvergenceError
 from gearjax.gears.hypoid.flank import flank_surface, machine_chain, point_and_first_equation
 from gearjax.newton import newton_solve
 from gearjax.gears.hypoid.flank_correction import (DEFAULT_GENERATED, ROTATION, correct_flanks,
                                                    corrected_design, line_deviations,
-                                                   model_deviations, problem_on_lines)
+                                                   problem_on_lines)
 from gearjax.gears.hypoid.pair import SIDES, pair_flanks, program_pair
 from gearjax.gears.hypoid.synthesis import conjugate_start
 from gearjax.io import FlankGrid, MeasuredGrid
@@ -57,15 +59,6 @@ __all__ = ["DEFAULT_EASE_OFF_SETTINGS", "target_ease_off", "ease_off_problem", "
 
 #: default pinion settings of the ease-off fit (the first-order set and the rotation)
 DEFAULT_EASE_OFF_SETTINGS = DEFAULT_GENERATED + (ROTATION,)
-
-
-def target_ease_off(n_xi: int, n_s: int, crowning_um: float, profile_um: float,
-                    bias_um: float) -> np.ndarray:
-    """``e*(u, w) = C_L u^2 + C_P w^2 + B u w`` (um) on an ``n_xi`` x ``n_s`` grid
-    (module docstring)."""
-    u = np.linspace(-1.0, 1.0, int(n_xi))[:, None]
-    w = np.linspace(-1.0, 1.0, int(n_s))[None, :]
-    return crowning_um * u ** 2 + profile_um * w ** 2 + bias_um * u * w
 
 
 def _circle_system(y, p):
@@ -144,14 +137,6 @@ def ease_off_problem(design, side: str, target_um=None, *, settings=None, grid=(
 _lines_jit = jax.jit(line_deviations)
 
 
-def ease_off(problem, values=None) -> np.ndarray:
-    """Ease-off (um, (n_xi, n_s); positive = relief) of the pinion with the setting
-    changes ``values`` (unknown name -> internal units; default none: the design's),
-    the rotation about the axis included."""
-    dev, _ = model_deviations(problem, values or {})
-    return -dev[0]
-
-
 def fit_ease_off(problem, **kw):
     """Fit the pinion settings to the problem's target (:func:`correct_flanks`; the
     result's ``before_um`` is ``-(target - ease-off of the design)``, its ``after_um``
@@ -162,3 +147,11 @@ def fit_ease_off(problem, **kw):
 def ease_off_design(result, description: str | None = None):
     """The design with the fitted pinion settings (``+delta``), validated."""
     return corrected_design(result, description=description)
+
+
+def _register():
+    from gearjax.gears.hypoid.design_file import HypoidDesign
+    register_ease_off(HypoidDesign, sys.modules[__name__])
+
+
+_register()

@@ -166,6 +166,13 @@ class VHCattDesign(DesignFileMixin):
         from gearjax.correction import correction_family
         return correction_family(self).corrected_design(result, description=description)
 
+    def ease_off_family(self):
+        """The target ease-off fit of this design's family, which ``gearjax ease-off``
+        runs: the module registered in :func:`gearjax.correction.ease_off_family`
+        (:mod:`gearjax.gears.vh_catt.ease_off`)."""
+        from gearjax.correction import ease_off_family
+        return ease_off_family(self)
+
 
 def _table(data, key):
     t = data.get(key)

@@ -69,7 +69,7 @@ from gearjax.surfaces import meshing_function
 
 __all__ = ["FIELDS", "UNITS", "SHARED", "DEFAULT_SETTINGS", "FlankSetup", "flank_setup",
            "flank_deviations", "correction_problem", "corrected_design",
-           "with_setting_errors", "member_fields"]
+           "with_setting_errors", "member_fields", "with_member_fields"]
 
 #: the correctable fields of a member, in the order of a flank's increments ``delta``
 FIELDS = ("cutter_radius", "blade_offset", "blade_angle")
@@ -177,7 +177,7 @@ def member_fields(design, member: str) -> dict:
     return out
 
 
-def _write(design, member: str, values: dict, description=None):
+def with_member_fields(design, member: str, values: dict, description=None):
     """The design with the member's fields ``values`` (keys of :func:`member_fields`,
     file units) written to its file tables, validated by the family's loader."""
     data = copy.deepcopy(design.to_dict())
@@ -214,7 +214,7 @@ def corrected_design(result, *, description: str | None = None):
         else:
             for a, f in enumerate(p.flanks):
                 values[f"{f}.{name}"] = now[f"{f}.{name}"] + math.degrees(float(inc[a, k]))
-    return _write(p.design, p.member, values, description)
+    return with_member_fields(p.design, p.member, values, description)
 
 
 def with_setting_errors(design, member: str, errors: dict):
@@ -238,7 +238,7 @@ def with_setting_errors(design, member: str, errors: dict):
             for f in ([flank] if flank else ["convex", "concave"]):
                 k = f"{f}.{name}"
                 values[k] = values.get(k, now[k]) + float(v)
-    return _write(design, member, values)
+    return with_member_fields(design, member, values)
 
 
 register_correction(VHCattDesign, sys.modules[__name__])
