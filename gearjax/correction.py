@@ -54,7 +54,8 @@ from gearjax import optimize
 from gearjax.errors import ConvergenceError, check_int, check_range
 
 __all__ = ["ROTATION", "INDISTINCT", "DEFAULT_REGULARISATION", "UM", "CorrectionProblem",
-           "CorrectionResult", "checked_settings", "measured_reference_grids", "unknown_columns", "model_deviations", "correct_flanks",
+           "CorrectionResult", "checked_settings", "measured_reference_grids", "unknown_columns",
+           "model_deviations", "correct_flanks",
            "flank_increments", "register_correction", "correction_family", "target_ease_off",
            "ease_off_map", "register_ease_off", "ease_off_family"]
 
