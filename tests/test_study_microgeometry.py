@@ -269,6 +269,11 @@ def _replace(text, old, new):
      r"\[\[variables\]\] 1: field 'pair.x1': a line-contact study varies micro-geometry"),
     ("f_ma_um", "dE_mm", r"\[scenarios\] dE_mm: a scenario key of the TCA route"),
     ("[line]", "[tca]", r"\[tca\]: the TCA grid"),
+    ("[scenarios]", "[operating]\nedge_softening_mm = 0.01\n\n[scenarios]",
+     r"\[operating\] edge_softening_mm: the soft active set"),
+    ('field = "microgeometry.pinion.tip_relief_length_mm"',
+     'field = "microgeometry.pinion.tip_relief_length_mm"\nunit = "deg"',
+     r"\[\[variables\]\] 2 \(microgeometry.pinion.tip_relief_length_mm\): unit = 'deg'"),
 ])
 def test_bad_study_refused_naming_the_entry(tmp_path, old, new, match):
     with pytest.raises(ValueError, match=match):
@@ -297,6 +302,11 @@ def test_micro_variables_need_the_line_route(tmp_path):
      r"\[\[variables\]\] 2 .*outside the field's range \[> 0"),
     ("f_ma_um = [-10.0, 10.0]", "f_ma_um = [-10.0, 2000.0]",
      r"\[scenarios\] scenario 2: f_ma_um = 2000"),
+    ("torque_Nm = [200.0, 400.0]", "torque_Nm = [-200.0, 400.0]",
+     r"\[scenarios\] scenario 1: torque_Nm = -200"),
+    ("lower = -15.0\nupper = 15.0", "lower = -15.0\nupper = 900.0",
+     r"\[\[variables\]\] 5 \(microgeometry.pinion.helix_slope_um\): bounds \[-15, 900\] um "
+     r"outside the field's range"),
     ("microgeometry.gear_drive.tip_relief_um", "microgeometry.pinion_drive.tip_relief_um",
      r"\[\[variables\]\] 3: field 'microgeometry.pinion_drive.tip_relief_um' is the field "
      r"of \[\[variables\]\] 1 again"),
@@ -367,3 +377,19 @@ def test_member_variable_of_a_design_whose_flanks_differ_is_refused(tmp_path):
                                          r"tip_relief_um\): the design's pinion flanks differ "
                                          r"in tip_relief_um .*microgeometry.pinion_drive"):
         sr.set_up(read_study(_write(tmp_path, text)))
+
+
+def test_a_scenario_with_one_unconverged_position_is_flagged(problem):
+    """The acceptance reads every position of a scenario: one position of one scenario
+    not converged flags that scenario (and only it), with the count of valid ones."""
+    from gearjax.studies.line_route import line_flags
+    prob, _ = problem
+    res = sr.start_point(prob)[1]
+    conv = np.asarray(res.converged)
+    assert conv.ndim == 2 and conv.all()
+    bad = conv.copy()
+    bad[1, 3] = False
+    f = [line_flags(res._replace(converged=bad), None, k) for k in range(bad.shape[0])]
+    assert not f[1]["converged"] and f[1]["n_valid"] == bad.shape[1] - 1
+    assert all(g["converged"] and g["n_valid"] == bad.shape[1] for k, g in enumerate(f)
+               if k != 1)
