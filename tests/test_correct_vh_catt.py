@@ -449,3 +449,22 @@ def test_ease_off_command_on_vh_catt_crowning_target(design, tmp_path, capsys):
     for k in ("design", "written"):
         t = rep["tca"][k]
         assert t is not None and "error" not in t and t["contact_ratio"] > 1.4
+
+
+def test_setting_errors_of_the_synthetic_machine():
+    """The synthetic "machine" of the recovery tests: a plain ``blade_angle`` error tilts
+    both blades of the member, a flank's own adds to its blade only, the head's fields
+    are shared, and the other member is untouched (a machine that cut the wrong blades
+    would make every recovery test check the wrong thing)."""
+    d = gearjax.load_design("example:vh_catt_17x23")
+    bad = vc.with_setting_errors(d, "pinion", {"blade_angle": 0.04, "convex.blade_angle": 0.01,
+                                               "cutter_radius": 3.0, "blade_offset": -0.5})
+    a, b = vc.member_fields(d, "pinion"), vc.member_fields(bad, "pinion")
+    change = {k: b[k] - a[k] for k in a}
+    expect = {"convex.blade_angle": 0.05, "concave.blade_angle": 0.04, "cutter_radius": 3.0,
+              "blade_offset": -0.5}
+    for k, v in expect.items():
+        assert change[k] == pytest.approx(v, abs=1e-9), (k, change[k])
+    assert vc.member_fields(bad, "gear") == vc.member_fields(d, "gear")
+    with pytest.raises(ValueError, match="convex.cutter_radius"):
+        vc.with_setting_errors(d, "pinion", {"convex.cutter_radius": 1.0})
