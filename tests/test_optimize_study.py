@@ -51,6 +51,8 @@ def test_sliding_study_converges_on_the_tooth_form_limit(sliding_run):
     d = gj.load_design(str(out / "spur_sliding_optimised.toml"))
     assert float(d.design.pair.x1) == pytest.approx(v["pair.x1"]["end"], rel=1e-12)
     assert d.data["design"]["name"] == "khk_spur_12x24_optimised"
+    assert d.data["design"]["description"].endswith(
+        "; the end design of study spur_sliding (gearjax optimize)")
     assert (out / "spur_sliding.png").stat().st_size > 10_000
 
 

@@ -238,7 +238,11 @@ def _run(study, out, args) -> int:
                 f"{name} ({'accepted' if result.accepted else 'NOT accepted'})\n")
         data = dict(result.end_data)
         des = dict(data.get("design", {}))
-        data["design"] = dict(des, name=f"{des.get('name', name)}_optimised")
+        # the start's description no longer describes the file ("unmodified", ...)
+        desc = des.get("description", des.get("name", name))
+        data["design"] = dict(des, name=f"{des.get('name', name)}_optimised",
+                              description=f"{desc}; the end design of study {name} "
+                                          f"(gearjax optimize)")
         atomic_write(path, head + dumps_toml(data))
         files["design"] = path
     if not args.no_plot:
