@@ -207,6 +207,20 @@ def test_refusals_at_set_up(tmp_path, old, new, match):
         sr.set_up(st)
 
 
+def test_sweep_runs_the_kinematics_study(run):
+    from gearjax.studies.sweep import run_sweep, set_up_sweep
+    prob, res = run
+    sp = set_up_sweep(prob.study)
+    U = np.array([np.zeros(3), prob.upper, [-0.5, 0.2, 0.1]])
+    r = run_sweep(sp, U, chunk=4)
+    assert r.ok.all() and r.flags["converged"].all() and not r.flags["edge_contact"].any()
+    idx = [sp.study.quantities.index(q) for q in prob.study.quantities]
+    # row 0 is the start, row 1 the corner where the optimiser ended (the upper bounds)
+    np.testing.assert_allclose(r.values[0][:, idx], np.asarray(res.start[0]), rtol=1e-10)
+    assert np.allclose(res.u, prob.upper)
+    np.testing.assert_allclose(r.values[1][:, idx], np.asarray(res.end[0]), rtol=1e-10)
+
+
 def test_packaged_study_and_quantity_list(capsys):
     st = read_study("example:hypoid_cutter_radius")
     assert st.route == "kinematics" and st.kinematics == {"flank": "convex", "grid": (9, 7)}
