@@ -161,6 +161,51 @@ def test_written_design_round_trips(run):
         float(np.asarray(res.end[0])[0, qi["kin_mean_r_eff_mm"]]), rel=1e-10)
 
 
+def test_round_trip_at_an_interior_radius(run):
+    from gearjax.studies.kinematics_route import kinematics_round_trip
+    prob = run[0]
+    r0 = 101.23456789012
+    data, err, diff = kinematics_round_trip(prob, {"cutter_radius": jnp.asarray(r0),
+                                                   "blade_angle_delta": jnp.asarray(0.01),
+                                                   "cutter_shift": jnp.asarray(1.5)})
+    assert err is None and diff < 1e-12
+    assert float(design_from_dict(data).blank_input().cutter_radius) == pytest.approx(
+        r0, rel=1e-14)
+    assert prob.design.data["blank"]["cutter_radius_mm"] == 95.25      # start untouched
+    data, err, diff = kinematics_round_trip(prob, {"cutter_radius": jnp.asarray(-5.0)})
+    assert data is None and "cutter_radius" in err and diff == math.inf
+
+
+def test_quantities_on_synthetic_fields_match_the_plain_statistics():
+    """Each kin_* quantity against cutter_radius._stats on fields whose eigenfunctions
+    are negative at the grid centre (the pitch-point sign normalisation) and whose SRR
+    has its largest magnitude at a negative value."""
+    from types import SimpleNamespace
+
+    from gearjax.studies.kinematics_route import KIN_QUANTITIES, KinematicsResult
+    rng = np.random.default_rng(3)
+    shape = (9, 7)
+    f = SimpleNamespace(**{k: jnp.asarray(rng.normal(size=shape)) for k in
+                           ("srr", "u_e", "phi_I", "phi_II")},
+                        r_eff=jnp.asarray(rng.uniform(2.0, 30.0, size=shape)))
+    f.phi_I = -jnp.abs(f.phi_I) - 0.5
+    f.phi_II = f.phi_II.at[4, 3].set(-2.0)
+    f.srr = f.srr.at[0, 0].set(-5.0)
+    plain = hk._stats(f)
+    res = KinematicsResult(f, jnp.asarray(1.0), jnp.asarray(0.0))
+    n = 63
+    for q, (name, t, sense) in PLAIN.items():
+        v, ref = float(KIN_QUANTITIES[q].fn(res, None, None, None)), float(plain[name])
+        if sense == 2:
+            assert ref - 1e-12 <= v <= ref + t * math.log(2 * n), q
+        else:
+            assert ref - t * math.log(n) <= v <= ref + 1e-12, q
+    assert float(plain["min_phi_I"]) > 0.0 and float(plain["max_abs_srr"]) == 5.0
+    for q, name in MEANS.items():
+        assert float(KIN_QUANTITIES[q].fn(res, None, None, None)) == pytest.approx(
+            float(plain[name]), rel=1e-12), q
+
+
 BASE = STUDY.split("[[objective]]")[0] + '[[objective]]\nquantity = "kin_max_abs_srr"\n'
 
 
