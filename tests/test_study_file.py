@@ -132,7 +132,7 @@ def test_duplicate_variable_and_unknown_field(tmp_path):
 def test_packaged_studies_read():
     names = list_studies()
     assert {"spur_efficiency", "hypoid_efficiency_te", "preset_bevel_robust_kappa",
-            "vh_catt_cutter_radius"} <= set(names)
+            "vh_catt_cutter_radius", "hypoid_cutter_radius"} <= set(names)
     scenarios = {"preset_bevel_robust_kappa": 4, "vh_catt_cutter_radius": 2,
                  "helical_microgeometry_robust": 12}
     for n in names:

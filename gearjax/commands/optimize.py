@@ -34,9 +34,11 @@ HISTORY_KEYS_DOC = """JSON keys of NAME_history.json:
   study, description, design, family, side   the study's [study] table (design as given)
   variables         per variable: field, unit ("field": the field's own mm/rad/-, or
                     "deg"), lower, upper, start, end (in that unit)
-  route             "tca" or "line" (the loaded line contact, micro-geometry variables)
+  route             "tca", "line" (the loaded line contact, micro-geometry variables) or
+                    "kinematics" (hypoid eigenfunction kinematics, cutter settings)
   scenarios         per scenario: torque_Nm, pinion_rpm, dE_mm, dP_mm, dG_mm, dSigma_deg
-                    (a line-contact study: torque_Nm, pinion_rpm, f_ma_um)
+                    (a line-contact study: torque_Nm, pinion_rpm, f_ma_um; a kinematics
+                    study: one empty scenario)
   edge_softening_mm the soft active set of the loaded chain (mm; 0: none)
   quantities        per quantity: unit, start and end (one value per scenario); loaded
                     quantities of a study with edge softening also start_hard_model and
@@ -55,7 +57,9 @@ HISTORY_KEYS_DOC = """JSON keys of NAME_history.json:
   checks            accepted, reasons (why not), round_trip_difference (largest
                     |field| difference of the design file read back), flags_start and
                     flags_end (TCA quality flags per scenario; n_valid for loaded studies;
-                    a line-contact study: converged, n_valid of the mesh positions)
+                    a line-contact study: converged, n_valid of the mesh positions; a
+                    kinematics study: converged, blank_converged, n_valid of the grid
+                    points, max_residual of the meshing equation)
   seconds           wall time of the run
   files             design, history, figure: the paths written (null: not written)
 """
@@ -94,7 +98,8 @@ def _list(args) -> int:
             print(f"{name:34s} {st.description}")
     if args.quantities:
         for q, d in QUANTITIES.items():
-            kind = "line" if d.route == "line" else ("loaded" if d.loaded else "TCA")
+            kind = {"line": "line", "kinematics": "kin"}.get(
+                d.route, "loaded" if d.loaded else "TCA")
             t = "" if d.temperature is None else f" [smooth, T = {d.temperature:g}]"
             print(f"{q:22s} {d.unit or '-':7s} {kind:6s} {d.description}{t}")
     return 0
@@ -108,6 +113,9 @@ def _fields(study) -> int:
     if study.route == "line":
         from gearjax.studies.line_route import line_chain
         pair = line_chain(design, study).pair
+    elif study.route == "kinematics":
+        from gearjax.studies.kinematics_route import kinematics_chain
+        pair = kinematics_chain(design, study).pair
     else:
         pair = gj.tca_function(design, side=study.side).pair
     for name, v in gj.get_fields(pair).items():
@@ -158,8 +166,10 @@ def _table(rep) -> str:
 def _figure(prob, rep, result):
     """The study's figure (:mod:`gearjax.plot.study`): that of the TCA route, or for a
     line-contact study the loaded TE against torque and the end pinion flank's
-    modification map."""
+    modification map; for a kinematics study the history, quantities and variables."""
     from gearjax.plot import study as plot
+    if prob.route == "kinematics":
+        return plot.kinematics_study_figure(rep)
     if prob.route != "line":
         return plot.study_figure(rep, result.start, result.end, prob.data.mask[0])
     flank = sweep = None
@@ -236,6 +246,14 @@ def _run(study, out, args) -> int:
         path = os.path.join(out, f"{name}_optimised.toml")
         head = (f"# written by gearjax optimize {study.source}: the end design of study "
                 f"{name} ({'accepted' if result.accepted else 'NOT accepted'})\n")
+        if prob.route == "kinematics":
+            # the machine settings are no design-file fields: a comment, as in the history
+            from gearjax.studies.kinematics_route import KIN_FIELDS
+            unit = {v["field"]: "deg" if v["unit"] == "deg" else KIN_FIELDS[v["field"]][2]
+                    for v in rep["variables"]}
+            head += "".join(f"# study setting (not a design field): {v['field']} = "
+                            f"{v['end']:.10g} {unit[v['field']]}\n" for v in rep["variables"]
+                            if v["field"] != "cutter_radius")
         data = dict(result.end_data)
         des = dict(data.get("design", {}))
         # the start's description no longer describes the file ("unmodified", ...)

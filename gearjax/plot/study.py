@@ -11,7 +11,7 @@ import numpy as np
 from gearjax.plot.style import MIN_WIDTH_IN, report_style, te_axis_limits
 from gearjax.tca.path import ARCSEC
 
-__all__ = ["study_figure", "line_study_figure", "sweep_figure"]
+__all__ = ["study_figure", "line_study_figure", "kinematics_study_figure", "sweep_figure"]
 
 
 def _history(ax, hist, title, start=None):
@@ -186,6 +186,35 @@ def line_study_figure(report: dict, flank_map=None, flank_label: str = "pinion f
         else:
             ax[1, 0].set_visible(False)
         _variables(ax[1, 1], report["variables"])
+        fig.tight_layout()
+    return fig
+
+
+def kinematics_study_figure(report: dict):
+    """The figure of a kinematics study (:mod:`gearjax.studies.kinematics_route`): the
+    history, each quantity's end value over its start value, and the variables."""
+    from gearjax.plot import headless
+    headless()
+    import matplotlib.pyplot as plt
+
+    with report_style():
+        fig, ax = plt.subplots(1, 3, figsize=(max(MIN_WIDTH_IN, 15.0), 4.5))
+        opt = report["optimizer"]
+        _history(ax[0], report["history"],
+                 f"{report['study']}\n{opt['method']}, {opt['iterations']} iterations",
+                 (report["objective"]["start"], report["max_violation"]["start"]))
+        qs = report["quantities"]
+        names = list(qs)
+        ratio = [qs[q]["end"][0] / qs[q]["start"][0] if qs[q]["start"][0] else np.nan
+                 for q in names]
+        y = np.arange(len(names))
+        ax[1].barh(y, ratio, color="C0", height=0.5)
+        ax[1].axvline(1.0, color="k", lw=0.8)
+        ax[1].set_yticks(y, names)
+        ax[1].set_xlabel("end / start")
+        ax[1].set_title("quantities")
+        ax[1].grid(True, axis="x", lw=0.3, alpha=0.6)
+        _variables(ax[2], report["variables"])
         fig.tight_layout()
     return fig
 

@@ -50,7 +50,8 @@ from gearjax.tca.path import ARCSEC
 
 __all__ = ["Quantity", "QUANTITIES", "smooth_max", "smooth_min", "te_ptp_continuous",
            "quantity_values",
-           "needs_loaded", "uses_mask", "start_mask", "route_of", "LINE_QUANTITIES"]
+           "needs_loaded", "uses_mask", "start_mask", "route_of", "LINE_QUANTITIES",
+           "KIN_QUANTITIES"]
 
 
 def smooth_max(q, mask, temperature):
@@ -79,7 +80,9 @@ class Quantity(NamedTuple):
     TCA and the point-contact loaded chain) or ``"line"`` (the loaded line contact of
     involute pairs with micro-geometry, :mod:`gearjax.studies.line_route`: ``res`` a
     :class:`~gearjax.gears.involute.line_load.LineLoad`, ``eff`` a
-    :class:`~gearjax.gears.involute.line_efficiency.LineEfficiency` or None); a study
+    :class:`~gearjax.gears.involute.line_efficiency.LineEfficiency` or None) or
+    ``"kinematics"`` (the eigenfunction kinematics of a hypoid flank,
+    :mod:`gearjax.studies.kinematics_route`: ``res`` a ``KinematicsResult``); a study
     uses one route."""
 
     unit: str
@@ -394,11 +397,18 @@ LINE_QUANTITIES = {
 }
 QUANTITIES.update(LINE_QUANTITIES)
 
+# the eigenfunction kinematics of a hypoid flank (route "kinematics",
+# gearjax.studies.kinematics_route; imported here, after Quantity, which it uses)
+from gearjax.studies.kinematics_route import KIN_QUANTITIES  # noqa: E402
+
+QUANTITIES.update(KIN_QUANTITIES)
+
 
 def route_of(names) -> str:
-    """The route of the quantities ``names`` (``"tca"`` or ``"line"``; all of one route,
-    which :func:`gearjax.studies.study_file.read_study` has checked)."""
-    return "line" if any(QUANTITIES[n].route == "line" for n in names) else "tca"
+    """The route of the quantities ``names`` (``"tca"``, ``"line"`` or ``"kinematics"``;
+    all of one route, which :func:`gearjax.studies.study_file.read_study` has checked)."""
+    routes = {QUANTITIES[n].route for n in names}
+    return next((r for r in ("line", "kinematics") if r in routes), "tca")
 
 
 def needs_loaded(names) -> bool:

@@ -15,6 +15,8 @@ full text with examples)::
     [tca]          optional TCA grid: steps_per_pitch, half_pitches, n_pairs
     [line]         optional, a line-contact study: positions (per base pitch, default
                    24), slices (face-width slices, default 12)
+    [kinematics]   optional, a kinematics study: flank ("convex" | "concave"), grid =
+                   [depth, face] points (default [9, 7]); no [scenarios]/[operating]
     [[variables]]  field (a field of the design's pair, ``gearjax optimize STUDY
                    --fields`` lists them; a line-contact study: a micro-geometry field
                    ``microgeometry.TABLE.KEY`` as in the design file's tables,
@@ -34,7 +36,10 @@ full text with examples)::
 **Routes.**  The quantities of a study are of one route (``Quantity.route``): the
 unloaded TCA and its point-contact loaded chain (``"tca"``), or the loaded line contact
 of an involute pair with micro-geometry (``"line"``: the ``line_*`` quantities,
-micro-geometry variables, the ``f_ma_um`` scenarios); a study that mixes them, or whose
+micro-geometry variables, the ``f_ma_um`` scenarios), or the eigenfunction kinematics
+of a hypoid flank (``"kinematics"``: the ``kin_*`` quantities, the cutter settings as
+variables, one implicit scenario, :mod:`gearjax.studies.kinematics_route`); a study
+that mixes them, or whose
 variables do not belong to its route, is refused naming the entry.
 
 Every entry is checked before any work; a bad one is a one-line ``ValueError`` naming
@@ -143,10 +148,12 @@ class Study:
     sweep: dict = field(default_factory=dict)
     #: the ``[line]`` table of a line-contact study (positions, slices; defaults filled)
     line: dict = field(default_factory=dict)
+    #: the ``[kinematics]`` table of a kinematics study (flank, grid; defaults filled)
+    kinematics: dict = field(default_factory=dict)
 
     @property
     def route(self) -> str:
-        """``"tca"`` or ``"line"`` (module docstring)."""
+        """``"tca"``, ``"line"`` or ``"kinematics"`` (module docstring)."""
         from gearjax.studies.quantities import route_of
         return route_of([t.quantity for t in self.objective]
                         + [c.quantity for c in self.constraints])
@@ -340,7 +347,8 @@ def _one_route(objective, constraints) -> str:
     first = QUANTITIES[entries[0][1]].route
     for where, q in entries[1:]:
         if QUANTITIES[q].route != first:
-            names = {"tca": "TCA", "line": "loaded line-contact"}
+            names = {"tca": "TCA", "line": "loaded line-contact",
+                     "kinematics": "eigenfunction kinematics"}
             raise ValueError(f"{where}: quantity {q!r} is of the {names[QUANTITIES[q].route]} "
                              f"route, [[objective]] 1 ({entries[0][1]!r}) of the "
                              f"{names[first]} route: a study uses one route")
@@ -349,10 +357,23 @@ def _one_route(objective, constraints) -> str:
 
 def _check_variable_routes(variables, route: str, side: str) -> None:
     """Micro-geometry fields in a line-contact study only, and only those there (their
-    form checked: :func:`gearjax.studies.line_route.micro_field`)."""
+    form checked: :func:`gearjax.studies.line_route.micro_field`); the cutter settings
+    in a kinematics study only, and only those there
+    (:func:`gearjax.studies.kinematics_route.check_field`)."""
+    from gearjax.studies.kinematics_route import KIN_FIELDS, check_field
     from gearjax.studies.line_route import MICRO_PREFIX, micro_field
     for i, v in enumerate(variables):
         w = f"[[variables]] {i + 1}"
+        if route == "kinematics" or v.field in KIN_FIELDS:
+            if route != "kinematics":
+                raise ValueError(f"{w}: field {v.field!r} is a cutter setting of the "
+                                 "eigenfunction kinematics: use its quantities (kin_*, "
+                                 "gearjax optimize --quantities)")
+            try:
+                check_field(v.field, v.unit)
+            except ValueError as exc:
+                raise ValueError(f"{w}: {exc}") from None
+            continue
         micro = v.field.startswith(MICRO_PREFIX)
         if micro and route != "line":
             raise ValueError(f"{w}: the micro-geometry field {v.field!r} is analysed by the "
@@ -377,7 +398,7 @@ def _line_table(data, route: str, op: dict, scenarios: dict) -> dict:
     if route != "line":
         if "line" in data:
             raise ValueError("[line]: the line-contact model's options, but the study's "
-                             "quantities are of the TCA route")
+                             f"quantities are of the {route} route")
         return {}
     if "tca" in data:
         raise ValueError("[tca]: the TCA grid, but the study's quantities are of the "
@@ -392,6 +413,33 @@ def _line_table(data, route: str, op: dict, scenarios: dict) -> dict:
     check_keys("line", ln, set(LINE_DEFAULTS))
     return {k: check_integer("line", k, ln.get(k, d), 4 if k == "positions" else 1)
             for k, d in LINE_DEFAULTS.items()}
+
+
+def _kinematics_table(data, route: str) -> dict:
+    """The ``[kinematics]`` table (defaults
+    :data:`gearjax.studies.kinematics_route.KIN_DEFAULTS`); a kinematics study has one
+    implicit scenario and no operating point, TCA or line-contact options."""
+    from gearjax.studies.kinematics_route import KIN_DEFAULTS
+    if route != "kinematics":
+        if "kinematics" in data:
+            raise ValueError("[kinematics]: the eigenfunction model's options, but the study's "
+                             f"quantities are of the {route} route")
+        return {}
+    for key in ("scenarios", "operating", "tca", "line"):
+        if key in data:
+            raise ValueError(f"[{key}]: a kinematics study (kin_* quantities) has one "
+                             "implicit scenario and no operating point; remove the table")
+    kt = data.get("kinematics", {})
+    check_keys("kinematics", kt, set(KIN_DEFAULTS))
+    flank = check_string("kinematics", "flank", kt.get("flank", KIN_DEFAULTS["flank"]),
+                         ("convex", "concave"))
+    grid = kt.get("grid", list(KIN_DEFAULTS["grid"]))
+    if not (isinstance(grid, list) and len(grid) == 2):
+        raise ValueError(f"[kinematics] grid = {grid!r} must be [depth, face] points")
+    g = tuple(check_integer("kinematics", f"grid[{i}]", x, 3) for i, x in enumerate(grid))
+    if max(g) > 201:
+        raise ValueError(f"[kinematics] grid = {list(g)}: at most 201 points each way")
+    return {"flank": flank, "grid": g}
 
 
 def _design_source(design: str, base) -> str:
@@ -411,7 +459,7 @@ def read_study(source) -> Study:
     except ValueError as exc:      # the reader speaks of design files
         raise ValueError(str(exc).replace("design file", "study file")) from None
     check_keys("", data, {"study", "operating", "scenarios", "tca", "variables", "objective",
-                          "constraints", "optimizer", "sweep", "line"})
+                          "constraints", "optimizer", "sweep", "line", "kinematics"})
     st = require_key("", data, "study")
     check_keys("study", st, {"name", "description", "design", "side"})
     name = check_string("study", "name", require_key("study", st, "name"))
@@ -434,6 +482,7 @@ def read_study(source) -> Study:
     constraints = [_constraint(i + 1, e) for i, e in enumerate(_entries(data, "constraints"))]
     route = _one_route(objective, constraints)
     _check_variable_routes(variables, route, side)
+    kinematics = _kinematics_table(data, route)
     names = [t.quantity for t in objective] + [c.quantity for c in constraints]
     if uses_mask(names) and not any(c.quantity == "min_margin_mm" and c.lower is not None
                                     for c in constraints):
@@ -459,7 +508,7 @@ def read_study(source) -> Study:
     return Study(name=name, design=design, side=side, variables=variables,
                  objective=objective, constraints=tuple(constraints),
                  description=check_string("study", "description", st.get("description", "")),
-                 operating=op, scenarios=scenarios, line=line,
+                 operating=op, scenarios=scenarios, line=line, kinematics=kinematics,
                  tca={k: check_number("tca", k, v) for k, v in tca.items()}, method=method,
                  max_iterations=max_it, tolerance=tol, starts=starts,
                  seed=check_integer("optimizer", "seed", opt.get("seed", 0), 0),

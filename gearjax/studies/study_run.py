@@ -37,6 +37,12 @@ softening, the hard model's objective may not rise by more than the softened one
 scenario one loaded line contact (torque, mesh misalignment f_ma), the same scaled
 problem, optimisers and acceptance, with the line contact's own flags (every mesh
 position converged) and design-file write-back (the ``[microgeometry]`` tables).
+
+**The kinematics route** (the ``kin_*`` quantities, :mod:`gearjax.studies.
+kinematics_route`): the variables are the cutter settings of the [Eigenfunctions]
+cutter-radius study, one implicit scenario (the flank grid), the same problem,
+optimisers and acceptance with its own flags (the blank's and every grid point's Newton
+solve converged) and write-back (``[blank] cutter_radius_mm``).
 """
 
 from __future__ import annotations
@@ -99,7 +105,8 @@ class Problem:
     loaded: bool
     soft: float = 0.0          # edge softening of the loaded chain (mm)
     family: str = ""
-    route: str = "tca"         # "line": the loaded line contact (gearjax.studies.line_route)
+    route: str = "tca"         # "line": the loaded line contact (gearjax.studies.line_route),
+    #                            "kinematics": the eigenfunction kinematics (kinematics_route)
     data: Data = None
     evaluate_program: object = None
     fun: object = None
@@ -108,6 +115,8 @@ class Problem:
 
 def _scenario_list(study: Study) -> list:
     op = study.operating
+    if study.route == "kinematics":     # one implicit scenario
+        return [{}]
     base = {"torque_Nm": float(op.get("torque_Nm", 0.0)),
             "pinion_rpm": float(op.get("pinion_rpm", 0.0))}
     base.update({"f_ma_um": 0.0} if study.route == "line" else
@@ -141,6 +150,8 @@ def set_up(study: Study) -> Problem:
     design = gj.load_design(study.design)
     if study.route == "line":
         return _set_up_line(study, design)
+    if study.route == "kinematics":
+        return _set_up_kinematics(study, design)
     loaded = needs_loaded(study.quantities)
     tca = {k: (int(v) if k != "half_pitches" else float(v)) for k, v in study.tca.items()}
     if loaded:
@@ -220,19 +231,43 @@ def _variables(study: Study, pair0, canonical=None):
     return fields, np.array(x0), np.array(lo), np.array(hi), sc
 
 
+def _with_reported(study: Study, reported) -> Study:
+    """``study`` also reporting the quantities ``reported`` it does not already use."""
+    return dataclasses.replace(study, reported=study.reported + tuple(
+        q for q in reported if q not in study.quantities))
+
+
+def _set_up_chain(study: Study, design, chain, scen: list, family: str, mis_key,
+                  oil=None, surface=None) -> Problem:
+    """The problem of a study on a route's own chain (line contact, kinematics):
+    ``chain.pair`` the variables' pytree, ``chain.canonical`` the study's field names
+    there; ``mis_key`` the scenario column traced as ``Data.mis`` (None: the route has
+    none, the torque column stands in)."""
+    fields, x0, lo, hi, sc = _variables(study, chain.pair, chain.canonical)
+    prob = Problem(study, design, chain, fields, x0, lo, hi, scen, False, family=family,
+                   route=study.route)
+    col = {k: jnp.array([s.get(k, 0.0) for s in scen])
+           for k in ("torque_Nm", "pinion_rpm", *scen[0])}
+    return _finish(prob, chain.pair, sc, col, col[mis_key or "torque_Nm"], oil, surface)
+
+
 def _set_up_line(study: Study, design) -> Problem:
     """:func:`set_up` of a line-contact study (:mod:`gearjax.studies.line_route`)."""
     from gearjax.studies.line_route import REPORTED, check_line_scenarios, line_chain
-    study = dataclasses.replace(study, reported=study.reported + tuple(
-        q for q in REPORTED if q not in study.quantities))
+    study = _with_reported(study, REPORTED)
     chain = line_chain(design, study)
-    fields, x0, lo, hi, sc = _variables(study, chain.pair, chain.canonical)
     scen = _scenario_list(study)
     oil, surface = check_line_scenarios(chain, study, scen)
-    prob = Problem(study, design, chain, fields, x0, lo, hi, scen, False, family="involute",
-                   route="line")
-    col = {k: jnp.array([s[k] for s in scen]) for k in scen[0]}
-    return _finish(prob, chain.pair, sc, col, col["f_ma_um"], oil, surface)
+    return _set_up_chain(study, design, chain, scen, "involute", "f_ma_um", oil, surface)
+
+
+def _set_up_kinematics(study: Study, design) -> Problem:
+    """:func:`set_up` of a kinematics study (:mod:`gearjax.studies.kinematics_route`): one
+    implicit scenario."""
+    from gearjax.studies.kinematics_route import REPORTED, kinematics_chain
+    study = _with_reported(study, REPORTED)
+    chain = kinematics_chain(design, study)
+    return _set_up_chain(study, design, chain, _scenario_list(study), "hypoid", None)
 
 
 def evaluator(prob: Problem, hard: bool = False, own_mask: bool = False):
@@ -244,6 +279,9 @@ def evaluator(prob: Problem, hard: bool = False, own_mask: bool = False):
     if prob.route == "line":
         from gearjax.studies.line_route import line_evaluator
         return line_evaluator(prob)
+    if prob.route == "kinematics":
+        from gearjax.studies.kinematics_route import kinematics_evaluator
+        return kinematics_evaluator(prob)
     chain, names, loaded = prob.chain, list(prob.fields), prob.loaded
     qnames = prob.study.quantities
 
@@ -367,7 +405,7 @@ def start_point(prob: Problem):
     points at each scenario) from a first evaluation, then the quantities there and
     the default scales.  Both calls run one compiled program (same shapes)."""
     u0 = np.zeros(len(prob.fields))
-    if prob.route == "tca":      # the line route has no path mask
+    if prob.route == "tca":      # the line and kinematics routes have no path mask
         prob.data = prob.data._replace(mask=jnp.ones((len(prob.scenarios), grid_size(prob)),
                                                      bool))
     out = evaluate(prob, u0)
@@ -387,6 +425,9 @@ def scenario_flags(prob: Problem, res, eff) -> list:
     if prob.route == "line":
         from gearjax.studies.line_route import line_flags
         return [line_flags(res, eff, k) for k in range(len(prob.scenarios))]
+    if prob.route == "kinematics":
+        from gearjax.studies.kinematics_route import kinematics_flags
+        return [kinematics_flags(res, k) for k in range(len(prob.scenarios))]
     out = []
     for k in range(len(prob.scenarios)):
         fl = scenario_of(res, k).flags()
@@ -577,6 +618,9 @@ def _round_trip(prob: Problem, end_pair):
     if prob.route == "line":
         from gearjax.studies.line_route import line_round_trip
         return line_round_trip(prob, end_pair)
+    if prob.route == "kinematics":
+        from gearjax.studies.kinematics_route import kinematics_round_trip
+        return kinematics_round_trip(prob, end_pair)
     ad = family_of(prob.design)
     try:
         data = ad.design_data(prob.design, end_pair, prob.study.side)

@@ -67,7 +67,9 @@ FLAG_KEYS = ("converged", "edge_contact", "tip_contact", "face_end_contact",
 def set_up_sweep(study) -> Problem:
     """:func:`gearjax.studies.study_run.set_up` for a sweep: the loaded quantities with
     the hard model (``edge_softening_mm = 0``, that of ``gearjax efficiency``) -- the
-    soft active set exists for an optimiser's gradients, which a sweep does not take."""
+    soft active set exists for an optimiser's gradients, which a sweep does not take.
+    A kinematics study (:mod:`gearjax.studies.kinematics_route`) is swept as it is (one
+    scenario, its flags: converged; the TCA's other flags False)."""
     from gearjax.studies.study_run import set_up
     if study.route == "line":
         raise ValueError(f"[[objective]] 1 ({study.objective[0].quantity}): gearjax sweep "
@@ -216,7 +218,9 @@ def run_sweep(prob: Problem, U, chunk: int = 16, devices=None, progress=None) ->
         for i in range(k):
             one = scenario_flags(prob, scenario_of(res, i), None)
             for key in FLAG_KEYS:
-                flags[key].append([f[key] for f in one])
+                # a flag a route does not have (the line contact and the kinematics
+                # have no edge contact) is False
+                flags[key].append([f.get(key, False) for f in one])
         vals.append(Q)
         if eff_nv is not None:
             nval.append(eff_nv)
