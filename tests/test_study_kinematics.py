@@ -19,7 +19,7 @@ from gearjax.cli import main
 from gearjax.io import design_from_dict
 from gearjax.studies import cutter_radius as hk
 from gearjax.studies import study_run as sr
-from gearjax.studies.kinematics_route import KIN_PHI_T, KIN_R_EFF_T_MM, KIN_SRR_T
+from gearjax.studies.quantities import KIN_PHI_T, KIN_R_EFF_T_MM, KIN_SRR_T
 from gearjax.studies.study_file import read_study
 
 PLAIN = {"kin_max_abs_srr": ("max_abs_srr", KIN_SRR_T, 2),
@@ -182,7 +182,8 @@ def test_quantities_on_synthetic_fields_match_the_plain_statistics():
     has its largest magnitude at a negative value."""
     from types import SimpleNamespace
 
-    from gearjax.studies.kinematics_route import KIN_QUANTITIES, KinematicsResult
+    from gearjax.studies.kinematics_route import KinematicsResult
+    from gearjax.studies.quantities import KIN_QUANTITIES
     rng = np.random.default_rng(3)
     shape = (9, 7)
     f = SimpleNamespace(**{k: jnp.asarray(rng.normal(size=shape)) for k in

@@ -1161,6 +1161,14 @@ def build_cases() -> list[Case]:
         "the design fields of a study's design")
     add("optimize.ok.sliding", ["optimize", "example:spur_sliding", "--out", "{tmp}/o",
                                 "--no-plot"], "ok", "a packaged study, converged", heavy=True)
+    add("optimize.ok.microgeometry", ["optimize", "example:helical_microgeometry_robust",
+                                      "--out", "{tmp}/o"], "ok",
+        "the packaged line-contact study (micro-geometry), converged, with its figure",
+        heavy=True)
+    add("optimize.ok.cutter_radius", ["optimize", "example:hypoid_cutter_radius", "--out",
+                                      "{tmp}/o", "--no-plot"], "ok",
+        "the packaged eigenfunction-kinematics study (seed cutter radius), converged",
+        heavy=True)
     add("optimize.no_study", ["optimize"], "refuse", "STUDY missing")
     add("optimize.unknown_example", ["optimize", "example:nope"], "refuse",
         "unknown packaged study")

@@ -75,7 +75,8 @@ from gearjax.newton import newton_solve, with_value
 from gearjax.surfaces import curvature_in_direction, local_geometry
 
 __all__ = ["STUDY_BLANK", "STUDY_CUTTERS", "study_blank_input", "StudySettings",
-           "PitchSetup", "pitch_setup", "FlankFields", "point_fields", "flank_fields", "field_stats",
+           "PitchSetup", "pitch_setup", "FlankFields", "point_fields", "grid_fields",
+           "flank_fields", "field_stats",
            "euler_bertrand", "limit_report", "FIELDS", "conjugate_check", "grid_uv", "STAT_NAMES",
            "flank_statistics", "statistics_gradient", "cutter_radius_sweep", "study_statistics"]
 
@@ -390,14 +391,16 @@ def grid_uv(s: PitchSetup, shape, extend=1.0):
     return jnp.stack([U, T], axis=-1)
 
 
-def _fields(inp, settings, flank, shape, extend):
+def grid_fields(inp, settings, flank, shape, extend):
+    """``(PitchSetup, FlankFields)`` over a ``shape`` grid of the flank (traceable in
+    ``settings``; the un-jitted core of :func:`flank_fields`)."""
     s = pitch_setup(inp, settings, flank)
     uv = grid_uv(s, shape, extend)
     f = jax.vmap(jax.vmap(partial(point_fields, s)))(uv)
     return s, f
 
 
-_fields_jit = jax.jit(_fields, static_argnums=(0, 2, 3, 4))
+_fields_jit = jax.jit(grid_fields, static_argnums=(0, 2, 3, 4))
 
 
 def flank_fields(inp: BlankInput, settings: StudySettings, flank: str = "convex",
@@ -503,7 +506,7 @@ def _stats(f: FlankFields):
 def study_statistics(inp, settings, flank, shape):
     """:data:`STAT_NAMES` of the flank fields on a ``shape`` grid (traceable in
     ``settings``; the un-jitted core of :func:`flank_statistics`)."""
-    return _stats(_fields(inp, settings, flank, shape, 1.0)[1])
+    return _stats(grid_fields(inp, settings, flank, shape, 1.0)[1])
 
 
 _stats_jit = jax.jit(study_statistics, static_argnums=(0, 2, 3))

@@ -23,7 +23,8 @@ blade, drive side; "concave") and ``grid = [depth, face]`` points (each 3..201).
 A kinematics study has one implicit scenario: it takes no ``[scenarios]``,
 ``[operating]``, ``[tca]`` or ``[line]`` table.
 
-**Quantities** (route ``"kinematics"``, :data:`KIN_QUANTITIES`; ``n`` = grid points):
+**Quantities** (route ``"kinematics"``, :data:`gearjax.studies.quantities.KIN_QUANTITIES`;
+``n`` = grid points):
 the extrema are smooth, ``smooth_max(q) = T log sum exp(q/T)`` (above the grid maximum by
 at most ``T ln n``) and ``smooth_min = -smooth_max(-q)``:
 
@@ -61,8 +62,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-__all__ = ["KIN_FIELDS", "KIN_DEFAULTS", "KIN_QUANTITIES", "KIN_SRR_T", "KIN_R_EFF_T_MM",
-           "KIN_PHI_T", "REPORTED", "KinematicsResult", "KinematicsChain", "kinematics_chain",
+__all__ = ["KIN_FIELDS", "KIN_DEFAULTS", "REPORTED", "KinematicsResult", "KinematicsChain", "kinematics_chain",
            "kinematics_evaluator", "kinematics_flags", "kinematics_round_trip", "check_field"]
 
 _DEG = math.pi / 180.0
@@ -72,10 +72,6 @@ KIN_FIELDS = {"cutter_radius": (20.0, 400.0, "mm"),
               "cutter_shift": (-20.0, 20.0, "mm")}
 #: the ``[kinematics]`` table's keys and defaults (gear flank, grid depth x face points)
 KIN_DEFAULTS = {"flank": "convex", "grid": (9, 7)}
-#: temperatures of the smooth extrema: SRR (-), effective radius (mm), eigenfunctions (-)
-KIN_SRR_T = 0.002
-KIN_R_EFF_T_MM = 0.02
-KIN_PHI_T = 0.01
 #: quantities every kinematics study reports (the plain grid extremes' smooth versions)
 REPORTED = ("kin_max_abs_srr", "kin_min_r_eff_mm", "kin_min_phi_I", "kin_min_phi_II")
 
@@ -120,10 +116,10 @@ class KinematicsChain:
         return name
 
     def __call__(self, tree) -> KinematicsResult:
-        from gearjax.studies.cutter_radius import StudySettings, _fields
+        from gearjax.studies.cutter_radius import StudySettings, grid_fields
         st = StudySettings(tree["cutter_radius"], tree["blade_angle_delta"],
                            tree["cutter_shift"])
-        s, f = _fields(self.inp, st, self.flank, self.grid, 1.0)
+        s, f = grid_fields(self.inp, st, self.flank, self.grid, 1.0)
         return KinematicsResult(f, jnp.asarray(s.blank["converged"], jnp.float64),
                                 jnp.asarray(s.blank["residual"], jnp.float64))
 
@@ -197,72 +193,3 @@ def kinematics_round_trip(prob, end_tree):
     except ValueError as exc:
         return None, str(exc), math.inf
     return data, None, abs(got - r0)
-
-
-# --------------------------------------------------------------------------- quantities
-
-def _abs_srr(res):
-    s = jnp.ravel(res.f.srr)
-    return jnp.concatenate([s, -s])
-
-
-def _normed(res, name):
-    """The eigenfunction ``name`` times its sign at the grid centre (the pitch point)."""
-    a = getattr(res.f, name)
-    c = tuple(n // 2 for n in a.shape)
-    return jnp.ravel(jax.lax.stop_gradient(jnp.sign(a[c])) * a)
-
-
-def _all(x):
-    return jnp.ones(x.shape, bool)
-
-
-def _smax(x, t):
-    from gearjax.studies.quantities import smooth_max
-    return smooth_max(x, _all(x), t)
-
-
-def _smin(x, t):
-    from gearjax.studies.quantities import smooth_min
-    return smooth_min(x, _all(x), t)
-
-
-def _quantities():
-    from gearjax.studies.quantities import Quantity
-
-    def q(unit, t, text, fn):
-        return Quantity(unit, False, False, t, text, lambda res, eff, mask, pair: fn(res),
-                        route="kinematics")
-
-    return {
-        "kin_max_abs_srr": q(
-            "", KIN_SRR_T, "hypoid eigenfunction kinematics: largest |SRR| over the working "
-            "gear flank grid (smooth max, <= max + T ln 2n)",
-            lambda r: _smax(_abs_srr(r), KIN_SRR_T)),
-        "kin_mean_abs_srr": q(
-            "", None, "hypoid eigenfunction kinematics: mean |SRR| over the flank grid",
-            lambda r: jnp.mean(jnp.abs(r.f.srr))),
-        "kin_min_r_eff_mm": q(
-            "mm", KIN_R_EFF_T_MM, "hypoid eigenfunction kinematics: smallest effective "
-            "radius R_eff over the flank grid (smooth min, >= min - T ln n)",
-            lambda r: _smin(jnp.ravel(r.f.r_eff), KIN_R_EFF_T_MM)),
-        "kin_mean_r_eff_mm": q(
-            "mm", None, "hypoid eigenfunction kinematics: mean effective radius over the grid",
-            lambda r: jnp.mean(r.f.r_eff)),
-        "kin_mean_abs_u_e": q(
-            "mm/rad", None, "hypoid eigenfunction kinematics: mean |entrainment velocity| "
-            "(per rad of pinion roll) over the grid",
-            lambda r: jnp.mean(jnp.abs(r.f.u_e))),
-        "kin_min_phi_I": q(
-            "", KIN_PHI_T, "hypoid eigenfunction kinematics: smallest Phi_I (meshing limit) "
-            "over the grid, times its pitch-point sign (> 0: limit off the flank; smooth min)",
-            lambda r: _smin(_normed(r, "phi_I"), KIN_PHI_T)),
-        "kin_min_phi_II": q(
-            "", KIN_PHI_T, "hypoid eigenfunction kinematics: smallest Phi_II (curvature "
-            "interference) over the grid, times its pitch-point sign (smooth min)",
-            lambda r: _smin(_normed(r, "phi_II"), KIN_PHI_T)),
-    }
-
-
-#: the quantities of the eigenfunction kinematics (route "kinematics"; module docstring)
-KIN_QUANTITIES = _quantities()

@@ -51,7 +51,7 @@ from gearjax.tca.path import ARCSEC
 __all__ = ["Quantity", "QUANTITIES", "smooth_max", "smooth_min", "te_ptp_continuous",
            "quantity_values",
            "needs_loaded", "uses_mask", "start_mask", "route_of", "LINE_QUANTITIES",
-           "KIN_QUANTITIES"]
+           "KIN_QUANTITIES", "KIN_SRR_T", "KIN_R_EFF_T_MM", "KIN_PHI_T"]
 
 
 def smooth_max(q, mask, temperature):
@@ -397,10 +397,70 @@ LINE_QUANTITIES = {
 }
 QUANTITIES.update(LINE_QUANTITIES)
 
-# the eigenfunction kinematics of a hypoid flank (route "kinematics",
-# gearjax.studies.kinematics_route; imported here, after Quantity, which it uses)
-from gearjax.studies.kinematics_route import KIN_QUANTITIES  # noqa: E402
+#: temperatures of the eigenfunction kinematics' smooth extrema: SRR (-), effective radius
+#: (mm), eigenfunctions (-)
+KIN_SRR_T = 0.002
+KIN_R_EFF_T_MM = 0.02
+KIN_PHI_T = 0.01
 
+
+def _kin_abs_srr(res):
+    """``[SRR, -SRR]`` over the grid: the smooth maximum of both is that of |SRR|."""
+    s = jnp.ravel(res.f.srr)
+    return jnp.concatenate([s, -s])
+
+
+def _kin_normed(res, name):
+    """The eigenfunction ``name`` times its sign at the grid centre (the pitch point)."""
+    a = getattr(res.f, name)
+    c = tuple(n // 2 for n in a.shape)
+    return jnp.ravel(jax.lax.stop_gradient(jnp.sign(a[c])) * a)
+
+
+def _kin_smax(x, t):
+    return smooth_max(x, jnp.ones(x.shape, bool), t)
+
+
+def _kin_smin(x, t):
+    return smooth_min(x, jnp.ones(x.shape, bool), t)
+
+
+def _kin(unit, t, text, fn):
+    return Quantity(unit, False, False, t, text, lambda res, eff, mask, pair: fn(res),
+                    route="kinematics")
+
+
+#: the quantities of the eigenfunction kinematics of a hypoid flank (route "kinematics",
+#: :mod:`gearjax.studies.kinematics_route`: ``res`` a ``KinematicsResult`` whose ``f`` are
+#: the flank fields of :mod:`gearjax.studies.cutter_radius` over the grid)
+KIN_QUANTITIES = {
+    "kin_max_abs_srr": _kin(
+        "", KIN_SRR_T, "hypoid eigenfunction kinematics: largest |SRR| over the working "
+        "gear flank grid (smooth max, <= max + T ln 2n)",
+        lambda r: _kin_smax(_kin_abs_srr(r), KIN_SRR_T)),
+    "kin_mean_abs_srr": _kin(
+        "", None, "hypoid eigenfunction kinematics: mean |SRR| over the flank grid",
+        lambda r: jnp.mean(jnp.abs(r.f.srr))),
+    "kin_min_r_eff_mm": _kin(
+        "mm", KIN_R_EFF_T_MM, "hypoid eigenfunction kinematics: smallest effective "
+        "radius R_eff over the flank grid (smooth min, >= min - T ln n)",
+        lambda r: _kin_smin(jnp.ravel(r.f.r_eff), KIN_R_EFF_T_MM)),
+    "kin_mean_r_eff_mm": _kin(
+        "mm", None, "hypoid eigenfunction kinematics: mean effective radius over the grid",
+        lambda r: jnp.mean(r.f.r_eff)),
+    "kin_mean_abs_u_e": _kin(
+        "mm/rad", None, "hypoid eigenfunction kinematics: mean |entrainment velocity| "
+        "(per rad of pinion roll) over the grid",
+        lambda r: jnp.mean(jnp.abs(r.f.u_e))),
+    "kin_min_phi_I": _kin(
+        "", KIN_PHI_T, "hypoid eigenfunction kinematics: smallest Phi_I (meshing limit) "
+        "over the grid, times its pitch-point sign (> 0: limit off the flank; smooth min)",
+        lambda r: _kin_smin(_kin_normed(r, "phi_I"), KIN_PHI_T)),
+    "kin_min_phi_II": _kin(
+        "", KIN_PHI_T, "hypoid eigenfunction kinematics: smallest Phi_II (curvature "
+        "interference) over the grid, times its pitch-point sign (smooth min)",
+        lambda r: _kin_smin(_kin_normed(r, "phi_II"), KIN_PHI_T)),
+}
 QUANTITIES.update(KIN_QUANTITIES)
 
 
