@@ -277,3 +277,43 @@ def test_packaged_study_and_quantity_list(capsys):
     out = capsys.readouterr().out
     for q in list(PLAIN) + list(MEANS):
         assert q in out
+
+
+def test_concave_flank_is_the_concave_flanks_statistics(tmp_path):
+    """``[kinematics] flank = "concave"``: the study's quantities are those of the concave
+    gear flank (flank_statistics of that flank), which differ from the convex one's."""
+    text = STUDY.replace("grid = [9, 7]", 'grid = [5, 3]\nflank = "concave"')
+    prob = sr.set_up(read_study(_write(tmp_path, text)))
+    Q = np.asarray(sr.start_point(prob)[0])
+    inp = prob.design.blank_input()
+    st = _settings(prob.x0)
+    plain = {f: hk.flank_statistics(inp, st, f, (5, 3)) for f in ("concave", "convex")}
+    qi = {q: i for i, q in enumerate(prob.study.quantities)}
+    for q, name in MEANS.items():
+        assert float(Q[0, qi[q]]) == pytest.approx(float(plain["concave"][name]), rel=1e-10)
+    a, b = float(plain["concave"]["mean_abs_srr"]), float(plain["convex"]["mean_abs_srr"])
+    assert abs(a - b) > 1e-3 * abs(b), (a, b)
+
+
+def test_blank_failure_fails_the_acceptance_flags(monkeypatch):
+    """A design whose blank Newton solve did not converge is not "converged", even when
+    every grid point's solve did; and a blank without offset is refused (the model is for
+    hypoid pairs)."""
+    import dataclasses
+
+    from gearjax.studies.kinematics_route import (KinematicsResult, kinematics_chain,
+                                                  kinematics_flags)
+    conv = np.ones((1, 3, 2), bool)
+    f = hk.FlankFields(*([np.zeros((1, 3, 2))] * len(hk.FlankFields._fields)))
+    f = f._replace(converged=conv)
+    good = KinematicsResult(f, np.array([1.0]), np.array([0.0]))
+    assert kinematics_flags(good, 0)["converged"]
+    bad = kinematics_flags(good._replace(blank_converged=np.array([0.0])), 0)
+    assert not bad["converged"] and not bad["blank_converged"] and bad["n_valid"] == 6
+    d = gj.load_design("example:hypoid_6x39_7p5in")
+    inp0 = d.blank_input()
+    flat = dataclasses.replace(inp0, offset=jnp.asarray(0.0))
+
+    monkeypatch.setattr(type(d), "blank_input", lambda self: flat)
+    with pytest.raises(ValueError, match="blank.offset_mm must be > 0"):
+        kinematics_chain(d, read_study("example:hypoid_cutter_radius"))
