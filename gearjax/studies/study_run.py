@@ -30,7 +30,7 @@ GearFamily.design_data`) and read again through the family's loader, which valid
 file round-trips, and at every scenario the TCA converged without edge contact and (a
 loaded study) no fewer positions of the cycle are valid than at the start; with edge
 softening, the hard model's objective may not rise by more than the softened one's
-(:func:`acceptance_reasons`).
+(:func:`gearjax.studies.end_checks.acceptance_reasons`).
 
 **The line-contact route** (a study of the ``line_*`` quantities,
 :mod:`gearjax.studies.line_route`): the variables are micro-geometry fields, each
@@ -59,6 +59,8 @@ import numpy as np
 
 from gearjax.compile_ahead import FAST_COMPILE_OPTIONS
 from gearjax.fields import field_names, get_fields, with_fields, with_scaled_fields
+from gearjax.studies.end_checks import (acceptance_reasons, end_round_trip, quantities_report,
+                                        scenario_flags, scenario_of)
 from gearjax.studies.quantities import QUANTITIES, quantity_values, smooth_max
 from gearjax.studies.study_file import Constraint, Study
 from gearjax.tca.assembly import Misalignment
@@ -416,27 +418,6 @@ def start_point(prob: Problem):
     return out
 
 
-def scenario_of(tree, k):
-    return jax.tree_util.tree_map(lambda a: a[k], tree)
-
-
-def scenario_flags(prob: Problem, res, eff) -> list:
-    """Per scenario: the TCA's quality flags and (loaded) the number of valid positions."""
-    if prob.route == "line":
-        from gearjax.studies.line_route import line_flags
-        return [line_flags(res, eff, k) for k in range(len(prob.scenarios))]
-    if prob.route == "kinematics":
-        from gearjax.studies.kinematics_route import kinematics_flags
-        return [kinematics_flags(res, k) for k in range(len(prob.scenarios))]
-    out = []
-    for k in range(len(prob.scenarios)):
-        fl = scenario_of(res, k).flags()
-        if eff is not None:
-            fl["n_valid"] = int(np.asarray(eff.n_valid)[k])
-        out.append(fl)
-    return out
-
-
 def _random_starts(prob: Problem, n: int) -> np.ndarray:
     """``n`` start points: the design's own (0) and ``n - 1`` seeded uniform points in the
     bounds."""
@@ -571,72 +552,6 @@ def _run_al(prob: Problem, callback):
                                  "derivatives": kw["derivatives"]}
 
 
-def acceptance_reasons(opt: dict, feasibility: float, tol: float, file_error, difference,
-                       x, flags0: list, flags1: list, hard=None, soft=None) -> list:
-    """Why an end design is not accepted (empty: accepted; module docstring): the
-    optimiser's stopping test (``opt["converged"]``), the scaled constraint violation
-    against ``tol``, the design file (``file_error`` of the loader; ``difference`` of its
-    fields from the optimiser's ``x``, relative 1e-9), per scenario the TCA flags and
-    valid positions (``flags0``/``flags1`` at start/end), and ``hard = (J0, J1)``, the
-    objective with the hard model when the study softens the edges: it may not rise by
-    more than ``tol`` beyond the rise of the softened objective ``soft = (J0, J1)`` (none
-    given: beyond 0).  A start that violates a constraint may cost objective to reach
-    feasibility; the hard model must then agree with that cost, not exceed it."""
-    reasons = []
-    if not opt["converged"]:
-        reasons.append(f"the optimiser did not meet its stopping test ({opt['message']})")
-    if feasibility > tol:
-        reasons.append(f"constraints violated by {feasibility:.3g} (scaled; tolerance {tol:g})")
-    if file_error is not None:
-        reasons.append(f"the end design is refused by its design-file checks: {file_error}")
-    elif difference > 1e-9 * (1.0 + float(np.max(np.abs(x)))):
-        reasons.append(f"the design file does not reproduce the end design (field difference "
-                       f"{difference:.3g})")
-    allowed = 0.0 if soft is None else max(0.0, soft[1] - soft[0])
-    if hard is not None and hard[1] > hard[0] + allowed + tol:
-        reasons.append(f"with the hard model (no edge softening, as gearjax efficiency) the "
-                       f"objective rose {hard[0]:.6g} -> {hard[1]:.6g}"
-                       + ("" if soft is None else
-                          f" (softened: {soft[0]:.6g} -> {soft[1]:.6g})"))
-    for k, (a, b) in enumerate(zip(flags0, flags1)):
-        where = f"scenario {k + 1}"
-        if not b["converged"]:
-            reasons.append(f"{where}: the end design's TCA did not converge")
-        if b.get("edge_contact") and not a.get("edge_contact"):
-            reasons.append(f"{where}: the end design has edge contact")
-        if "n_valid" in b and b["n_valid"] < a["n_valid"]:
-            reasons.append(f"{where}: fewer valid positions of the cycle at the end "
-                           f"({b['n_valid']} < {a['n_valid']})")
-    return reasons
-
-
-def _round_trip(prob: Problem, end_pair):
-    """The end design written to a design file and read back through the family's
-    validating loader; ``(data, error or None, max |field difference|)``."""
-    from gearjax.io import design_from_dict
-    from gearjax.tca.result import family_of
-    if prob.route == "line":
-        from gearjax.studies.line_route import line_round_trip
-        return line_round_trip(prob, end_pair)
-    if prob.route == "kinematics":
-        from gearjax.studies.kinematics_route import kinematics_round_trip
-        return kinematics_round_trip(prob, end_pair)
-    ad = family_of(prob.design)
-    try:
-        data = ad.design_data(prob.design, end_pair, prob.study.side)
-        d2 = design_from_dict(data)
-    except ValueError as exc:
-        return None, str(exc), math.inf
-    back = ad.fam.user_pair(ad.fam.setup(d2, prob.study.side)[0])
-    a, b = get_fields(end_pair, prob.fields), get_fields(back, prob.fields)
-    diff = max(abs(float(np.asarray(a[n])) - float(np.asarray(b[n]))) for n in prob.fields)
-    return data, None, diff
-
-
-def _q_table(prob, Q):
-    return {q: np.asarray(Q)[:, i].tolist() for i, q in enumerate(prob.study.quantities)}
-
-
 def run_study(prob: Problem, callback=None, phase=None) -> StudyResult:
     """Run the study set up in ``prob`` (module docstring).  ``callback(k, J, feasibility,
     stationarity)`` per iteration (progress); ``phase(name)`` a context manager around
@@ -677,7 +592,7 @@ def run_study(prob: Problem, callback=None, phase=None) -> StudyResult:
         x = prob.x0 + np.asarray(prob.data.scale) * u
         end_pair = with_fields(prob.data.pair0, {n: jnp.asarray(x[i])
                                                  for i, n in enumerate(prob.fields)})
-        data, err, diff = _round_trip(prob, end_pair)
+        data, err, diff = end_round_trip(prob, end_pair)
         flags0, flags1 = scenario_flags(prob, res0, eff0), scenario_flags(prob, res1, eff1)
     feas = float(np.max(np.asarray(g1), initial=0.0))
     reasons = acceptance_reasons(opt, feas, st.tolerance, err, diff, x, flags0, flags1,
@@ -694,7 +609,7 @@ def run_study(prob: Problem, callback=None, phase=None) -> StudyResult:
               "variables": variables,
               "scenarios": prob.scenarios,
               "edge_softening_mm": prob.soft,
-              "quantities": _quantities_report(prob, Q0, Q1, H0, H1),
+              "quantities": quantities_report(prob, Q0, Q1, H0, H1),
               "objective": {"start": float(J0), "end": float(J1),
                             "start_hard_model": Jh0, "end_hard_model": Jh1,
                             "terms": [dict(t._asdict() if hasattr(t, "_asdict") else
@@ -713,16 +628,3 @@ def run_study(prob: Problem, callback=None, phase=None) -> StudyResult:
               "seconds": time.time() - t0}
     return StudyResult(u, x, end_pair, data, not reasons, reasons, report,
                        (Q0, res0, eff0), (Q1, res1, eff1))
-
-
-def _quantities_report(prob: Problem, Q0, Q1, H0, H1) -> dict:
-    """Per quantity: unit, start and end per scenario; for the loaded quantities of a
-    study with edge softening also the hard model's (``start_hard_model``, ...)."""
-    out = {}
-    t0, t1, h0, h1 = (_q_table(prob, a) for a in (Q0, Q1, H0, H1))
-    for q in prob.study.quantities:
-        d = {"unit": QUANTITIES[q].unit, "start": t0[q], "end": t1[q]}
-        if prob.soft > 0.0 and QUANTITIES[q].loaded:
-            d.update(start_hard_model=h0[q], end_hard_model=h1[q])
-        out[q] = d
-    return out

@@ -50,8 +50,8 @@ import numpy as np
 from jax.sharding import Mesh, NamedSharding, PartitionSpec
 
 from gearjax.compile_ahead import FAST_COMPILE_OPTIONS
-from gearjax.studies.study_run import (Problem, combine, evaluator, scenario_flags,
-                                       scenario_of, set_scales)
+from gearjax.studies.end_checks import scenario_flags, scenario_of
+from gearjax.studies.study_run import Problem, combine, evaluator, set_scales
 
 __all__ = ["SweepResult", "set_up_sweep", "check_design_count", "sample_points",
            "sweep_program", "run_sweep", "npz_columns", "chunk_size", "steady_rate", "best_row",
