@@ -86,10 +86,16 @@ def register_correction(design_type, family) -> None:
 def correction_family(design):
     """The registered correction family of ``design`` (:func:`register_correction`);
     ``ValueError`` for a design without one."""
-    for t, fam in _FAMILIES.items():
+    return _registered(_FAMILIES, design, "flank correction")
+
+
+def _registered(registry: dict, design, what: str):
+    """The entry of ``registry`` (design type -> family) for ``design``; ``ValueError``
+    naming ``what`` for a design without one."""
+    for t, fam in registry.items():
         if isinstance(design, t):
             return fam
-    raise ValueError(f"no flank correction is defined for {type(design).__name__} designs")
+    raise ValueError(f"no {what} is defined for {type(design).__name__} designs")
 
 
 #: design type -> the family's target ease-off module (``target_ease_off``,
@@ -107,10 +113,7 @@ def register_ease_off(design_type, family) -> None:
 def ease_off_family(design):
     """The registered ease-off family of ``design`` (:func:`register_ease_off`);
     ``ValueError`` for a design without one."""
-    for t, fam in _EASE_OFF.items():
-        if isinstance(design, t):
-            return fam
-    raise ValueError(f"no target ease-off is defined for {type(design).__name__} designs")
+    return _registered(_EASE_OFF, design, "target ease-off")
 
 
 def target_ease_off(n_xi: int, n_s: int, crowning_um: float, profile_um: float,
