@@ -355,13 +355,122 @@ def test_efficiency_needs_the_operating_point(tmp_path):
         read_study(_write(tmp_path, text))
 
 
-def test_sweep_and_sensitivity_refuse_the_line_route(tmp_path, capsys):
+def _design_with(values: dict):
+    """``example:helical_microgeometry`` with the member tables' keys set (``values``:
+    ``microgeometry.MEMBER[_FLANK].KEY`` -> value; a flank table's key is written to its
+    member's table, which the drive-side model reads alike) -- a second route to a
+    moved design: the design file's own reader."""
+    from gearjax.io import design_from_dict
+    data = read_toml("example:helical_microgeometry")
+    for name, v in values.items():
+        _, table, key = name.split(".")
+        data["microgeometry"][table.split("_")[0]][key] = float(v)
+    return design_from_dict(data)
+
+
+def test_sweep_of_a_line_study_is_each_designs_loaded_map(tmp_path, capsys):
+    """`gearjax sweep` of a line-contact study: every row's quantities against
+    ``loaded_te_map`` of that row's design written as a design file (the `gearjax
+    loaded` route), the valid counts, ``ok``, ``feasible`` and ``J`` by hand.  Planted
+    bugs caught: rows paired with the wrong designs (a shuffled or padded chunk), the
+    flags or counts of another row or scenario, the constraint sense or the objective's
+    scaling, a refusal left in place."""
     path = _write(tmp_path, STUDY)
-    assert main(["sweep", path, "--out", str(tmp_path / "sw")]) == 2
-    assert "gearjax sweep runs TCA-route studies" in capsys.readouterr().err
+    out = tmp_path / "sw"
+    assert main(["sweep", path, "--samples", "3", "--chunk", "2", "--seed", "3",
+                 "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    d = dict(np.load(out / "mg_sweep.npz"))
+    names = [str(q) for q in d["quantities"]]
+    fields = [str(v) for v in d["variables"]]
+    assert d["x"].shape == (4, 5) and d["values"].shape == (4, 4, len(names))
+    qi = {q: i for i, q in enumerate(names)}
+    for k in range(4):
+        m = loaded_te_map(_design_with(dict(zip(fields, d["x"][k]))), TORQUES, MISALIGNMENTS,
+                          positions=POSITIONS, slices=SLICES, temperature_um=0.02)
+        v = d["values"][k]
+        np.testing.assert_allclose(v[:, qi["line_te_ptp_hard_um"]],
+                                   np.asarray(m.te_ptp_um).ravel(), rtol=1e-10, atol=1e-12)
+        np.testing.assert_allclose(v[:, qi["line_te_ptp_um"]],
+                                   np.asarray(m.te_ptp_smooth_um).ravel(), rtol=1e-10)
+        assert np.all(v[:, qi["line_p_max_MPa"]] >= np.asarray(m.p_max).ravel())
+        conv = np.asarray(m.converged).ravel()
+        np.testing.assert_array_equal(d["flag:converged"][k], conv)
+        np.testing.assert_array_equal(d["n_valid"][k] == POSITIONS, conv)
+    v = d["values"]
+    ok = d["flag:converged"].all(axis=1) & np.isfinite(v).all(axis=(1, 2))
+    np.testing.assert_array_equal(d["ok"], ok)
+    feas = ok & np.all(v[:, :, qi["line_p_max_MPa"]] <= 1400.0, axis=1) & np.all(
+        v[:, :, qi["line_end_load"]] <= 1.2, axis=1)
+    np.testing.assert_array_equal(d["feasible"], feas)
+    np.testing.assert_allclose(d["J"], v[:, :, qi["line_te_ptp_um"]].mean(axis=1), rtol=1e-12)
+    assert not d["flag:edge_contact"].any()
+    assert "4 designs (random)" in text
+    np.testing.assert_array_equal(d["scenario:f_ma_um"], list(MISALIGNMENTS) * 2)
+
+
+LINE_SENS = ("line_te_ptp_um", "line_te_mean_um")
+SENS_FIELDS = ("microgeometry.pinion.tip_relief_um", "microgeometry.pinion.lead_crowning_um",
+               "microgeometry.gear.tip_relief_length_mm")
+
+
+def test_sensitivity_of_line_outputs_against_central_differences(capsys):
+    """`gearjax sensitivity` of line-contact outputs with respect to micro-geometry
+    fields (forward mode through the exact load solution) against central differences
+    of ``loaded_te_map`` on design files with the field moved (a second route), at one
+    torque and misalignment; the values equal the map's; elasticities by definition.
+    Planted bugs caught: a derivative dropped or of the wrong field, the torque or the
+    misalignment of the command not reaching the model, the line options ignored."""
+    rc = main(["sensitivity", "example:helical_microgeometry", "--outputs", ",".join(LINE_SENS),
+               "--params", ",".join(SENS_FIELDS), "--torque-Nm", "300", "--f-ma-um", "5",
+               "--positions", str(POSITIONS), "--slices", str(SLICES), "--json"])
+    assert rc == 0
+    rep = json.loads(capsys.readouterr().out)
+    assert rep["scenario"] == {"torque_Nm": 300.0, "f_ma_um": 5.0, "positions": POSITIONS,
+                               "slices": SLICES}
+    x0 = {"microgeometry.pinion.tip_relief_um": 8.0, "microgeometry.pinion.lead_crowning_um": 6.0,
+          "microgeometry.gear.tip_relief_length_mm": 2.5}
+
+    def outputs(values):
+        m = loaded_te_map(_design_with(values), [300.0], [5.0], positions=POSITIONS,
+                          slices=SLICES, temperature_um=0.02)
+        return np.array([float(m.te_ptp_smooth_um[0, 0]), float(m.te_mean_um[0, 0])])
+
+    base = outputs(x0)
+    for i, o in enumerate(rep["outputs"]):
+        assert o["name"] == LINE_SENS[i] and o["value"] == pytest.approx(base[i], rel=1e-11)
+    h = 1e-4
+    for name in SENS_FIELDS:
+        cd = (outputs({**x0, name: x0[name] + h}) - outputs({**x0, name: x0[name] - h})) / (2 * h)
+        for i, o in enumerate(rep["outputs"]):
+            p = next(p for p in o["params"] if p["field"] == name)
+            assert p["value"] == x0[name]
+            assert p["per_unit"] == pytest.approx(cd[i], rel=1e-5, abs=1e-8), (o["name"], name)
+            assert p["elasticity"] == pytest.approx(p["per_unit"] * x0[name] / o["value"],
+                                                    rel=1e-12)
+    assert max(abs(p["per_unit"]) for o in rep["outputs"] for p in o["params"]) > 1e-3
+
+
+@pytest.mark.parametrize("extra, match", [
+    ([], "the line-contact quantity 'line_te_ptp_um' needs the operating point: torque_Nm"),
+    (["--torque-Nm", "300", "--misalign", "dE=0.01"],
+     "scenario key 'dE_mm' is not one of the line outputs' (allowed: f_ma_um)"),
+    (["--torque-Nm", "300", "--f-ma-um", "5000"], "--f-ma-um = 5000"),
+    (["--torque-Nm", "300", "--slices", "0"], "--slices = 0"),
+])
+def test_line_sensitivity_refusals(capsys, extra, match):
     assert main(["sensitivity", "example:helical_microgeometry", "--outputs",
-                 "line_te_ptp_um", "--params", "microgeometry.pinion.tip_relief_um"]) == 2
-    assert "a quantity of the loaded line contact" in capsys.readouterr().err
+                 "line_te_ptp_um", "--params", "microgeometry.pinion.tip_relief_um",
+                 *extra]) == 2
+    err = capsys.readouterr().err
+    assert match in err and err.count("\n") == 1
+
+
+def test_tca_sensitivity_refuses_a_mesh_misalignment(capsys):
+    assert main(["sensitivity", "example:khk_spur_12x24", "--outputs", "contact_ratio",
+                 "--params", "pair.x1", "--f-ma-um", "5"]) == 2
+    err = capsys.readouterr().err
+    assert "scenario key 'f_ma_um' is not one of the tca outputs'" in err
 
 
 def test_member_variable_of_a_design_whose_flanks_differ_is_refused(tmp_path):

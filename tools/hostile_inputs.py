@@ -1208,6 +1208,26 @@ def build_cases() -> list[Case]:
     add("sensitivity.plot_dir_missing", [*sens, "--outputs", "contact_ratio", "--params",
                                          "pair.x1", "--plot", "{tmp}/no/dir/t.png"], "refuse",
         "--plot into a missing directory: refused before any work")
+    line = ["sensitivity", "example:helical_microgeometry", "--outputs", "line_te_ptp_um",
+            "--params", "microgeometry.pinion.tip_relief_um"]
+    add("sensitivity.ok.line", [*line, "--torque-Nm", "300", "--f-ma-um", "5", "--positions",
+                                "8", "--slices", "4", "--json"], "ok",
+        "a line-contact output w.r.t. a micro-geometry field", heavy=True)
+    for cid, extra, why in (
+            ("line_without_torque", [], "a line output without --torque-Nm"),
+            ("line_with_tca_misalign", ["--torque-Nm", "300", "--misalign", "dE=0.01"],
+             "the TCA's misalignment given to a line output"),
+            ("line_f_ma_out_of_range", ["--torque-Nm", "300", "--f-ma-um", "5000"],
+             "--f-ma-um outside [-1000, 1000] um"),
+            ("line_f_ma_nan", ["--torque-Nm", "300", "--f-ma-um", "nan"], "--f-ma-um NaN"),
+            ("line_positions=2", ["--torque-Nm", "300", "--positions", "2"],
+             "fewer than 4 positions"),
+            ("line_slices=1.5", ["--torque-Nm", "300", "--slices", "1.5"],
+             "a fractional slice count")):
+        add(f"sensitivity.{cid}", [*line, *extra], "refuse", why)
+    add("sensitivity.tca_with_f_ma", [*sens, "--outputs", "contact_ratio", "--params",
+                                      "pair.x1", "--f-ma-um", "5"], "refuse",
+        "a mesh misalignment given to a TCA output")
 
     # ---------------------------------------------------------------- sweep
     sw = ["sweep", "example:spur_sliding"]
@@ -1226,6 +1246,9 @@ def build_cases() -> list[Case]:
             ("seed=-1", "--seed", "-1", "a negative seed"),
             ("method=lhs", "--method", "lhs", "unknown method")):
         add(f"sweep.{cid}", [*sw, flag, value], "refuse", why)
+    add("sweep.ok.line_study", ["sweep", "example:helical_microgeometry_robust", "--samples",
+                                "2", "--out", "{tmp}/s", "--no-plot"], "ok",
+        "a line-contact study swept over its micro-geometry fields", heavy=True)
     add("sweep.grid_too_large", [*sw, "--method", "grid", "--points", "1001"], "refuse",
         "a grid of more than 1e6 designs: refused before any compilation")
     add("sweep.out_is_a_file", [*sw, "--out", "{file}"], "refuse", "--out names a file",

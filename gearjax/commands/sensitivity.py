@@ -5,7 +5,10 @@ of study quantities to design fields from the exact Jacobian
 DESIGN is a design file or ``example:NAME``; the outputs are quantity names
 (``gearjax optimize --quantities``), the params field names (``gearjax optimize STUDY
 --fields``, or ``--params`` with a bad name lists them).  Loaded outputs need
-``--torque-Nm``, ``--rpm``, ``--oil`` and ``--sigma-um``.  Prints a table (value,
+``--torque-Nm``, ``--rpm``, ``--oil`` and ``--sigma-um``; the outputs of the loaded line
+contact (``line_*``: an involute design's micro-geometry fields
+``microgeometry.TABLE.KEY``) need ``--torque-Nm`` and take the mesh misalignment
+``--f-ma-um`` (``--misalign`` is the TCA's).  Prints a table (value,
 per-unit derivative, elasticity) or ``--json``; ``--plot F.png`` draws a tornado chart of
 the elasticities (one panel per output).  Exit 0, or 2 for bad input.
 """
@@ -16,7 +19,8 @@ import math
 
 SENSITIVITY_KEYS_DOC = """JSON keys (--json):
   design, side, scenario   as given (scenario: torque_Nm, pinion_rpm, oil, sigma_um,
-                           dE_mm, dP_mm, dG_mm, dSigma_deg)
+                           dE_mm, dP_mm, dG_mm, dSigma_deg; line-contact outputs:
+                           f_ma_um, positions, slices)
   outputs                  per output: name, unit, value, and per param: field (name),
                            value (field units), per_unit (d output / d field, output unit
                            per field unit: mm, rad, -), elasticity (d ln output / d ln
@@ -27,6 +31,7 @@ SENSITIVITY_KEYS_DOC = """JSON keys (--json):
 def register(sub):
     import argparse
 
+    from gearjax.studies.study_file import LINE_DEFAULTS
     from gearjax.tribology import OILS
     p = sub.add_parser(
         "sensitivity", help="exact sensitivities (per unit, elasticities) of quantities to "
@@ -45,6 +50,15 @@ def register(sub):
                    help="composite roughness (um, loaded outputs)")
     p.add_argument("--misalign", default="",
                    help="dE=..,dP=..,dG=..,dSigma=.. (mm, mm, mm, deg; default 0)")
+    p.add_argument("--f-ma-um", type=float, default=None,
+                   help="mesh misalignment f_ma (um over the face width; line-contact "
+                        "outputs, default 0)")
+    p.add_argument("--positions", type=float, default=None,
+                   help=f"mesh positions per base pitch, integer 4..1024 (line-contact "
+                        f"outputs, default {LINE_DEFAULTS['positions']})")
+    p.add_argument("--slices", type=float, default=None,
+                   help=f"face-width slices, integer 1..400 (line-contact outputs, default "
+                        f"{LINE_DEFAULTS['slices']})")
     p.add_argument("--plot", default=None, help="write the tornado chart (.png)")
     p.add_argument("--json", action="store_true", help="print JSON instead of the table")
     p.set_defaults(func=run)
@@ -108,8 +122,10 @@ def _tornado(rep, path):
 
 
 def run(args) -> int:
+    import gearjax as gj
     from gearjax.commands import print_json
     from gearjax.commands.designs import parse_misalign
+    from gearjax.errors import check_int, check_range
     from gearjax.io import check_output_path
     from gearjax.studies.sensitivity import sensitivities
 
@@ -118,12 +134,20 @@ def run(args) -> int:
         check_output_path(args.plot, "--plot", (".png",))
     kv, _ = parse_misalign(args.misalign)
     scenario = {f"{k}_mm" if k != "dSigma" else "dSigma_deg": float(v) for k, v in kv.items()}
+    line = {}
+    for flag, key, lo, hi in (("--positions", "positions", 4, 1024),
+                              ("--slices", "slices", 1, 400)):
+        if getattr(args, key) is not None:
+            line[key] = check_int(flag, getattr(args, key), lo=lo, hi=hi)
+    if args.f_ma_um is not None:
+        scenario["f_ma_um"] = check_range("--f-ma-um", args.f_ma_um,
+                                          *gj.involute.MISALIGNMENT_RANGE_UM, unit="um")
     operating = {k: v for k, v in (("torque_Nm", args.torque_Nm), ("pinion_rpm", args.rpm),
                                    ("oil", args.oil), ("sigma_um", args.sigma_um))
                  if v is not None}
     r = sensitivities(args.design, outputs, params, side=args.side, operating=operating,
-                      scenario=scenario)
-    rep = _report(args, r, operating, scenario)
+                      scenario=scenario, line=line)
+    rep = _report(args, r, operating, {**scenario, **line})
     if args.plot:
         _tornado(rep, args.plot)
     if args.json:

@@ -69,13 +69,14 @@ def set_up_sweep(study) -> Problem:
     the hard model (``edge_softening_mm = 0``, that of ``gearjax efficiency``) -- the
     soft active set exists for an optimiser's gradients, which a sweep does not take.
     A kinematics study (:mod:`gearjax.studies.kinematics_route`) is swept as it is (one
-    scenario, its flags: converged; the TCA's other flags False)."""
+    scenario, its flags: converged; the TCA's other flags False), and so is a
+    line-contact study (:mod:`gearjax.studies.line_route`, whose exact load solution
+    has no softened model; flags: every position converged -- with the efficiency,
+    every loaded point's friction too --, the TCA's other flags False, ``n_valid`` the
+    converged positions)."""
     from gearjax.studies.study_run import set_up
-    if study.route == "line":
-        raise ValueError(f"[[objective]] 1 ({study.objective[0].quantity}): gearjax sweep "
-                         "runs TCA-route studies; a line-contact study is optimised by "
-                         "gearjax optimize (gearjax loaded maps one design over torques "
-                         "and misalignments)")
+    if study.route != "tca":
+        return set_up(study)
     return set_up(dataclasses.replace(study, operating={**study.operating,
                                                         "edge_softening_mm": 0.0}))
 
@@ -212,18 +213,24 @@ def run_sweep(prob: Problem, U, chunk: int = 16, devices=None, progress=None) ->
         # every process holds U: each gives the rows of its own devices
         chunk_u = jax.make_array_from_callback(rows.shape, sharding, lambda idx: rows[idx])
         Q, res, eff, _ = prog(chunk_u, data)
-        # the padding rows dropped from every output at once
-        Q, res, eff_nv = jax.tree_util.tree_map(
-            lambda v: v[:k], _to_host((Q, res, None if eff is None else eff.n_valid)))
+        # the padding rows dropped from every output at once; of a loaded TCA study's
+        # efficiency only the valid counts come back (a line study's flags read its
+        # per-position validity)
+        if eff is not None and prob.route == "tca":
+            eff = eff.n_valid
+        Q, res, eff = jax.tree_util.tree_map(lambda v: v[:k], _to_host((Q, res, eff)))
         for i in range(k):
-            one = scenario_flags(prob, scenario_of(res, i), None)
+            row_eff = None if eff is None else scenario_of(eff, i)
+            if prob.route == "tca" and row_eff is not None:
+                row_eff = _Counts(row_eff)
+            one = scenario_flags(prob, scenario_of(res, i), row_eff)
             for key in FLAG_KEYS:
                 # a flag a route does not have (the line contact and the kinematics
                 # have no edge contact) is False
                 flags[key].append([f.get(key, False) for f in one])
+            if "n_valid" in one[0]:
+                nval.append([f["n_valid"] for f in one])
         vals.append(Q)
-        if eff_nv is not None:
-            nval.append(eff_nv)
         if first is None:
             first = time.time() - t0
         if progress is not None:
@@ -234,9 +241,15 @@ def run_sweep(prob: Problem, U, chunk: int = 16, devices=None, progress=None) ->
     ok = (np.all(flags["converged"] & ~flags["edge_contact"], axis=1)
           & np.all(np.isfinite(values), axis=(1, 2)))
     J, feasible = _objective_and_feasibility(prob, values, ok)
-    n_valid = np.concatenate(nval) if nval else None
+    n_valid = np.asarray(nval, int) if nval else None
     return SweepResult(U, file_units(prob, U), values, flags, n_valid, ok, feasible, J, seconds,
                        first, nd, c)
+
+
+class _Counts(NamedTuple):
+    """A row's valid-position counts where the flags expect the efficiency result."""
+
+    n_valid: np.ndarray
 
 
 def _objective_and_feasibility(prob: Problem, values, ok):
