@@ -49,6 +49,10 @@ base pitch, T torques; with --side both the side keys are under "drive" and "coa
   warnings         the warning lines (also on stderr)
   plot             the figure's path or null"""
 
+#: why the point-contact options have no meaning in the line contact
+MIS_WHY = "it takes the mesh misalignment f_ma as --misalignment-um"
+CYCLE_WHY = "it analyses one mesh cycle, set by --positions"
+
 #: figure suffixes of the line-contact figure
 PLOT_SUFFIXES = (".png", ".pdf", ".svg")
 
@@ -101,17 +105,16 @@ def modifications(design, side) -> dict:
 
 def check_line_options(args, point_only) -> tuple:
     """``(positions, slices, torques, f_ma)`` of the line route, checked (one line each);
-    ``point_only``: ``(flag, given)`` of options the line contact does not take."""
+    ``point_only``: ``(flag, given, why)`` of options the line contact does not take."""
     import gearjax as gj
     from gearjax.commands.loaded import parse_torques
     from gearjax.errors import check_int, check_range
     from gearjax.io import check_output_path
 
-    for flag, given in point_only:
+    for flag, given, why in point_only:
         if given:
             raise ValueError(f"{flag}: not an option of the line contact of a design with "
-                             "[microgeometry] (the thin-slice model takes the mesh "
-                             "misalignment as --misalignment-um); leave it out")
+                             f"[microgeometry] ({why}); leave it out")
     positions = check_int("--positions", 32 if args.positions is None else args.positions,
                           lo=4, hi=1024)
     slices = check_int("--slices", 20 if args.slices is None else args.slices, lo=1, hi=400)
@@ -157,8 +160,10 @@ def run_line_tca(args, design) -> int:
     from gearjax.progress import Progress
 
     positions, slices, torques, f_ma = check_line_options(args, (
-        ("--misalign", bool(args.misalign.strip())), ("--pitches", args.pitches is not None),
-        ("--kinematics", args.kinematics)))
+        ("--misalign", bool(args.misalign.strip()), MIS_WHY),
+        ("--pitches", args.pitches is not None, CYCLE_WHY),
+        ("--kinematics", args.kinematics, "the velocities along the contact lines are "
+                                          "those of `gearjax efficiency`")))
     sides = ["drive", "coast"] if args.side == "both" else [args.side]
     results = {}
     with Progress(len(sides), "tca") as bar:
