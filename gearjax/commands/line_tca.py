@@ -113,8 +113,8 @@ def check_line_options(args, point_only) -> tuple:
 
     for flag, given, why in point_only:
         if given:
-            raise ValueError(f"{flag}: not an option of the line contact of a design with "
-                             f"[microgeometry] ({why}); leave it out")
+            raise ValueError(f"{flag}: not an option of the thin-slice line contact ({why}) "
+                             "that analyses this design; leave it out")
     positions = check_int("--positions", 32 if args.positions is None else args.positions,
                           lo=4, hi=1024)
     slices = check_int("--slices", 20 if args.slices is None else args.slices, lo=1, hi=400)
