@@ -18,6 +18,12 @@ loaded edge contact, a grid too short, implausible results (``plausibility`` of
 only) -- are ``gearjax: warning:`` lines on stderr
 and ``valid``/``warnings`` in the output); 2 bad input, refused before any work; 3
 no position of the cycle is valid (the result is printed, with one error line).
+
+A pair in line contact that this chain does not load -- an involute design file with
+``[microgeometry]`` tables, or a helical pair without lead or profile crown -- goes to
+the thin-slice line contact (:mod:`gearjax.commands.line_efficiency`; ``--torque-Nm``
+then also takes a list or a range).  A design without ``[microgeometry]`` otherwise runs
+exactly the chain above, with one torque.
 """
 
 from __future__ import annotations
@@ -106,7 +112,8 @@ def register(sub):
                     "friction coefficient and sliding power loss at each position of one "
                     "mesh cycle, and the mean mesh efficiency, of an involute pair or a "
                     "hypoid/spiral-bevel design at a pinion torque and speed.",
-        epilog=EFFICIENCY_KEYS_DOC + "\n" + LINE_EFFICIENCY_KEYS_DOC, formatter_class=argparse.RawDescriptionHelpFormatter)
+        epilog=EFFICIENCY_KEYS_DOC + "\n" + LINE_EFFICIENCY_KEYS_DOC,
+        formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("design", help="involute:z1=..,z2=..,m=..,alpha=..,b=..[,...], or a "
                                   "hypoid/spiral-bevel design file or example:NAME")
     lo, hi = gj.loading.TORQUE_RANGE_NM
@@ -132,7 +139,7 @@ def register(sub):
     p.add_argument("--positions", type=float, default=None,
                    help=f"positions per mesh cycle (one pinion pitch), integer "
                         f"{POSITIONS_RANGE[0]}..{POSITIONS_RANGE[1]} (default 24 involute, "
-                        "16 hypoid)")
+                        "16 hypoid; a pair in line contact: per base pitch, default 32)")
     p.add_argument("--pitches", type=float, default=None,
                    help=f"half-range of the TCA grid in pitches ({PITCHES_RANGE[0]:g} ... "
                         f"{PITCHES_RANGE[1]:g}; default 1.25 involute, 2 hypoid)")

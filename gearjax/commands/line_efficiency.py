@@ -24,8 +24,8 @@ import numpy as np
 
 from gearjax.commands.line_tca import modifications
 
-LINE_EFFICIENCY_KEYS_DOC = """JSON keys of a pair in line contact (a design with [microgeometry], or an
-unmodified helical pair; T torques):
+LINE_EFFICIENCY_KEYS_DOC = """JSON keys of a pair in line contact (a design with [microgeometry],
+or an unmodified helical pair; T torques):
   input                 the options as given (design, side, torque_Nm, rpm, oil,
                         sigma_um, asperity options, fc, film, viscosity, compliance,
                         positions, slices, misalignment_um) plus the oil's eta0_Pas,

@@ -6,6 +6,9 @@ DESIGN is either an involute pair given inline,
 deg, profile shifts, pinion pressure-angle change deg, pinion profile and lead
 crown 1/mm), or a hypoid/spiral-bevel design file (a path or ``example:NAME``;
 :mod:`gearjax.gears.hypoid.tca`; drive side = pinion concave on gear convex).
+
+An involute design file with ``[microgeometry]`` tables goes to the unloaded TCA of the
+modified flanks by the thin-slice line contact (:mod:`gearjax.commands.line_tca`).
 """
 
 from __future__ import annotations
@@ -65,7 +68,8 @@ def register(sub):
         description="Unloaded tooth contact analysis of an involute pair (optionally with a "
                     "crowned or mismatched pinion) or of a hypoid/spiral-bevel design, "
                     "with misalignments.",
-        epilog=JSON_KEYS_DOC + "\n\n" + LINE_TCA_KEYS_DOC, formatter_class=argparse.RawDescriptionHelpFormatter)
+        epilog=JSON_KEYS_DOC + "\n\n" + LINE_TCA_KEYS_DOC,
+        formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("design", help="involute:z1=..,z2=..,m=..,alpha=..,b=..[,...], or a "
                                   "design file of any kind (DESIGN.toml or example:NAME)")
     p.add_argument("--side", choices=["drive", "coast", "both"], default="drive")

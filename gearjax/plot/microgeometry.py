@@ -14,7 +14,8 @@ modification maps of both flanks in mesh, the unloaded TE over the mesh cycle (Â
 against the pinion angle; the loaded TE at each torque dashed) and, with torques, the
 loaded TE p-t-p against torque.  ``gearjax efficiency`` of such a design
 (:func:`line_efficiency_figure`): the pinion flank's map, the mesh efficiency and the
-power loss against torque, and the loaded TE p-t-p against torque.  Built with the object API and the
+power loss against torque, and the loaded TE p-t-p against torque.  Built with the
+object API and the
 report style of :mod:`gearjax.plot.style` (never ``pyplot``); written atomically by
 :func:`save_loaded_plot`.
 """
