@@ -44,6 +44,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from gearjax.compile_ahead import call
 from gearjax.errors import check_range
 from gearjax.gears.involute.geometry import pair_geometry
 from gearjax.gears.involute.line_load import line_load_traced
@@ -168,6 +169,6 @@ def line_tca(design, *, torques_Nm=(), side="drive", misalignment_um=0.0, positi
     f = check_range("misalignment_um", misalignment_um, *MISALIGNMENT_RANGE_UM, unit="um")
     pair, b, mods, mat = line_design(design, mods, side)
     opts = line_options(pair, b, positions, slices, compliance)
-    out = _program(*_split(pair), b, mods, f, mat.youngs_modulus_MPa, mat.poisson,
-                   jnp.asarray(1e3 * T), opts=opts, drive=side == "drive")
+    out = call(_program, *_split(pair), b, mods, f, mat.youngs_modulus_MPa, mat.poisson,
+               jnp.asarray(1e3 * T), opts=opts, drive=side == "drive")
     return LineTCA(*out[:17], jnp.asarray(T), *out[17:])
