@@ -116,6 +116,21 @@ def test_tca_table_matches_the_json(tca_run, capsys):
     assert f"{data['ptp_um']:.4f} um" in text
 
 
+def test_tca_both_sides_json(tca_run):
+    """Catches: --side both printing one side twice (the coast flanks' tables ignored)
+    or its objects not under "drive" and "coast"."""
+    rc, out, err = _call(["tca", EXAMPLE, *SMALL, "--side", "both", "--json"])
+    assert rc == 0, err
+    data = strict_json(out)
+    side_keys = set(_keys(LINE_TCA_KEYS_DOC)) - {"input", "warnings", "plot"}
+    assert set(data) == {"input", "drive", "coast", "warnings", "plot"}
+    assert set(data["drive"]) == side_keys == set(data["coast"])
+    assert data["drive"]["te_um"] == strict_json(tca_run[1])["te_um"]
+    r = gj.involute.line_tca(gj.load_design(EXAMPLE), side="coast", positions=8, slices=6)
+    np.testing.assert_allclose(data["coast"]["te_um"], np.asarray(r.te_um), atol=1e-12)
+    assert data["coast"]["modifications"] == data["drive"]["modifications"]
+
+
 # ------------------------------------------------------- (a) an unmodified pair: conjugate
 
 def test_unmodified_tables_give_zero_te_as_the_point_contact_tca():
