@@ -145,16 +145,29 @@ def line_tca_figure(maps, results, title=None):
         for ax, (label, fm) in zip(axs[0], maps):
             map_panel(fig, ax, fm, label)
         ax_te, ax_t = axs[1]
-        for side, r in results.items():
+        allT = np.concatenate([np.asarray(r.torque_Nm, float) for r in results.values()])
+        if loaded:
+            from matplotlib.cm import ScalarMappable
+            from matplotlib.colors import Normalize
+            norm = Normalize(allT.min(), allT.max() if allT.max() > allT.min()
+                             else allT.min() + 1.0)
+            smap = ScalarMappable(norm=norm, cmap="plasma")
+        for (side, r), ls, c in zip(results.items(), ("--", ":"), ("k", "0.45")):
             phi = np.degrees(np.asarray(r.phi1_rad, float))
-            ax_te.plot(phi, np.asarray(r.te_um, float), marker=".", label=f"{side}: unloaded")
+            ax_te.plot(phi, np.asarray(r.te_um, float), color=c, marker=".",
+                       label=f"{side}: unloaded")
             for T, te in zip(np.asarray(r.torque_Nm, float), np.asarray(r.te_loaded_um, float)):
-                ax_te.plot(phi, te, ls="--", lw=1.0, label=f"{side}: {T:g} N m")
+                ax_te.plot(phi, te, ls=ls, lw=1.0, color=smap.to_rgba(T))
             if np.size(r.torque_Nm):
+                ax_te.plot([], [], ls=ls, color="0.3", label=f"{side}: loaded")
                 _torque_ptp(ax_t, r.torque_Nm, r.te_loaded_ptp_um, r.converged, label=side)
+        if loaded:
+            fig.colorbar(smap, ax=ax_te, label="pinion torque (N m)")
         ax_te.set_xlabel("pinion angle φ1 (deg)")
         ax_te.set_ylabel("transmission error (µm along the line of action)")
         ax_te.set_title("TE over the mesh cycle")
+        lo, hi = ax_te.get_ylim()             # zero and at least 1 µm in view: a
+        ax_te.set_ylim(min(lo, 0.0), max(hi, 1.0))   # constant TE is not blown up
         ax_te.grid(True, alpha=0.3)
         ax_te.legend(loc="best", fontsize="small")
         if loaded:
