@@ -41,7 +41,7 @@ from gearjax.commands.ehl_check import (EHL_CHECK_KEYS_DOC, add_ehl_check_option
 from gearjax.commands.friction import PLOT_SUFFIXES, add_lubricant_options, lubricant_from_args
 from gearjax.commands.line_efficiency import (LINE_EFFICIENCY_KEYS_DOC, line_contact_design,
                                               refuse_line_options, run_line_efficiency)
-from gearjax.commands.line_tca import CYCLE_WHY, MIS_WHY
+from gearjax.commands.line_tca import CYCLE_WHY, MIS_WHY, check_line_values
 from gearjax.commands.loaded import parse_torques
 
 EFFICIENCY_KEYS_DOC = """JSON keys (K tooth pairs, M positions over one mesh cycle = one pinion pitch):
@@ -311,6 +311,7 @@ def run(args) -> int:
     mis_kv, mis = parse_misalign(args.misalign)
     opts = _grid_options(args)
     ehl_opts = check_ehl_options(args)
+    check_line_values(args)
     if args.plot is not None:
         check_output_path(args.plot, "--plot", PLOT_SUFFIXES)
     with warnings.catch_warnings(record=True) as caught:

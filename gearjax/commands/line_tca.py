@@ -75,12 +75,19 @@ def add_line_options(p) -> None:
                         f"face width, in [{mlo:g}, {mhi:g}]; default 0)")
 
 
-def line_route(design) -> bool:
-    """Whether ``design`` goes to the line contact: an involute design file with
-    ``[microgeometry]`` tables."""
+def line_route(text: str) -> bool:
+    """Whether DESIGN ``text`` names an involute design file with ``[microgeometry]``
+    tables (its raw TOML, read without building the design, so that the options are
+    checked first); a file that cannot be read is left to the design loader's refusal."""
     import gearjax as gj
-    return (isinstance(design, gj.involute.InvoluteFile)
-            and getattr(design, "micro", None) is not None)
+    if text.startswith("involute:"):
+        return False
+    try:
+        data = gj.io.read_toml(text)
+    except (OSError, ValueError):
+        return False
+    head = data.get("design")
+    return isinstance(head, dict) and head.get("kind") == "involute" and "microgeometry" in data
 
 
 def refuse_line_options(args) -> None:
@@ -101,6 +108,18 @@ def modifications(design, side) -> dict:
     pm = (getattr(design, "micro", None) or gj.involute.MicroGeometry.none()).flanks(side)
     return {m: {f.name: float(getattr(getattr(pm, m), f.name))
                 for f in fields(gj.involute.FlankModification)} for m in ("pinion", "gear")}
+
+
+def check_line_values(args) -> None:
+    """The values of ``--slices`` and ``--misalignment-um`` when given (one line each),
+    for a command that learns its route only from the design."""
+    import gearjax as gj
+    from gearjax.errors import check_int, check_range
+    if args.slices is not None:
+        check_int("--slices", args.slices, lo=1, hi=400)
+    if args.misalignment_um is not None:
+        check_range("--misalignment-um", args.misalignment_um,
+                    *gj.involute.MISALIGNMENT_RANGE_UM, unit="um")
 
 
 def check_line_options(args, point_only) -> tuple:
@@ -153,8 +172,9 @@ def _side_json(r, design, side) -> dict:
     return out
 
 
-def run_line_tca(args, design) -> int:
-    """``gearjax tca`` of a design with ``[microgeometry]`` (module docstring)."""
+def run_line_tca(args) -> int:
+    """``gearjax tca`` of a design with ``[microgeometry]`` (module docstring): the
+    options checked, then the design read, then the work."""
     import gearjax as gj
     from gearjax.commands import print_json, warn_nonfinite
     from gearjax.progress import Progress
@@ -164,6 +184,7 @@ def run_line_tca(args, design) -> int:
         ("--pitches", args.pitches is not None, CYCLE_WHY),
         ("--kinematics", args.kinematics, "the velocities along the contact lines are "
                                           "those of `gearjax efficiency`")))
+    design = gj.load_design(args.design)
     sides = ["drive", "coast"] if args.side == "both" else [args.side]
     results = {}
     with Progress(len(sides), "tca") as bar:

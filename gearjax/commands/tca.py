@@ -202,12 +202,9 @@ def run(args) -> int:
     from gearjax.progress import Progress
 
     from gearjax import load_design
-    # validated before any tracing
-    design = (involute_design(args.design)[1] if args.design.startswith("involute:")
-              else load_design(args.design))
-    if line_route(design):
+    if line_route(args.design):
         # an involute design file with [microgeometry]: the line contact's TCA
-        return run_line_tca(args, design)
+        return run_line_tca(args)
     refuse_line_options(args)
     mis_kv, mis = parse_misalign(args.misalign)
     if args.positions is None:
@@ -222,6 +219,9 @@ def run(args) -> int:
         check_output_path(args.plot, "--plot", (".png",))
     sides = ["drive", "coast"] if args.side == "both" else [args.side]
     from gearjax.tca import family_of
+    # validated before any tracing
+    design = (involute_design(args.design)[1] if args.design.startswith("involute:")
+              else load_design(args.design))
     # default: 1.25 pitches and 3 tooth pairs; a family that picks the grid for the
     # design (involute: wider for a path of contact that reaches further) gets its
     # default grid and pairs
