@@ -125,12 +125,14 @@ def test_bad_plot_path_refused_before_work(capsys, monkeypatch, tmp_path):
     assert "no_such_design" in capsys.readouterr().err
 
 
-def test_helical_pair_in_line_contact_refused_in_one_line(capsys):
-    """The library refuses it in its concrete set-up, before anything is traced."""
-    argv = ["efficiency", DESIGN + ",helix=15", *BASE[1:]]
+def test_helical_pair_in_line_contact_refuses_point_contact_options(capsys):
+    """An unmodified helical pair in line contact goes to the line contact
+    (tests/test_cli_microgeometry.py); the point-contact grid options are refused there
+    in one line, before anything is traced."""
+    argv = ["efficiency", DESIGN + ",helix=15", *BASE[1:], "--pairs", "3"]
     assert main(argv) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "helix = 15" in err[0] and "lead_crown" in err[0]
+    assert len(err) == 1 and "--pairs" in err[0] and "line contact" in err[0]
 
 
 def test_table_from_the_same_result(run, capsys):

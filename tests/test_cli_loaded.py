@@ -4,7 +4,7 @@ One real run of the command on the packaged ``helical_microgeometry`` example (8
 positions x 6 slices, 2 torques x 2 misalignments: one compiled program, shared by the
 tests through a module fixture; the table run below has the same shapes and reuses it),
 the design-file parsing (member and flank tables, shapes, refusals), the refusal of the
-TCA and the mesh efficiency of a design with micro-geometry, and refusals of bad input
+point-contact TCA of a design with micro-geometry, and refusals of bad input
 before any JAX work.  Each test's docstring names the planted bug it catches."""
 
 import contextlib
@@ -180,15 +180,11 @@ def test_non_involute_design_refused(monkeypatch):
     assert rc == 2 and len(err.splitlines()) == 1 and "involute" in err
 
 
-def test_tca_and_efficiency_refuse_microgeometry():
-    """Catches: `gearjax tca` / `gearjax efficiency` / run_tca silently ignoring the
-    [microgeometry] tables (an unmodified pair analysed as if it were the design)."""
-    for argv in (["tca", EXAMPLE],
-                 ["efficiency", EXAMPLE, "--torque-Nm", "100", "--rpm", "1000", "--oil",
-                  "mineral_vg100", "--sigma-um", "0.4"]):
-        rc, text, err = _call(argv)
-        assert rc == 2 and text == "", argv
-        assert len(err.splitlines()) == 1 and "`gearjax loaded`" in err, err
+def test_run_tca_refuses_microgeometry():
+    """Catches: run_tca (the point-contact TCA) silently ignoring the [microgeometry]
+    tables (an unmodified pair analysed as if it were the design); the commands `gearjax
+    tca` / `gearjax efficiency` take such a design to the line contact
+    (tests/test_cli_microgeometry.py)."""
     with pytest.raises(ValueError, match="microgeometry"):
         gj.run_tca(gj.load_design(EXAMPLE))
 

@@ -317,13 +317,13 @@ def _example_data(example: str) -> dict:
 
 def _has_flanks(example: str) -> bool:
     """The example has flanks for the TCA: machine settings of both members (hypoid,
-    spiral bevel), an involute pair (rack-generated) without a [microgeometry] table
-    (which the TCA refuses: `gearjax loaded` analyses it), or a family whose flanks
-    follow from the design (preset-TE bevel, VH-CATT)."""
+    spiral bevel), an involute pair (rack-generated; with a [microgeometry] table the
+    line-contact TCA analyses it), or a family whose flanks follow from the design
+    (preset-TE bevel, VH-CATT)."""
     data = _example_data(example)
     kind = data.get("design", {}).get("kind")
     if kind == "involute":
-        return "microgeometry" not in data
+        return True
     if kind in ("hypoid", "spiral_bevel"):
         return "pinion" in data and "gear" in data
     return True                 # the preset-TE bevel and VH-CATT pairs: flanks by design
@@ -1015,8 +1015,7 @@ def build_cases() -> list[Case]:
                 heavy=True)
         else:
             add(f"tca.example.{name}", ["tca", f"example:{name}", "--side", "both", "--json"],
-                "refuse", "packaged example without machine settings (a blank only), or "
-                "with [microgeometry] (analysed by gearjax loaded)")
+                "refuse", "packaged example without machine settings (a blank only)")
     add("tca.example.spiral_bevel_kinematics",
         ["tca", "example:spiral_bevel_10x30_synthesised", "--kinematics", "--json"], "flag",
         "packaged example with kinematics; its drive TE parabola opens upwards (pair 0 is "
@@ -1053,9 +1052,18 @@ def build_cases() -> list[Case]:
         "refuse", "unknown oil")
     add("efficiency.no_torque", ["efficiency", TCA_INV, *_argv(eff, {"--torque-Nm": None})],
         "refuse", "missing --torque-Nm")
-    add("efficiency.helical_line_contact",
-        ["efficiency", "involute:z1=20,z2=40,m=4,alpha=20,b=30,helix=15", *_argv(eff)],
-        "refuse", "helical pair in line contact: the loaded contact needs a lead crown")
+    add("efficiency.ok.helical_line_contact",
+        ["efficiency", "involute:z1=20,z2=40,m=4,alpha=20,b=30,helix=15", *_argv(eff),
+         "--positions", "8", "--slices", "6", "--json"],
+        "ok", "unmodified helical pair in line contact: the thin-slice line contact")
+    add("efficiency.helical_line_contact.pairs",
+        ["efficiency", "involute:z1=20,z2=40,m=4,alpha=20,b=30,helix=15", *_argv(eff),
+         "--pairs", "3"], "refuse", "a point-contact grid option in line contact")
+    add("efficiency.spur.torque_list",
+        ["efficiency", TCA_INV, *_argv(eff, {"--torque-Nm": "100,200"})], "refuse",
+        "a torque list for a point-contact pair: one torque")
+    add("efficiency.spur.slices", ["efficiency", TCA_INV, *_argv(eff), "--slices", "6"],
+        "refuse", "--slices is of the line contact only")
     add("efficiency.plot_dir_missing",
         ["efficiency", TCA_INV, *_argv(eff), "--plot", "{tmp}/no/such/dir/e.png"], "refuse",
         "--plot into a missing directory: refused before any work")
@@ -1148,11 +1156,50 @@ def build_cases() -> list[Case]:
             ("not_a_table", ((f"{mg}", 3.0),), "a number where a table belongs")):
         add(f"loaded.design.{cid}", ["loaded", "{design}", "--torque-Nm", "100", *small],
             "refuse", why, setup=design_file("helical_microgeometry", *edits))
-    add("tca.microgeometry_refused", ["tca", "example:helical_microgeometry"], "refuse",
-        "the TCA does not take [microgeometry]: refused, naming `gearjax loaded`")
-    add("efficiency.microgeometry_refused",
-        ["efficiency", "example:helical_microgeometry", *_argv(eff)], "refuse",
-        "the mesh efficiency does not take [microgeometry]: refused, naming `gearjax loaded`")
+    # tca / efficiency of a design with [microgeometry]: the line contact
+    add("tca.ok.microgeometry", ["tca", "example:helical_microgeometry", *small, "--json"],
+        "ok", "the line-contact TCA of the modified flanks, JSON")
+    add("tca.ok.microgeometry_torques",
+        ["tca", "example:helical_microgeometry", *small, "--torque-Nm", "50:200:3",
+         "--side", "both", "--plot", "{tmp}/t.png"], "ok",
+        "unloaded TCA and loaded TE at a torque range, both sides, table and figure")
+    add("tca.ok.microgeometry_unmodified", ["tca", "example:helical_23x67_unmodified",
+                                            *small, "--json"], "ok",
+        "zero amounts: unloaded TE 0")
+    for cid, extra, why in (
+            ("misalign", ["--misalign", "dE=0.1"], "point-contact misalignment"),
+            ("pitches", ["--pitches", "2"], "point-contact grid"),
+            ("kinematics", ["--kinematics"], "point-contact kinematics"),
+            ("count0", ["--torque-Nm", "50:200:0"], "a torque range of COUNT 0"),
+            ("torque_nan", ["--torque-Nm", "nan"], "a NaN torque"),
+            ("torque_big", ["--torque-Nm", "1e9"], "a torque out of range"),
+            ("positions", ["--positions", "2"], "too few positions"),
+            ("slices", ["--slices", "1e6"], "too many slices"),
+            ("misalignment", ["--misalignment-um", "inf"], "an infinite misalignment"),
+            ("plot_dir", ["--plot", "{tmp}/no/such/dir/t.png"], "a missing plot directory")):
+        add(f"tca.microgeometry.{cid}", ["tca", "example:helical_microgeometry", *extra],
+            "refuse", why)
+    add("tca.inline.torque", ["tca", TCA_INV, "--torque-Nm", "100"], "refuse",
+        "--torque-Nm is of the line contact only")
+    add("efficiency.ok.microgeometry",
+        ["efficiency", "example:helical_microgeometry", *_argv(eff), *small, "--json"], "ok",
+        "the line-contact efficiency of the modified flanks, JSON")
+    add("efficiency.ok.microgeometry_range",
+        ["efficiency", "example:helical_microgeometry",
+         *_argv(eff, {"--torque-Nm": "50:400:4"}), *small, "--plot", "{tmp}/e.png"], "ok",
+        "a torque range: a row per torque, and the figure")
+    for cid, over, extra, why in (
+            ("count0", {"--torque-Nm": "50:200:0"}, [], "a torque range of COUNT 0"),
+            ("torque_big", {"--torque-Nm": "1e7"}, [], "a torque out of range"),
+            ("torque_twice", {"--torque-Nm": "50,50"}, [], "a torque given twice"),
+            ("misalign", {}, ["--misalign", "dE=0.1"], "point-contact misalignment"),
+            ("pairs", {}, ["--pairs", "3"], "point-contact pairs"),
+            ("E_prime", {}, ["--E-prime-MPa", "2e5"], "the material is the design's"),
+            ("ehl_check", {}, ["--ehl-check", "3"], "the point-contact EHL check"),
+            ("rpm_missing", {"--rpm": None}, [], "no speed")):
+        add(f"efficiency.microgeometry.{cid}",
+            ["efficiency", "example:helical_microgeometry", *_argv(eff, over), *extra],
+            "refuse", why)
 
     # ---------------------------------------------------------------- optimize
     add("optimize.ok.list", ["optimize", "--list"], "ok", "packaged studies")

@@ -18,6 +18,12 @@ loaded edge contact, a grid too short, implausible results (``plausibility`` of
 only) -- are ``gearjax: warning:`` lines on stderr
 and ``valid``/``warnings`` in the output); 2 bad input, refused before any work; 3
 no position of the cycle is valid (the result is printed, with one error line).
+
+A pair in line contact that this chain does not load -- an involute design file with
+``[microgeometry]`` tables, or a helical pair without lead or profile crown -- goes to
+the thin-slice line contact (:mod:`gearjax.commands.line_efficiency`; ``--torque-Nm``
+then also takes a list or a range).  A design without ``[microgeometry]`` otherwise runs
+exactly the chain above, with one torque.
 """
 
 from __future__ import annotations
@@ -33,6 +39,10 @@ from gearjax.commands.designs import involute_design, is_involute, parse_misalig
 from gearjax.commands.ehl_check import (EHL_CHECK_KEYS_DOC, add_ehl_check_options,
                                         check_ehl_options, ehl_check, print_ehl_check)
 from gearjax.commands.friction import PLOT_SUFFIXES, add_lubricant_options, lubricant_from_args
+from gearjax.commands.line_efficiency import (LINE_EFFICIENCY_KEYS_DOC, line_contact_design,
+                                              refuse_line_options, run_line_efficiency)
+from gearjax.commands.line_tca import CYCLE_WHY, MIS_WHY, check_line_values
+from gearjax.commands.loaded import parse_torques
 
 EFFICIENCY_KEYS_DOC = """JSON keys (K tooth pairs, M positions over one mesh cycle = one pinion pitch):
   input                 the options as given (design, side, misalign, torque_Nm, rpm,
@@ -102,12 +112,15 @@ def register(sub):
                     "friction coefficient and sliding power loss at each position of one "
                     "mesh cycle, and the mean mesh efficiency, of an involute pair or a "
                     "hypoid/spiral-bevel design at a pinion torque and speed.",
-        epilog=EFFICIENCY_KEYS_DOC, formatter_class=argparse.RawDescriptionHelpFormatter)
+        epilog=EFFICIENCY_KEYS_DOC + "\n" + LINE_EFFICIENCY_KEYS_DOC,
+        formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("design", help="involute:z1=..,z2=..,m=..,alpha=..,b=..[,...], or a "
                                   "hypoid/spiral-bevel design file or example:NAME")
     lo, hi = gj.loading.TORQUE_RANGE_NM
-    p.add_argument("--torque-Nm", type=float, required=True,
-                   help=f"pinion torque (N m, in [{lo:g}, {hi:g}])")
+    p.add_argument("--torque-Nm", required=True,
+                   help=f"pinion torque (N m, in [{lo:g}, {hi:g}]); a pair in line contact "
+                        "(a design with [microgeometry], or an unmodified helical pair) also "
+                        "takes a comma list 50,100,200 or a range START:STOP:COUNT")
     lo, hi = gj.loading.RPM_RANGE
     p.add_argument("--rpm", type=float, required=True,
                    help=f"pinion speed (rpm, in [{lo:g}, {hi:g}])")
@@ -126,16 +139,25 @@ def register(sub):
     p.add_argument("--positions", type=float, default=None,
                    help=f"positions per mesh cycle (one pinion pitch), integer "
                         f"{POSITIONS_RANGE[0]}..{POSITIONS_RANGE[1]} (default 24 involute, "
-                        "16 hypoid)")
+                        "16 hypoid; a pair in line contact: per base pitch, default 32)")
     p.add_argument("--pitches", type=float, default=None,
                    help=f"half-range of the TCA grid in pitches ({PITCHES_RANGE[0]:g} ... "
                         f"{PITCHES_RANGE[1]:g}; default 1.25 involute, 2 hypoid)")
     p.add_argument("--pairs", type=float, default=None,
                    help=f"tooth pairs considered, odd {PAIRS_RANGE[0]}..{PAIRS_RANGE[1]} "
                         "(default 3 involute, 5 hypoid)")
+    mlo, mhi = gj.involute.MISALIGNMENT_RANGE_UM
+    p.add_argument("--slices", type=float, default=None,
+                   help="pairs in line contact only: face-width slices, integer 1..400 "
+                        "(default 20)")
+    p.add_argument("--misalignment-um", type=float, default=None,
+                   help=f"pairs in line contact only: mesh misalignment f_ma (um over the "
+                        f"face width, in [{mlo:g}, {mhi:g}]; default 0)")
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.add_argument("--plot", default=None,
-                   help="write load share, mu and P_f along the mesh (.png, .pdf or .svg)")
+                   help="write load share, mu and P_f along the mesh (.png, .pdf or .svg); a "
+                        "pair in line contact: efficiency, power loss and loaded TE against "
+                        "torque and the pinion flank's modification map")
     add_ehl_check_options(p)
     p.set_defaults(func=run)
 
@@ -243,7 +265,7 @@ def _print_table(out, args):
     phi = out["phi1_deg"]
     pairs = out["pairs"]
     share = np.asarray(out["load_share"], float)
-    print(f"# mesh efficiency {args.design} ({args.side}); T1 = {args.torque_Nm:g} N m, "
+    print(f"# mesh efficiency {args.design} ({args.side}); T1 = {out['input']['torque_Nm']:g} N m, "
           f"n1 = {args.rpm:g} rpm, oil {args.oil or 'custom'}, sigma = {args.sigma_um:g} um; "
           f"misalign {out['input']['misalign'] or 'none'}")
     inp = out["input"]
@@ -281,12 +303,15 @@ def run(args) -> int:
     from gearjax.progress import Progress
 
     # every input is checked before any work (one line naming it, status 2)
-    T = check_range("--torque-Nm", args.torque_Nm, *gj.loading.TORQUE_RANGE_NM, unit="N m")
+    torques = parse_torques(args.torque_Nm, *gj.loading.TORQUE_RANGE_NM)
     n = check_range("--rpm", args.rpm, *gj.loading.RPM_RANGE, unit="rpm")
-    gj.check_operating_point(T, n)
+    for T in torques:
+        gj.check_operating_point(T, n)
+    T = torques[0]
     mis_kv, mis = parse_misalign(args.misalign)
     opts = _grid_options(args)
     ehl_opts = check_ehl_options(args)
+    check_line_values(args)
     if args.plot is not None:
         check_output_path(args.plot, "--plot", PLOT_SUFFIXES)
     with warnings.catch_warnings(record=True) as caught:
@@ -294,6 +319,17 @@ def run(args) -> int:
         oil, surf, _ = lubricant_from_args(args)   # E': the material below
     design = (involute_design(args.design)[1] if is_involute(args.design)
               else gj.load_design(args.design))
+    if line_contact_design(design):
+        # [microgeometry] or an unmodified helical pair: the thin-slice line contact
+        return run_line_efficiency(args, design, torques, n, oil, surf, caught, (
+            ("--misalign", bool(mis_kv), MIS_WHY),
+            ("--pitches", args.pitches is not None, CYCLE_WHY),
+            ("--pairs", args.pairs is not None, "it takes every tooth pair on the path"),
+            ("--E-prime-MPa", args.E_prime_MPa is not None,
+             "the material is the design's [material], else steel"),
+            ("--ehl-check", ehl_opts is not None, "the EHL check is of the point-contact "
+                                                  "chain's ellipses")))
+    refuse_line_options(args, torques)
     opts_all = {**gj.tca.family_of(design).defaults, **opts}
     # the material: --E-prime-MPa (validated above) > the design's [material] > steel;
     # mesh_efficiency resolves it the same way from the same E_prime argument

@@ -6,6 +6,9 @@ DESIGN is either an involute pair given inline,
 deg, profile shifts, pinion pressure-angle change deg, pinion profile and lead
 crown 1/mm), or a hypoid/spiral-bevel design file (a path or ``example:NAME``;
 :mod:`gearjax.gears.hypoid.tca`; drive side = pinion concave on gear convex).
+
+An involute design file with ``[microgeometry]`` tables goes to the unloaded TCA of the
+modified flanks by the thin-slice line contact (:mod:`gearjax.commands.line_tca`).
 """
 
 from __future__ import annotations
@@ -18,6 +21,8 @@ import sys
 import numpy as np
 
 from gearjax.commands.designs import involute_design, parse_misalign
+from gearjax.commands.line_tca import (LINE_TCA_KEYS_DOC, add_line_options, line_route,
+                                       refuse_line_options, run_line_tca)
 
 JSON_KEYS_DOC = """JSON keys:
   input            the design and options as given
@@ -63,16 +68,19 @@ def register(sub):
         description="Unloaded tooth contact analysis of an involute pair (optionally with a "
                     "crowned or mismatched pinion) or of a hypoid/spiral-bevel design, "
                     "with misalignments.",
-        epilog=JSON_KEYS_DOC, formatter_class=argparse.RawDescriptionHelpFormatter)
+        epilog=JSON_KEYS_DOC + "\n\n" + LINE_TCA_KEYS_DOC,
+        formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("design", help="involute:z1=..,z2=..,m=..,alpha=..,b=..[,...], or a "
                                   "design file of any kind (DESIGN.toml or example:NAME)")
     p.add_argument("--side", choices=["drive", "coast", "both"], default="drive")
     p.add_argument("--misalign", default="",
                    help="dE=mm,dP=mm,dG=mm,dSigma=deg (any subset; default all 0)")
-    p.add_argument("--positions", type=float, default=61,
+    p.add_argument("--positions", type=float, default=None,
                    help="grid positions, 10k+1 (k >= 1): 4k steps per pitch, "
                         "1.25 pitches each side (with --pitches P: P pitches each side, "
-                        "8kP+1 positions)")
+                        "8kP+1 positions); default 61.  A design with [microgeometry] "
+                        "(line contact): mesh positions per base pitch, integer 4..1024, "
+                        "default 32")
     p.add_argument("--pitches", type=float, default=None,
                    help="half-range of the grid in angular pitches (0.75 ... 4, default 1.25; "
                         "an involute pair whose path of contact reaches further from the pitch "
@@ -81,8 +89,12 @@ def register(sub):
     p.add_argument("--kinematics", action="store_true",
                    help="also compute rolling/sliding velocities, SRR and effective radii at "
                         "the contact points (JSON key 'kinematics')")
+    add_line_options(p)
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
-    p.add_argument("--plot", default=None, help="write the TE and contact-pattern figure (.png)")
+    p.add_argument("--plot", default=None,
+                   help="write the TE and contact-pattern figure (.png); a design with "
+                        "[microgeometry]: the modification maps and the unloaded TE over "
+                        "the cycle (and loaded TE against torque) (.png, .pdf or .svg)")
     p.set_defaults(func=run)
 
 
@@ -189,7 +201,14 @@ def run(args) -> int:
     from gearjax.io import check_output_path
     from gearjax.progress import Progress
 
+    from gearjax import load_design
+    if line_route(args.design):
+        # an involute design file with [microgeometry]: the line contact's TCA
+        return run_line_tca(args)
+    refuse_line_options(args)
     mis_kv, mis = parse_misalign(args.misalign)
+    if args.positions is None:
+        args.positions = 61
     n = check_int("positions", args.positions, lo=11, hi=1001)
     if (n - 1) % 10:
         raise ValueError(f"positions = {n} must be of the form 10k+1 (11, 21, ..., 61, ...)")
@@ -200,7 +219,6 @@ def run(args) -> int:
         check_output_path(args.plot, "--plot", (".png",))
     sides = ["drive", "coast"] if args.side == "both" else [args.side]
     from gearjax.tca import family_of
-    from gearjax import load_design
     # validated before any tracing
     design = (involute_design(args.design)[1] if args.design.startswith("involute:")
               else load_design(args.design))

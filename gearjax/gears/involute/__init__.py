@@ -6,7 +6,7 @@ file (``[design] kind = "involute"``, :class:`InvoluteFile`), the kinematics alo
 the path of contact.  Its TCA runs through :func:`gearjax.run_tca` like every family.
 The flank micro-geometry (:class:`MicroGeometry`, :func:`flank_removal_um`) and the
 loaded line contact of spur and helical pairs (:func:`line_contact`,
-:func:`loaded_te_map`) are this family's own (docs/microgeometry.md).
+:func:`loaded_te_map`, the unloaded TCA of the modified flanks :func:`line_tca`) are this family's own (docs/microgeometry.md).
 """
 
 from gearjax.gears.involute.geometry import (InvolutePair, generated_flank, pair_geometry,
@@ -19,9 +19,10 @@ from gearjax.gears.involute.microgeometry import (FlankModification, MicroGeomet
 from gearjax.gears.involute.loaded_lines import (MISALIGNMENT_RANGE_UM, TORQUE_RANGE_NM,
                                                  LoadedTEMap, line_contact, loaded_te_map,
                                                  resolution_warnings)
+from gearjax.gears.involute.line_tca import LineTCA, line_tca
 
 __all__ = ["InvolutePair", "generated_flank", "pair_geometry", "path_kinematics", "path_table",
            "InvoluteTCA", "involute_limits", "InvoluteFile", "FlankModification",
            "PairModification", "MicroGeometry", "flank_removal_um", "line_contact",
            "loaded_te_map", "LoadedTEMap", "TORQUE_RANGE_NM", "MISALIGNMENT_RANGE_UM",
-           "resolution_warnings"]
+           "resolution_warnings", "line_tca", "LineTCA"]
