@@ -82,6 +82,7 @@ import jax
 import jax.numpy as jnp
 
 from gearjax.contact import hertz_line_traced
+from gearjax.gears.involute.face_coupling import ACTIVE_SET_STEPS, coupled_solve, face_links
 from gearjax.gears.involute.geometry import InvolutePair, pair_geometry
 from gearjax.gears.involute.mesh import virtual_teeth
 from gearjax.gears.involute.microgeometry import (PairModification, flank_removal_um,
@@ -109,6 +110,10 @@ class LineLoadOptions(NamedTuple):
         (:func:`path_points_bound`; 0: no bound known).  The friction of
         :mod:`gearjax.gears.involute.line_efficiency` is evaluated at that many points
         per position instead of at every pair's slices.
+    coupling_length : the coupling length ``lambda`` (mm) of the Pasternak foundation
+        along the face (:mod:`gearjax.gears.involute.face_coupling`); 0: the Winkler
+        foundation of independent slices (the module docstring's model, the default).
+    coupling_steps : cap of the coupled contact's active-set iterations.
     """
 
     positions: int = 32
@@ -117,6 +122,8 @@ class LineLoadOptions(NamedTuple):
     k_hi: int = 3
     compliance: str = "weber"
     path_points: int = 0
+    coupling_length: float = 0.0
+    coupling_steps: int = ACTIVE_SET_STEPS
 
 
 def path_points_bound(pair: InvolutePair, face_width, slices: int) -> int:
@@ -178,7 +185,12 @@ class LineLoad(NamedTuple):
         more than the middle over the cycle; 1 for an aligned unmodified pair).
     n_points : (M,) slice points carrying load.
     balance : (M,) relative torque residual.  converged : (M,) balance below
-        :data:`BALANCE_TOL` and some point on the path.
+        :data:`BALANCE_TOL` and some point on the path (with coupling also the active
+        set found and the complementarity residual below its tolerance).
+    complementarity : (M,) complementarity residual: the largest tensile load over the
+        transmitted load, or interpenetration over the compression
+        (:func:`~gearjax.gears.involute.face_coupling.coupled_solve`; 0 for the Winkler
+        foundation, whose loads are ``k max(delta - e, 0)`` by construction).
     """
 
     s0: jax.Array
@@ -203,6 +215,7 @@ class LineLoad(NamedTuple):
     n_points: jax.Array
     balance: jax.Array
     converged: jax.Array
+    complementarity: jax.Array
 
 
 def _solve(e, k, W):
@@ -280,16 +293,32 @@ def line_load_traced(pair: InvolutePair, face_width, mods: PairModification, tor
     e_pos = jnp.moveaxis(e, 1, 0).reshape(M, -1)
     k_pos = jnp.moveaxis(k, 1, 0).reshape(M, -1)
     delta, some = jax.vmap(_solve, in_axes=(0, 0, None))(e_pos, k_pos, W)
-    gap = jnp.maximum(delta[None, :, None] - e, 0.0)
-    F = k * gap * cb
+    if opts.coupling_length > 0.0:
+        # Pasternak foundation along each pair's face (face_coupling); links per pair
+        link = face_links(jnp.where(on, dy / (cb * q_unit), 0.0), frac, dy,
+                          opts.coupling_length)
+        link_pos = jnp.moveaxis(link, 1, 0).reshape(M, -1)
+        sol = jax.vmap(lambda e_, k_, c_, d_: coupled_solve(e_, k_, c_, W, d_,
+                                                            opts.coupling_steps))(
+            e_pos, k_pos, link_pos, delta)
+        delta = sol.delta
+        F = jnp.moveaxis(sol.load.reshape(M, k.shape[0], N), 0, 1) * cb
+        slope = sol.slope
+        comp_res = sol.residual
+        solved = sol.converged
+    else:
+        F = k * jnp.maximum(delta[None, :, None] - e, 0.0) * cb
+        slope = jnp.sum(jnp.where(F > 0.0, k, 0.0), axis=(0, 2))
+        comp_res = jnp.zeros(M)
+        solved = True
     balance = jnp.abs(jnp.sum(F, axis=(0, 2)) * rb1 * cb / T1 - 1.0)
-    converged = some & (balance <= BALANCE_TOL)
+    converged = some & (balance <= BALANCE_TOL) & solved
     w_line = jnp.where(on, F / jnp.where(on, length, 1.0), 0.0)
     E_prime = E / (1.0 - nu ** 2)
     loaded = F > 0.0
     half_w, p = hertz_line_traced(jnp.where(loaded, w_line, 1.0), r_n, E_prime)
     p_max = jnp.where(loaded, p, 0.0)
-    stiff = cb ** 2 * jnp.sum(jnp.where(loaded, k, 0.0), axis=(0, 2)) / b * 1e-3
+    stiff = cb ** 2 * slope / b * 1e-3
     face = jnp.sum(F, axis=0) / dy                    # (M, N) normal load per face width
     mean_face = jnp.mean(face, axis=1)
     k_hb = jnp.max(face, axis=1) / mean_face
@@ -302,7 +331,7 @@ def line_load_traced(pair: InvolutePair, face_width, mods: PairModification, tor
                     end_load=jnp.maximum(face[:, 0], face[:, -1]) / mean_face,
                     end_load_mean=jnp.maximum(cyc[0], cyc[-1]) / jnp.mean(cyc),
                     n_points=jnp.sum(loaded, axis=(0, 2)), balance=balance,
-                    converged=converged)
+                    converged=converged, complementarity=comp_res)
 
 
 def smooth_ptp(x, temperature):
