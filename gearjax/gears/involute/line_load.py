@@ -187,6 +187,9 @@ class LineLoad(NamedTuple):
     balance : (M,) relative torque residual.  converged : (M,) balance below
         :data:`BALANCE_TOL` and some point on the path (with coupling also the active
         set found and the complementarity residual below its tolerance).
+    gap_um : (K, M, N) loaded gap ``w + e - delta`` of each slice point (µm; 0 where
+        loaded, NaN off the path), ``w`` the slice's deflection: ``max(delta - e, 0)``
+        for the Winkler foundation, the coupled solution's with coupling.
     complementarity : (M,) complementarity residual: the largest tensile load over the
         transmitted load, or interpenetration over the compression
         (:func:`~gearjax.gears.involute.face_coupling.coupled_solve`; 0 for the Winkler
@@ -215,6 +218,7 @@ class LineLoad(NamedTuple):
     n_points: jax.Array
     balance: jax.Array
     converged: jax.Array
+    gap_um: jax.Array
     complementarity: jax.Array
 
 
@@ -303,11 +307,13 @@ def line_load_traced(pair: InvolutePair, face_width, mods: PairModification, tor
             e_pos, k_pos, link_pos, delta)
         delta = sol.delta
         F = jnp.moveaxis(sol.load.reshape(M, k.shape[0], N), 0, 1) * cb
+        gap = jnp.moveaxis(sol.w.reshape(M, k.shape[0], N), 0, 1) + e - delta[None, :, None]
         slope = sol.slope
         comp_res = sol.residual
         solved = sol.converged
     else:
         F = k * jnp.maximum(delta[None, :, None] - e, 0.0) * cb
+        gap = jnp.maximum(e - delta[None, :, None], 0.0)
         slope = jnp.sum(jnp.where(F > 0.0, k, 0.0), axis=(0, 2))
         comp_res = jnp.zeros(M)
         solved = True
@@ -331,7 +337,8 @@ def line_load_traced(pair: InvolutePair, face_width, mods: PairModification, tor
                     end_load=jnp.maximum(face[:, 0], face[:, -1]) / mean_face,
                     end_load_mean=jnp.maximum(cyc[0], cyc[-1]) / jnp.mean(cyc),
                     n_points=jnp.sum(loaded, axis=(0, 2)), balance=balance,
-                    converged=converged, complementarity=comp_res)
+                    converged=converged, gap_um=jnp.where(on, 1e3 * gap, jnp.nan),
+                    complementarity=comp_res)
 
 
 def smooth_ptp(x, temperature):
