@@ -31,9 +31,13 @@ along its normal.
 **Compliance: a Winkler foundation of thin slices.**  This is the elastic foundation
 behind ISO 6336-1's face load factor: the mesh as independent springs of stiffness
 ``c_gamma`` per unit face width.  Their linear load distribution under a mesh
-misalignment gives the standard's K_Hbeta formulas, which the tests reproduce.  The
-slices are not coupled along the face, so a modification's effect spreads only as
-far as the slice width; that is the model's stated limit.  A slice of contact-line length
+misalignment gives the standard's K_Hbeta formulas, which the tests reproduce.  By
+default the slices are not coupled along the face, so a modification's effect spreads
+only as far as the slice width.  With ``opts.coupling_length`` > 0 the slices of each
+tooth pair are coupled by a Pasternak foundation along the face, ``k w - G w'' = q``
+with free ends ([Pasternak1954], [AjmiVelex2005]), and the equilibrium below becomes a
+linear complementarity problem solved per position by an active-set method
+(:mod:`gearjax.gears.involute.face_coupling`).  A slice of contact-line length
 ``l`` has the normal stiffness ``k = l / q'(s)`` (N/mm), ``q'`` the compliance of the
 tooth pair per unit length of contact line at that point of the path: both teeth as
 Weber/Sainsot cantilevers of the virtual spur gears of the normal section plus
@@ -64,13 +68,15 @@ of action, positive: the gear lags; the angle is ``delta / r_b2`` of the gear), 
 unloaded TE ``min_j e_j`` (the approach at zero load), loads, line loads ``F / l``
 (N/mm) and Hertz pressures of the line contact of the normal-section radii ``rho_n =
 xi / cos(beta_b)`` ([Johnson1985] eq. 4.45), the mesh stiffness ``c_gamma =
-cos^2(beta_b) sum_(loaded) k / b`` (N/(mm µm) after the unit factor: transverse load
-along the line of action per unit face width per µm of approach), and the face load
+cos^2(beta_b) (dW/d delta) / b``, ``dW/d delta = sum_(loaded) k`` for the Winkler
+foundation (N/(mm µm) after the unit factor: transverse load along the line of action
+per unit face width per µm of approach), and the face load
 factor ``K_Hbeta = max_y w(y) / mean_y w(y)`` of the load per unit face width ``w(y)``
 (summed over the pairs; per position and for the cycle-mean distribution, [ISO6336-1]).
 
 Units: mm, N, N mm, MPa, µm where named.  References (docs/references.md):
-[ISO21771]; [ISO6336-1]; [Weber1949]; [Sainsot2004]; [Johnson1985].
+[ISO21771]; [ISO6336-1]; [Weber1949]; [Sainsot2004]; [Johnson1985]; [Pasternak1954];
+[AjmiVelex2005].
 """
 
 from __future__ import annotations
