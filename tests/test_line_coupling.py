@@ -399,3 +399,53 @@ def test_coupling_length_is_range_checked():
     with pytest.raises(ValueError, match=r"coupling_length_mm = 2000 mm"):
         gj.involute.loaded_te_map(des, [100.0], coupling_length_mm=2000.0)
     assert gj.involute.module_coupling_length(des) == pytest.approx(3.175)
+
+
+STUDY = """
+[study]
+name = "mgc"
+design = "example:helical_microgeometry"
+
+[scenarios]
+torque_Nm = [200.0, 400.0]
+f_ma_um = [10.0]
+
+[line]
+positions = 8
+slices = 6
+coupling_length_mm = 3.0
+
+[[variables]]
+field = "microgeometry.pinion.tip_relief_um"
+lower = 0.0
+upper = 30.0
+scale = 30.0
+
+[[objective]]
+quantity = "line_te_ptp_um"
+scale = 1.0
+"""
+
+
+def test_study_route_takes_the_coupling_length(tmp_path):
+    """``[line] coupling_length_mm`` reaches the study's model: its quantities equal
+    loaded_te_map with the same coupling (and differ from the Winkler map); a value out of
+    range is refused naming the table, key, value and range.  Planted bug caught: the
+    key read but not passed to the model options."""
+    from gearjax.studies import study_run as sr
+    from gearjax.studies.study_file import read_study
+    p = tmp_path / "s.toml"
+    p.write_text(STUDY.replace("3.0\n\n[[var", "-2.0\n\n[[var"))
+    with pytest.raises(ValueError, match=r"\[line\] coupling_length_mm = -2 mm.*\[0, 1000\]"):
+        read_study(str(p))
+    p.write_text(STUDY)
+    prob = sr.set_up(read_study(str(p)))
+    Q0 = np.asarray(sr.start_point(prob)[0])
+    qi = {q: i for i, q in enumerate(prob.study.quantities)}
+    kw = dict(positions=8, slices=6, temperature_um=0.02)
+    m = gj.involute.loaded_te_map(prob.design, [200.0, 400.0], [10.0], coupling_length_mm=3.0,
+                                  **kw)
+    np.testing.assert_allclose(Q0[:, qi["line_te_ptp_hard_um"]], np.asarray(m.te_ptp_um).ravel(),
+                               rtol=1e-12)
+    w = gj.involute.loaded_te_map(prob.design, [200.0, 400.0], [10.0], **kw)
+    assert np.max(np.abs(np.asarray(w.te_ptp_um) - np.asarray(m.te_ptp_um))) > 1e-3
