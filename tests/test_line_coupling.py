@@ -324,8 +324,8 @@ def test_coupled_equations_and_complementarity_on_a_seeded_sweep():
 def test_gradients_with_coupling_against_central_differences():
     """d(smooth LTE p-t-p, p_max, K_Hbeta, mean LTE)/d(nine modification fields, torque,
     misalignment) of the coupled helical pair (jacfwd through the re-solve of the final
-    active set) against central differences (one vmapped program over the +-h designs).
-    Planted bugs caught: a stop_gradient on the re-solve's inputs, the derivative taken
+    active set) against central differences (one vmapped program over the +-h designs),
+    and reverse mode against forward mode.  Planted bugs caught: a stop_gradient on the re-solve's inputs, the derivative taken
     through the loop's frozen values, a derivative of the approach missing the link
     stiffness."""
     pair = _pair(*HELICAL)
@@ -361,6 +361,9 @@ def test_gradients_with_coupling_against_central_differences():
     scale = np.abs(fd).max(axis=1, keepdims=True)
     err = np.abs(J - fd) / scale
     assert err.max() < 1e-5, (np.unravel_index(err.argmax(), err.shape), err.max())
+    # reverse mode (through the same re-solve) gives the same derivative
+    g = np.asarray(jax.jit(jax.grad(lambda v: outputs(v)[0]))(x0))
+    np.testing.assert_allclose(g, J[0], rtol=1e-9, atol=1e-12 * np.abs(J[0]).max())
     # the coupling changes the derivatives (they are not the Winkler ones)
     opts_w = _opts(pair, b, 12, 0.0, "weber", positions=6)
     r_w = jax.jacfwd(lambda v: jnp.mean(line_load_traced(pair, b, mods_of(v[:-2]), v[-2],
