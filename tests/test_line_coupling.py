@@ -452,3 +452,39 @@ def test_study_route_takes_the_coupling_length(tmp_path):
                                rtol=1e-12)
     w = gj.involute.loaded_te_map(prob.design, [200.0, 400.0], [10.0], **kw)
     assert np.max(np.abs(np.asarray(w.te_ptp_um) - np.asarray(m.te_ptp_um))) > 1e-3
+
+
+def _cli(argv):
+    import contextlib
+    import io
+    from gearjax.cli import main
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            rc = main(argv)
+        except SystemExit as exc:
+            rc = exc.code
+    return rc, out.getvalue(), err.getvalue()
+
+
+def test_cli_flag_reaches_the_model_and_is_checked(monkeypatch):
+    """``gearjax loaded --coupling-length-mm module``: the JSON ``input`` names the λ used
+    (the normal module) and the values are the library map's with that coupling; a bad
+    value is one line naming the flag, before any work.  Planted bugs caught: the flag
+    parsed but not passed, ``module`` not resolved to m_n."""
+    import json
+    ex = "example:helical_microgeometry"
+    small = ["--torque-Nm", "200", "--positions", "8", "--slices", "6"]
+    rc, out, err = _cli(["loaded", ex, *small, "--coupling-length-mm", "module", "--json"])
+    assert rc == 0, err
+    js = json.loads(out)
+    assert js["input"]["coupling_length_mm"] == pytest.approx(3.0)
+    m = gj.involute.loaded_te_map(gj.load_design(ex), [200.0], positions=8, slices=6,
+                                  coupling_length_mm=3.0)
+    assert js["te_ptp_um"][0][0] == pytest.approx(float(m.te_ptp_um[0, 0]), rel=1e-12)
+    monkeypatch.setattr(gj.involute, "loaded_te_map",
+                        lambda *a, **k: pytest.fail("computed on bad input"))
+    for bad in ("-1", "abc", "2000"):
+        rc, out, err = _cli(["loaded", ex, *small, "--coupling-length-mm", bad])
+        assert rc == 2 and out == "" and len(err.splitlines()) == 1, err
+        assert "--coupling-length-mm" in err
