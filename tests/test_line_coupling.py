@@ -325,9 +325,9 @@ def test_gradients_with_coupling_against_central_differences():
     """d(smooth LTE p-t-p, p_max, K_Hbeta, mean LTE)/d(nine modification fields, torque,
     misalignment) of the coupled helical pair (jacfwd through the re-solve of the final
     active set) against central differences (one vmapped program over the +-h designs),
-    and reverse mode against forward mode.  Planted bugs caught: a stop_gradient on the re-solve's inputs, the derivative taken
-    through the loop's frozen values, a derivative of the approach missing the link
-    stiffness."""
+    and reverse mode against forward mode.  Planted bugs caught: a stop_gradient on the
+    re-solve's inputs, the derivative taken through the loop's frozen values, a
+    derivative of the approach missing the link stiffness."""
     pair = _pair(*HELICAL)
     b = B_HEL
     opts = _opts(pair, b, 12, LAM, "weber", positions=6)

@@ -24,19 +24,22 @@ stiffness times ``lambda^2`` is ``G`` on the face between them) and ``P_i`` the 
 load (N).  A piece only partly on the path (the fraction ``f_i`` at a tip circle) links
 with the factor ``min(f_i, f_{i+1})``: a piece entering the path enters the coupling
 with its length, so the loads stay continuous in the mesh position (a sliver is not
-handed a finite share of its neighbour's load).  A link exists only between neighbouring slices of the SAME tooth pair that
-both lie on the path; the end of a contact line (a face end, or where a helical line
-leaves the path at a tip circle) has no outer link: the free end ``dw/dy = 0``.  The
+handed a finite share of its neighbour's load).  A link exists only between
+neighbouring slices of the SAME tooth pair that both lie on the path; the end of a
+contact line (a face end, or where a helical line leaves the path at a tip circle) has
+no outer link: the free end ``dw/dy = 0``.  The
 matrix ``A = diag(k) + L`` (``L`` the weighted graph Laplacian of the links) is a
 symmetric, diagonally dominant M-matrix, tridiagonal in the pair-major order of the
 points, block-diagonal per pair.
 
-**End forces.**  Where a compressed face end has a slope (a linearly misaligned flank),
-the continuous problem carries a concentrated end force ``G |dw/dy|`` at that end (the
-shear of the coupling layer stops there).  The discrete model puts it in the end
-slice's load ``c_{1/2} (w_0 - w_1)``, so the end slice's line load (and the p_max and
-K_Hbeta read from it) grows as the slice narrows while the force itself, the approach
-and the loads inside converge (docs/microgeometry.md).
+**Concentrated forces.**  Where a compressed end of a contact line has a slope (a
+linearly misaligned flank), the continuous problem carries a concentrated end force
+``G |dw/dy|`` at that end (the shear of the coupling layer stops there), and at a kink
+of the separation along a line in contact (the start of a linear relief) the force
+``G |jump of de/dy|``.  The discrete model puts each in the slice (or the two slices)
+holding it (the end slice's load has ``c_{1/2} (w_0 - w_1)``), so that slice's line
+load, and the p_max and K_Hbeta read from it, grow as the slices narrow, while the
+forces themselves, the approach and the loads inside converge (docs/microgeometry.md).
 
 **Contact** at one mesh position: with the unloaded separations ``e_j`` and the approach
 ``delta``, the gap ``g_j = w_j + e_j - delta`` and the loads satisfy
