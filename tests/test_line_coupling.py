@@ -187,8 +187,10 @@ def test_misalignment_closed_form_of_the_pasternak_beam(spur):
                      abs(loaded.max() + dy / 2 - a) / dy,
                      np.max(np.abs(gap[open_] - g_cf[open_])) / delta))
     errs = np.array(errs)
-    assert np.all(errs[-1] < [2e-4, 0.05, 1.0, 2e-3]), errs
-    assert errs[2, 0] < errs[0, 0] / 3 and errs[2, 1] < errs[0, 1] / 3, errs
+    # measured at 160 slices: 2e-6, 4e-7, 0.64, 2e-5 (the approach's error is not
+    # monotone in the slices: the contact edge falls at varying places inside a slice)
+    assert np.all(errs[-1] < [2e-5, 1e-5, 1.0, 1e-4]), errs
+    assert errs[2, 0] < errs[0, 0] and errs[2, 1] < errs[0, 1] / 3, errs
     assert errs[2, 3] < errs[0, 3] / 3, errs
 
 
@@ -246,7 +248,8 @@ def test_end_relief_is_spread_over_the_coupling_length(spur):
                      np.max(np.abs(gap[open_] - g_cf[open_])) / delta,
                      abs(P[i - 2:i + 3].sum() - dist - G * s) / (G * s)))
     errs = np.array(errs)
-    assert np.all(errs[-1] < [2e-4, 1.0, 1e-3, 0.05]), errs
+    # measured at 160 slices: 1.1e-5, 0.55, 4.5e-5, 2.1e-4
+    assert np.all(errs[-1] < [5e-5, 1.0, 2e-4, 1e-3]), errs
     assert errs[2, 0] < errs[0, 0] / 3 and errs[2, 2] < errs[0, 2] / 3, errs
     # the open zone is dragged along: positive deflection w = gap - e + delta there
     w_open = (gap - e_of(y) + d)[open_]
