@@ -35,8 +35,9 @@ NOT_CONVERGED_STATUS = 3
 
 JSON_KEYS_DOC = """JSON keys:
   input            the design and options as given (design, side, torque_Nm,
-                   misalignment_um, positions, slices, compliance, rpm, oil, sigma_um,
-                   film, viscosity)
+                   misalignment_um, positions, slices, compliance,
+                   coupling_length_mm (the value used, mm), rpm, oil, sigma_um, film,
+                   viscosity)
   torque_Nm        the pinion torques (N m), T values
   misalignment_um  the mesh misalignments f_ma (um over the face width), A values
   te_ptp_um        loaded TE peak-to-peak over the mesh cycle (um along the line of
@@ -92,6 +93,12 @@ def register(sub):
                    help="tooth compliance per unit length of contact line: weber (Weber/"
                         "Sainsot cantilevers and Weber's contact term) or iso6336 (the "
                         "constant single stiffness of ISO 6336-1); default weber")
+    clo, chi = gj.involute.COUPLING_LENGTH_RANGE_MM
+    p.add_argument("--coupling-length-mm", default="0",
+                   help=f"coupling length of the slices along the face (mm, in [{clo:g}, "
+                        f"{chi:g}]), or 'module' (the normal module, the recommended value): "
+                        "a Pasternak foundation along each tooth pair's face; 0 (default): "
+                        "independent slices (Winkler)")
     rlo, rhi = gj.loading.RPM_RANGE
     p.add_argument("--rpm", type=float, default=None,
                    help=f"pinion speed (rpm, in [{rlo:g}, {rhi:g}]): adds the sliding power "
@@ -195,24 +202,32 @@ def run(args) -> int:
         oil, surf, _ = lubricant_from_args(args)
         lube = dict(pinion_rpm=args.rpm, oil=oil, surface=surf,
                     viscosity_model=args.viscosity, film_method=args.film)
+    by_module = args.coupling_length_mm.strip() == "module"
+    if not by_module:
+        coupling = _number("--coupling-length-mm", args.coupling_length_mm,
+                           *gj.involute.COUPLING_LENGTH_RANGE_MM, "mm")
     design = (involute_design(args.design)[1] if is_involute(args.design)
               else gj.load_design(args.design))
     if not isinstance(design, (gj.involute.InvoluteFile, gj.involute.InvoluteTCA)):
         raise ValueError(f"DESIGN {args.design!r} is not an involute pair: `gearjax loaded` "
                          "analyses spur and helical involute pairs ([design] kind = "
                          "'involute' or involute:...)")
+    if by_module:
+        coupling = gj.involute.module_coupling_length(design)
     with Progress(1, "loaded") as bar, bar.phase(
             f"{args.side} side: loaded line contact, {len(torques)} torque(s) x "
             f"{len(mis)} misalignment(s), {positions} positions x {slices} slices"):
         res = gj.involute.loaded_te_map(design, torques, mis, side=args.side,
                                         positions=positions, slices=slices,
-                                        compliance=args.compliance, **lube)
+                                        compliance=args.compliance,
+                                        coupling_length_mm=coupling, **lube)
         bar.update()
     arr = lambda a: np.asarray(a, float).tolist()  # noqa: E731
     out = {
         "input": {"design": args.design, "side": args.side, "torque_Nm": torques,
                   "misalignment_um": mis, "positions": positions, "slices": slices,
-                  "compliance": args.compliance, "rpm": args.rpm, "oil": args.oil,
+                  "compliance": args.compliance, "coupling_length_mm": coupling,
+                  "rpm": args.rpm, "oil": args.oil,
                   "sigma_um": args.sigma_um, "film": args.film, "viscosity": args.viscosity},
         "torque_Nm": arr(res.torque_Nm), "misalignment_um": arr(res.misalignment_um),
         "te_ptp_um": arr(res.te_ptp_um), "te_mean_um": arr(res.te_mean_um),
@@ -229,7 +244,8 @@ def run(args) -> int:
     bad = [(T, a) for i, j, T, a in _rows(out) if not out["converged"][i][j]]
     for T, a in bad:
         out["warnings"].append(f"{args.side} side: the loaded contact at {T:g} N m, f_ma "
-                               f"{a:g} um did not converge (torque balance or no contact)")
+                               f"{a:g} um did not converge (torque balance, no contact, or "
+                               "the coupled contact's active set)")
     for w in out["warnings"]:
         sys.stderr.write(f"gearjax: warning: {w}\n")
     if args.plot is not None:
@@ -257,7 +273,8 @@ def run(args) -> int:
 def _print_table(out, args):
     inp = out["input"]
     print(f"# loaded line contact {args.design} ({args.side}); {inp['positions']} positions "
-          f"x {inp['slices']} slices, compliance {inp['compliance']}")
+          f"x {inp['slices']} slices, compliance {inp['compliance']}, coupling length "
+          f"{inp['coupling_length_mm']:g} mm")
     eff = out["efficiency"] is not None
     print(f"{'torque[Nm]':>11s} {'f_ma[um]':>9s} {'LTE_ptp[um]':>12s} {'LTE_mean[um]':>13s} "
           f"{'p_max[MPa]':>11s} {'K_Hbeta':>8s} {'end_load':>9s} "

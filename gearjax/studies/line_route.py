@@ -87,13 +87,16 @@ class LineChain:
     name (a member or a flank table) to its name there; ``__call__(tree, T_Nm, rpm,
     f_ma_um, oil, surface) -> (LineLoad, LineEfficiency or None)`` (traceable)."""
 
-    def __init__(self, design, side, positions, slices, compliance, efficiency):
+    def __init__(self, design, side, positions, slices, compliance, efficiency,
+                 coupling_length_mm=0.0):
         from gearjax.gears.involute.design_file import MICRO_KEYS
         from gearjax.gears.involute.loaded_lines import line_design, line_options
         self.design, self.side, self.efficiency = design, side, efficiency
         self.pair_geo, self.b, self.mods0, self.material = line_design(design, None, side)
-        self.opts = line_options(self.pair_geo, self.b, positions, slices, compliance)
-        self.options = {"positions": positions, "slices": slices, "compliance": compliance}
+        self.opts = line_options(self.pair_geo, self.b, positions, slices, compliance,
+                                 coupling_length_mm)
+        self.options = {"positions": positions, "slices": slices, "compliance": compliance,
+                        "coupling_length_mm": coupling_length_mm}
         self.pair = {"microgeometry": {
             f"{m}_{side}": {k: jnp.asarray(getattr(getattr(self.mods0, m), f), jnp.float64)
                             for k, f in MICRO_KEYS.items()} for m in ("pinion", "gear")}}
@@ -154,7 +157,7 @@ def line_chain(design, study) -> LineChain:
     comp = study.operating.get("compliance", "weber")
     try:
         chain = LineChain(design, study.side, study.line["positions"], study.line["slices"],
-                          comp, efficiency)
+                          comp, efficiency, study.line.get("coupling_length_mm", 0.0))
     except (ValueError, TypeError) as exc:
         raise ValueError(f"[study] design = {study.design!r}: {exc}") from None
     micro = design.micro

@@ -410,9 +410,19 @@ def _line_table(data, route: str, op: dict, scenarios: dict) -> dict:
         raise ValueError("[operating] torque_Nm: a line-contact study needs the torque "
                          "([operating] torque_Nm or [scenarios] torque_Nm)")
     ln = data.get("line", {})
-    check_keys("line", ln, set(LINE_DEFAULTS))
-    return {k: check_integer("line", k, ln.get(k, d), 4 if k == "positions" else 1)
-            for k, d in LINE_DEFAULTS.items()}
+    check_keys("line", ln, set(LINE_DEFAULTS) | {"coupling_length_mm"})
+    out = {k: check_integer("line", k, ln.get(k, d), 4 if k == "positions" else 1)
+           for k, d in LINE_DEFAULTS.items()}
+    # the coupling of the slices along the face (mm; 0: Winkler), docs/microgeometry.md
+    from gearjax.errors import check_range
+    from gearjax.gears.involute.loaded_lines import COUPLING_LENGTH_RANGE_MM
+    lam = check_number("line", "coupling_length_mm", ln.get("coupling_length_mm", 0.0))
+    try:
+        out["coupling_length_mm"] = check_range("coupling_length_mm", lam,
+                                                *COUPLING_LENGTH_RANGE_MM, unit="mm")
+    except ValueError as exc:
+        raise ValueError(f"[line] {exc}") from None
+    return out
 
 
 def _kinematics_table(data, route: str) -> dict:

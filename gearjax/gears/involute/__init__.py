@@ -16,13 +16,15 @@ from gearjax.gears.involute.limits import involute_limits
 from gearjax.gears.involute.design_file import InvoluteFile
 from gearjax.gears.involute.microgeometry import (FlankModification, MicroGeometry,
                                                   PairModification, flank_removal_um)
-from gearjax.gears.involute.loaded_lines import (MISALIGNMENT_RANGE_UM, TORQUE_RANGE_NM,
+from gearjax.gears.involute.loaded_lines import (COUPLING_LENGTH_RANGE_MM,
+                                                 MISALIGNMENT_RANGE_UM, TORQUE_RANGE_NM,
                                                  LoadedTEMap, line_contact, loaded_te_map,
-                                                 resolution_warnings)
+                                                 module_coupling_length, resolution_warnings)
 from gearjax.gears.involute.line_tca import LineTCA, line_tca
 
 __all__ = ["InvolutePair", "generated_flank", "pair_geometry", "path_kinematics", "path_table",
            "InvoluteTCA", "involute_limits", "InvoluteFile", "FlankModification",
            "PairModification", "MicroGeometry", "flank_removal_um", "line_contact",
            "loaded_te_map", "LoadedTEMap", "TORQUE_RANGE_NM", "MISALIGNMENT_RANGE_UM",
-           "resolution_warnings", "line_tca", "LineTCA"]
+           "resolution_warnings", "line_tca", "LineTCA", "COUPLING_LENGTH_RANGE_MM",
+           "module_coupling_length"]

@@ -31,9 +31,13 @@ along its normal.
 **Compliance: a Winkler foundation of thin slices.**  This is the elastic foundation
 behind ISO 6336-1's face load factor: the mesh as independent springs of stiffness
 ``c_gamma`` per unit face width.  Their linear load distribution under a mesh
-misalignment gives the standard's K_Hbeta formulas, which the tests reproduce.  The
-slices are not coupled along the face, so a modification's effect spreads only as
-far as the slice width; that is the model's stated limit.  A slice of contact-line length
+misalignment gives the standard's K_Hbeta formulas, which the tests reproduce.  By
+default the slices are not coupled along the face, so a modification's effect spreads
+only as far as the slice width.  With ``opts.coupling_length`` > 0 the slices of each
+tooth pair are coupled by a Pasternak foundation along the face, ``k w - G w'' = q``
+with free ends ([Pasternak1954], [AjmiVelex2005]), and the equilibrium below becomes a
+linear complementarity problem solved per position by an active-set method
+(:mod:`gearjax.gears.involute.face_coupling`).  A slice of contact-line length
 ``l`` has the normal stiffness ``k = l / q'(s)`` (N/mm), ``q'`` the compliance of the
 tooth pair per unit length of contact line at that point of the path: both teeth as
 Weber/Sainsot cantilevers of the virtual spur gears of the normal section plus
@@ -64,13 +68,15 @@ of action, positive: the gear lags; the angle is ``delta / r_b2`` of the gear), 
 unloaded TE ``min_j e_j`` (the approach at zero load), loads, line loads ``F / l``
 (N/mm) and Hertz pressures of the line contact of the normal-section radii ``rho_n =
 xi / cos(beta_b)`` ([Johnson1985] eq. 4.45), the mesh stiffness ``c_gamma =
-cos^2(beta_b) sum_(loaded) k / b`` (N/(mm µm) after the unit factor: transverse load
-along the line of action per unit face width per µm of approach), and the face load
+cos^2(beta_b) (dW/d delta) / b``, ``dW/d delta = sum_(loaded) k`` for the Winkler
+foundation (N/(mm µm) after the unit factor: transverse load along the line of action
+per unit face width per µm of approach), and the face load
 factor ``K_Hbeta = max_y w(y) / mean_y w(y)`` of the load per unit face width ``w(y)``
 (summed over the pairs; per position and for the cycle-mean distribution, [ISO6336-1]).
 
 Units: mm, N, N mm, MPa, µm where named.  References (docs/references.md):
-[ISO21771]; [ISO6336-1]; [Weber1949]; [Sainsot2004]; [Johnson1985].
+[ISO21771]; [ISO6336-1]; [Weber1949]; [Sainsot2004]; [Johnson1985]; [Pasternak1954];
+[AjmiVelex2005].
 """
 
 from __future__ import annotations
@@ -82,6 +88,7 @@ import jax
 import jax.numpy as jnp
 
 from gearjax.contact import hertz_line_traced
+from gearjax.gears.involute.face_coupling import ACTIVE_SET_STEPS, coupled_solve, face_links
 from gearjax.gears.involute.geometry import InvolutePair, pair_geometry
 from gearjax.gears.involute.mesh import virtual_teeth
 from gearjax.gears.involute.microgeometry import (PairModification, flank_removal_um,
@@ -109,6 +116,10 @@ class LineLoadOptions(NamedTuple):
         (:func:`path_points_bound`; 0: no bound known).  The friction of
         :mod:`gearjax.gears.involute.line_efficiency` is evaluated at that many points
         per position instead of at every pair's slices.
+    coupling_length : the coupling length ``lambda`` (mm) of the Pasternak foundation
+        along the face (:mod:`gearjax.gears.involute.face_coupling`); 0: the Winkler
+        foundation of independent slices (the module docstring's model, the default).
+    coupling_steps : cap of the coupled contact's active-set iterations.
     """
 
     positions: int = 32
@@ -117,6 +128,8 @@ class LineLoadOptions(NamedTuple):
     k_hi: int = 3
     compliance: str = "weber"
     path_points: int = 0
+    coupling_length: float = 0.0
+    coupling_steps: int = ACTIVE_SET_STEPS
 
 
 def path_points_bound(pair: InvolutePair, face_width, slices: int) -> int:
@@ -178,7 +191,15 @@ class LineLoad(NamedTuple):
         more than the middle over the cycle; 1 for an aligned unmodified pair).
     n_points : (M,) slice points carrying load.
     balance : (M,) relative torque residual.  converged : (M,) balance below
-        :data:`BALANCE_TOL` and some point on the path.
+        :data:`BALANCE_TOL` and some point on the path (with coupling also the active
+        set found and the complementarity residual below its tolerance).
+    gap_um : (K, M, N) loaded gap ``w + e - delta`` of each slice point (µm; 0 where
+        loaded, NaN off the path), ``w`` the slice's deflection: ``max(delta - e, 0)``
+        for the Winkler foundation, the coupled solution's with coupling.
+    complementarity : (M,) complementarity residual: the largest tensile load over the
+        transmitted load, or interpenetration over the compression
+        (:func:`~gearjax.gears.involute.face_coupling.coupled_solve`; 0 for the Winkler
+        foundation, whose loads are ``k max(delta - e, 0)`` by construction).
     """
 
     s0: jax.Array
@@ -203,6 +224,8 @@ class LineLoad(NamedTuple):
     n_points: jax.Array
     balance: jax.Array
     converged: jax.Array
+    gap_um: jax.Array
+    complementarity: jax.Array
 
 
 def _solve(e, k, W):
@@ -280,16 +303,34 @@ def line_load_traced(pair: InvolutePair, face_width, mods: PairModification, tor
     e_pos = jnp.moveaxis(e, 1, 0).reshape(M, -1)
     k_pos = jnp.moveaxis(k, 1, 0).reshape(M, -1)
     delta, some = jax.vmap(_solve, in_axes=(0, 0, None))(e_pos, k_pos, W)
-    gap = jnp.maximum(delta[None, :, None] - e, 0.0)
-    F = k * gap * cb
+    if opts.coupling_length > 0.0:
+        # Pasternak foundation along each pair's face (face_coupling); links per pair
+        link = face_links(jnp.where(on, dy / (cb * q_unit), 0.0), frac, dy,
+                          opts.coupling_length)
+        link_pos = jnp.moveaxis(link, 1, 0).reshape(M, -1)
+        sol = jax.vmap(lambda e_, k_, c_, d_: coupled_solve(e_, k_, c_, W, d_,
+                                                            opts.coupling_steps))(
+            e_pos, k_pos, link_pos, delta)
+        delta = sol.delta
+        F = jnp.moveaxis(sol.load.reshape(M, k.shape[0], N), 0, 1) * cb
+        gap = jnp.moveaxis(sol.w.reshape(M, k.shape[0], N), 0, 1) + e - delta[None, :, None]
+        slope = sol.slope
+        comp_res = sol.residual
+        solved = sol.converged
+    else:
+        F = k * jnp.maximum(delta[None, :, None] - e, 0.0) * cb
+        gap = jnp.maximum(e - delta[None, :, None], 0.0)
+        slope = jnp.sum(jnp.where(F > 0.0, k, 0.0), axis=(0, 2))
+        comp_res = jnp.zeros(M)
+        solved = True
     balance = jnp.abs(jnp.sum(F, axis=(0, 2)) * rb1 * cb / T1 - 1.0)
-    converged = some & (balance <= BALANCE_TOL)
+    converged = some & (balance <= BALANCE_TOL) & solved
     w_line = jnp.where(on, F / jnp.where(on, length, 1.0), 0.0)
     E_prime = E / (1.0 - nu ** 2)
     loaded = F > 0.0
     half_w, p = hertz_line_traced(jnp.where(loaded, w_line, 1.0), r_n, E_prime)
     p_max = jnp.where(loaded, p, 0.0)
-    stiff = cb ** 2 * jnp.sum(jnp.where(loaded, k, 0.0), axis=(0, 2)) / b * 1e-3
+    stiff = cb ** 2 * slope / b * 1e-3
     face = jnp.sum(F, axis=0) / dy                    # (M, N) normal load per face width
     mean_face = jnp.mean(face, axis=1)
     k_hb = jnp.max(face, axis=1) / mean_face
@@ -302,7 +343,8 @@ def line_load_traced(pair: InvolutePair, face_width, mods: PairModification, tor
                     end_load=jnp.maximum(face[:, 0], face[:, -1]) / mean_face,
                     end_load_mean=jnp.maximum(cyc[0], cyc[-1]) / jnp.mean(cyc),
                     n_points=jnp.sum(loaded, axis=(0, 2)), balance=balance,
-                    converged=converged)
+                    converged=converged, gap_um=jnp.where(on, 1e3 * gap, jnp.nan),
+                    complementarity=comp_res)
 
 
 def smooth_ptp(x, temperature):

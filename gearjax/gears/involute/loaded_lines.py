@@ -35,13 +35,18 @@ from gearjax.loading.loaded_contact import COMPLIANCE_MODELS
 from gearjax.loading.materials import pair_material
 
 __all__ = ["line_contact", "loaded_te_map", "LoadedTEMap", "line_design", "resolution_warnings",
-           "line_options",
-           "TORQUE_RANGE_NM", "MISALIGNMENT_RANGE_UM"]
+           "line_options", "module_coupling_length",
+           "TORQUE_RANGE_NM", "MISALIGNMENT_RANGE_UM", "COUPLING_LENGTH_RANGE_MM",
+           "COUPLING_LENGTH_PER_MODULE"]
 
 #: accepted pinion torques (N m)
 TORQUE_RANGE_NM = (1e-3, 1e7)
 #: accepted mesh misalignments (µm)
 MISALIGNMENT_RANGE_UM = (-1000.0, 1000.0)
+#: accepted coupling lengths of the foundation along the face (mm; 0: Winkler)
+COUPLING_LENGTH_RANGE_MM = (0.0, 1000.0)
+#: recommended coupling length over the normal module (docs/microgeometry.md)
+COUPLING_LENGTH_PER_MODULE = 1.0
 
 
 def line_design(design, mods=None, side: str = "drive"):
@@ -96,18 +101,30 @@ def resolution_warnings(design, slices) -> list:
             f"lines is coarsely resolved; use at least {need} slices"]
 
 
-def line_options(pair, b, positions, slices, compliance) -> LineLoadOptions:
+def line_options(pair, b, positions, slices, compliance,
+                 coupling_length_mm=0.0) -> LineLoadOptions:
     """The static :class:`~gearjax.gears.involute.line_load.LineLoadOptions` of ``pair``
-    (concrete; face width ``b`` mm): the checked resolution and compliance model, the
-    tooth pairs of :func:`~gearjax.gears.involute.line_load.pair_range` and the bound of
-    the points on the path."""
+    (concrete; face width ``b`` mm): the checked resolution, compliance model and
+    coupling length along the face (mm; 0: Winkler), the tooth pairs of
+    :func:`~gearjax.gears.involute.line_load.pair_range` and the bound of the points on
+    the path."""
     check_int("positions", positions, lo=4, hi=1024)
     check_int("slices", slices, lo=1, hi=400)
     if compliance not in COMPLIANCE_MODELS:
         raise ValueError(f"compliance = {compliance!r} must be one of {COMPLIANCE_MODELS}")
+    lam = check_range("coupling_length_mm", coupling_length_mm, *COUPLING_LENGTH_RANGE_MM,
+                      unit="mm")
     k_lo, k_hi = pair_range(pair, b)
     return LineLoadOptions(int(positions), int(slices), k_lo, k_hi, compliance,
-                           path_points_bound(pair, b, int(slices)))
+                           path_points_bound(pair, b, int(slices)), float(lam))
+
+
+def module_coupling_length(design) -> float:
+    """The recommended coupling length of ``design`` (mm): :data:`COUPLING_LENGTH_PER_MODULE`
+    times its normal module (the decay length of a local load along the face is of the
+    order of the tooth's height; docs/microgeometry.md)."""
+    pair, _, _, _ = line_design(design)
+    return COUPLING_LENGTH_PER_MODULE * float(pair.module)
 
 
 def _split(pair):
@@ -128,15 +145,18 @@ def _one(blank, teeth, b, mods, T, f_ma, E, nu, opts, drive):
 
 
 def line_contact(design, torque_Nm, *, mods=None, misalignment_um=0.0, side="drive",
-                 positions=32, slices=20, compliance="weber") -> LineLoad:
+                 positions=32, slices=20, compliance="weber",
+                 coupling_length_mm=0.0) -> LineLoad:
     """The loaded line contact of ``design`` at ``torque_Nm`` (pinion, N m) and mesh
     misalignment ``misalignment_um`` (µm over the face width): a
     :class:`~gearjax.gears.involute.line_load.LineLoad` over one mesh cycle
-    (``positions`` per base pitch, ``slices`` across the face)."""
+    (``positions`` per base pitch, ``slices`` across the face; ``coupling_length_mm``
+    > 0: the slices of a tooth pair coupled along the face,
+    :mod:`gearjax.gears.involute.face_coupling`)."""
     T = check_range("torque_Nm", torque_Nm, *TORQUE_RANGE_NM, unit="N m")
     f = check_range("misalignment_um", misalignment_um, *MISALIGNMENT_RANGE_UM, unit="um")
     pair, b, mods, mat = line_design(design, mods, side)
-    opts = line_options(pair, b, positions, slices, compliance)
+    opts = line_options(pair, b, positions, slices, compliance, coupling_length_mm)
     return _one(*_split(pair), b, mods, 1e3 * T, f, mat.youngs_modulus_MPa, mat.poisson,
                 opts, side == "drive")
 
@@ -210,11 +230,12 @@ def _map(blank, teeth, b, mods, T, f_ma, E, nu, temperature_um, rpm, oil, surfac
 def loaded_te_map(design, torques_Nm, misalignments_um=(0.0,), *, mods=None, side="drive",
                   positions=32, slices=20, compliance="weber", temperature_um=0.01,
                   pinion_rpm=None, oil=None, surface=None, viscosity_model="roelands",
-                  film_method="auto") -> LoadedTEMap:
+                  film_method="auto", coupling_length_mm=0.0) -> LoadedTEMap:
     """Loaded TE, peak pressure and face load factor of ``design`` over every torque
     (N m) and misalignment (µm) in one vmapped, jitted program (:class:`LoadedTEMap`);
     with ``pinion_rpm``, ``oil`` and ``surface`` also the sliding power loss and the
-    mesh efficiency (:mod:`gearjax.gears.involute.line_efficiency`)."""
+    mesh efficiency (:mod:`gearjax.gears.involute.line_efficiency`);
+    ``coupling_length_mm`` > 0 couples the slices along the face (:func:`line_contact`)."""
     T = np.atleast_1d(np.asarray(torques_Nm, float))
     A = np.atleast_1d(np.asarray(misalignments_um, float))
     if T.ndim != 1 or T.size == 0 or A.ndim != 1 or A.size == 0:
@@ -224,6 +245,8 @@ def loaded_te_map(design, torques_Nm, misalignments_um=(0.0,), *, mods=None, sid
     for a in A:
         check_range("misalignments_um", a, *MISALIGNMENT_RANGE_UM, unit="um")
     check_range("temperature_um", temperature_um, 0.0, 10.0, lo_open=True, unit="um")
+    check_range("coupling_length_mm", coupling_length_mm, *COUPLING_LENGTH_RANGE_MM,
+                unit="mm")
     pair, b, mods, mat = line_design(design, mods, side)
     rpm = None
     if pinion_rpm is not None:
@@ -235,7 +258,7 @@ def loaded_te_map(design, torques_Nm, misalignments_um=(0.0,), *, mods=None, sid
                                 film_method)
         rpm = float(pinion_rpm)
         oil = dataclasses.replace(oil, name="")     # the label is not part of the program
-    opts = line_options(pair, b, positions, slices, compliance)
+    opts = line_options(pair, b, positions, slices, compliance, coupling_length_mm)
     out = call(_map, *_split(pair), b, mods, jnp.asarray(1e3 * T), jnp.asarray(A),
                mat.youngs_modulus_MPa, mat.poisson, float(temperature_um), rpm, oil, surface,
                opts=opts, drive=side == "drive", vm=viscosity_model, fm=film_method)
