@@ -144,6 +144,10 @@ def test_unmodified_tables_give_zero_te_as_the_point_contact_tca():
     assert all(v == 0.0 for v in data["te_um"])
     eps = data["contact_ratio"] + data["overlap_ratio"]
     assert data["contact_ratio_zero_load"] == pytest.approx(eps, abs=4.0 / 16)
+    # ISO 21771: eps_beta = b sin(beta) / (pi m_n) (= b tan(beta_b) / p_bt)
+    pair = gj.load_design(UNMODIFIED).design.pair
+    assert data["overlap_ratio"] == pytest.approx(
+        30.0 * math.sin(float(pair.helix)) / (math.pi * float(pair.module)), rel=1e-12)
     res = gj.run_tca(gj.load_design(UNMODIFIED).design)
     assert float(res.multi.ptp) / gj.ARCSEC < 1e-6
     assert float(res.multi.contact_ratio) == pytest.approx(data["contact_ratio"], rel=1e-9)
