@@ -487,6 +487,10 @@ def test_cli_flag_reaches_the_model_and_is_checked(monkeypatch):
     m = gj.involute.loaded_te_map(gj.load_design(ex), [200.0], positions=8, slices=6,
                                   coupling_length_mm=3.0)
     assert js["te_ptp_um"][0][0] == pytest.approx(float(m.te_ptp_um[0, 0]), rel=1e-12)
+    # p_max is where the coupling shows at this aligned point (the TE p-t-p hardly moves)
+    assert js["p_max_MPa"][0][0] == pytest.approx(float(m.p_max[0, 0]), rel=1e-12)
+    w = gj.involute.loaded_te_map(gj.load_design(ex), [200.0], positions=8, slices=6)
+    assert abs(float(w.p_max[0, 0]) - float(m.p_max[0, 0])) > 1.0
     monkeypatch.setattr(gj.involute, "loaded_te_map",
                         lambda *a, **k: pytest.fail("computed on bad input"))
     for bad in ("-1", "abc", "2000"):
