@@ -416,3 +416,71 @@ def test_coupling_length_refused_in_one_line_before_any_work(monkeypatch, argv, 
     monkeypatch.setattr(gj.involute, "line_tca", forbidden)
     rc, out, err = _call(argv)
     assert rc == 2 and match in err and err.count("\n") == 1, err
+
+
+# ------------------------------------------------------- side, misalignment, arcsec
+
+def _two_sided(tmp_path):
+    """A design whose pinion flanks differ: drive tip relief 8 um, coast 2 um over
+    other lengths (the side must reach the model)."""
+    text = gj.io.read_toml(EXAMPLE)
+    mg = text["microgeometry"]
+    pin = mg.pop("pinion")
+    mg["pinion_drive"] = dict(pin)
+    mg["pinion_coast"] = dict(pin, tip_relief_um=2.0, tip_relief_length_mm=1.0)
+    path = tmp_path / "two_sided.toml"
+    path.write_text(gj.io.dumps_toml(text))
+    return str(path)
+
+
+def test_side_and_misalignment_reach_the_model(tmp_path):
+    """``line_tca``, `gearjax tca` and `gearjax efficiency` on the coast side of a design
+    whose coast flank differs, at a mesh misalignment, against ``loaded_te_map`` with
+    that side and misalignment (the library route of `gearjax loaded`); the arcsec
+    columns of the gear's base radius.  Catches: the side or the misalignment dropped
+    on the way (the drive side's, or the aligned mesh's, numbers), the loaded TE of
+    ``line_tca`` at f_ma = 0, the efficiency's arcsec of r_b1."""
+    path = _two_sided(tmp_path)
+    design = gj.load_design(path)
+    kw = dict(positions=8, slices=6)
+    m = gj.involute.loaded_te_map(design, [200.0], [-12.0], side="coast", **kw)
+    md = gj.involute.loaded_te_map(design, [200.0], [-12.0], side="drive", **kw)
+    assert abs(float(m.te_ptp_um[0, 0]) - float(md.te_ptp_um[0, 0])) > 1e-3
+    r = gj.involute.line_tca(design, torques_Nm=[200.0], side="coast", misalignment_um=-12.0,
+                             **kw)
+    assert float(r.te_loaded_ptp_um[0]) == pytest.approx(float(m.te_ptp_um[0, 0]), rel=1e-10)
+    assert float(r.ptp_um) == pytest.approx(float(m.te_unloaded_ptp_um[0, 0]), rel=1e-10)
+    rc, out, err = _call(["tca", path, *SMALL, "--side", "coast", "--misalignment-um", "-12",
+                          "--torque-Nm", "200", "--json"])
+    assert rc == 0, err
+    t = strict_json(out)
+    assert t["loaded"]["te_ptp_um"][0] == pytest.approx(float(m.te_ptp_um[0, 0]), rel=1e-10)
+    assert t["ptp_um"] == pytest.approx(float(m.te_unloaded_ptp_um[0, 0]), rel=1e-10)
+    rc, out, err = _call(["efficiency", path, "--torque-Nm", "200", *LUBE, *SMALL, "--side",
+                          "coast", "--misalignment-um", "-12", "--json"])
+    assert rc == 0, err
+    e = strict_json(out)
+    assert e["te_loaded_ptp_um"][0] == pytest.approx(float(m.te_ptp_um[0, 0]), rel=1e-10)
+    rb2 = float(gj.involute.pair_geometry(design.design.pair)["rb2"])
+    assert e["te_loaded_ptp_arcsec"][0] == pytest.approx(
+        1e-3 * e["te_loaded_ptp_um"][0] / rb2 / gj.ARCSEC, rel=1e-12)
+    assert e["modifications"]["pinion"]["tip_relief"] == 2.0
+
+
+@pytest.mark.parametrize("argv, match", [
+    (["tca", "example:khk_spur_12x24", "--misalignment-um", "5"], "--misalignment-um = 5"),
+    (["tca", "example:khk_spur_12x24", "--slices", "6"], "--slices = 6"),
+])
+def test_line_options_refused_for_a_point_contact_tca(argv, match):
+    """Catches: a line-contact option silently ignored by the point-contact TCA."""
+    rc, out, err = _call(argv)
+    assert rc == 2 and match in err and err.count("\n") == 1, err
+
+
+def test_tca_plot_without_torques(tmp_path):
+    """The figure of the unloaded TCA alone (no loaded TE to draw).  Catches: the figure
+    taking every result for a loaded one (an empty torque array is not None)."""
+    png = tmp_path / "u.png"
+    rc, out, err = _call(["tca", EXAMPLE, *SMALL, "--plot", str(png)])
+    assert rc == 0, err
+    assert png.stat().st_size > 10_000
