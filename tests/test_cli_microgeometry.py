@@ -144,6 +144,10 @@ def test_unmodified_tables_give_zero_te_as_the_point_contact_tca():
     assert all(v == 0.0 for v in data["te_um"])
     eps = data["contact_ratio"] + data["overlap_ratio"]
     assert data["contact_ratio_zero_load"] == pytest.approx(eps, abs=4.0 / 16)
+    # ISO 21771: eps_beta = b sin(beta) / (pi m_n) (= b tan(beta_b) / p_bt)
+    pair = gj.load_design(UNMODIFIED).design.pair
+    assert data["overlap_ratio"] == pytest.approx(
+        30.0 * math.sin(float(pair.helix)) / (math.pi * float(pair.module)), rel=1e-12)
     res = gj.run_tca(gj.load_design(UNMODIFIED).design)
     assert float(res.multi.ptp) / gj.ARCSEC < 1e-6
     assert float(res.multi.contact_ratio) == pytest.approx(data["contact_ratio"], rel=1e-9)
@@ -176,7 +180,7 @@ def spur(tmp_path_factory):
     xi_s = rho_A + 0.5 * eps * p_bt
     path = _spur_design(d, rho_E - xi_s)
     return path, dict(rho_A=rho_A, rho_E=rho_E, rho_P=rho_P, p_bt=p_bt, xi_s=xi_s,
-                      rb2=float(geo["rb2"]), eps=eps)
+                      rb1=float(geo["rb1"]), rb2=float(geo["rb2"]), eps=eps)
 
 
 def _closed_form(s0, g):
@@ -201,6 +205,9 @@ def test_tip_relief_closed_form_library(spur):
     assert float(r.ptp_um) == pytest.approx(want.max() - want.min(), abs=1e-9)
     # the first contact: the lowest pair (pair 0 at s0 in one base pitch from s_A)
     np.testing.assert_allclose(np.asarray(r.first_xi1_mm), g["rho_P"] + s0, atol=1e-9)
+    # its radius on the pinion: the involute's r = sqrt(r_b1^2 + xi1^2)
+    np.testing.assert_allclose(np.asarray(r.first_r1_mm), np.hypot(g["rb1"], g["rho_P"] + s0),
+                               rtol=1e-12)
     assert set(np.asarray(r.first_pair).tolist()) == {0}
     # where the lower pair is alone, one pair touches; where two are on the path below
     # the relief, only the lower one touches (the upper is relieved)
@@ -350,3 +357,130 @@ def test_bad_input_refused_in_one_line_before_any_work(argv, needle, monkeypatch
     assert rc == 2 and text == "", (argv, err)
     lines = err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("gearjax: error:") and needle in err, err
+
+
+# ------------------------------------------------------- the coupling along the face
+
+def test_coupling_length_reaches_the_tca_and_efficiency_routes():
+    """``--coupling-length-mm`` of the two commands' line routes against
+    ``loaded_te_map`` with the same coupling (the library route of `gearjax loaded`);
+    ``module`` is the design's normal module; the unloaded TE does not depend on it.
+    Catches: the option parsed but not passed to the model (the Winkler numbers, which
+    differ here), ``module`` resolved to another length, the unloaded TE coupled."""
+    design = gj.load_design(EXAMPLE)
+    lam = gj.involute.module_coupling_length(design)
+    assert lam == pytest.approx(float(design.design.pair.module))
+    rc, out, err = _call(["tca", EXAMPLE, *SMALL, "--torque-Nm", "200", "--coupling-length-mm",
+                          "module", "--json"])
+    assert rc == 0, err
+    t = strict_json(out)
+    assert t["input"]["coupling_length_mm"] == lam
+    m = gj.involute.loaded_te_map(design, [200.0], [0.0], positions=8, slices=6,
+                                  coupling_length_mm=lam)
+    w = gj.involute.loaded_te_map(design, [200.0], [0.0], positions=8, slices=6)
+    np.testing.assert_allclose(t["loaded"]["te_ptp_um"], np.asarray(m.te_ptp_um)[:, 0],
+                               rtol=1e-9)
+    np.testing.assert_allclose(t["loaded"]["p_max_MPa"], np.asarray(m.p_max)[:, 0], rtol=1e-9)
+    assert abs(float(m.p_max[0, 0]) - float(w.p_max[0, 0])) > 1.0     # the coupling acts
+    r = gj.involute.line_tca(design, positions=8, slices=6)
+    np.testing.assert_allclose(t["te_um"], np.asarray(r.te_um), atol=1e-12)
+    rc, out, err = _call(["efficiency", EXAMPLE, "--torque-Nm", "200", *LUBE, *SMALL,
+                          "--coupling-length-mm", "2.5", "--json"])
+    assert rc == 0, err
+    e = strict_json(out)
+    assert e["input"]["coupling_length_mm"] == 2.5
+    rc, out, err = _call(["loaded", EXAMPLE, "--torque-Nm", "200", *LUBE, *SMALL,
+                          "--coupling-length-mm", "2.5", "--json"])
+    assert rc == 0, err
+    ld = strict_json(out)
+    assert e["power_loss_W"][0] == pytest.approx(ld["power_loss_W"][0][0], rel=1e-12)
+    assert e["p_max_MPa"][0] == pytest.approx(ld["p_max_MPa"][0][0], rel=1e-12)
+
+
+@pytest.mark.parametrize("argv, match", [
+    (["tca", "example:khk_spur_12x24", "--coupling-length-mm", "2"], "--coupling-length-mm = 2"),
+    (["tca", EXAMPLE, "--torque-Nm", "200", "--coupling-length-mm", "-1"],
+     "--coupling-length-mm = -1"),
+    (["tca", EXAMPLE, "--coupling-length-mm", "modul"], "--coupling-length-mm: 'modul'"),
+    (["efficiency", "example:khk_spur_12x24", "--torque-Nm", "200", *LUBE,
+      "--coupling-length-mm", "module"], "--coupling-length-mm = module"),
+    (["efficiency", EXAMPLE, "--torque-Nm", "200", *LUBE, "--coupling-length-mm", "2000"],
+     "--coupling-length-mm = 2000"),
+])
+def test_coupling_length_refused_in_one_line_before_any_work(monkeypatch, argv, match):
+    """Catches: the option accepted (and ignored) for a point-contact design, or a bad
+    value found only after the design is read and the model compiled."""
+    def forbidden(*a, **k):
+        raise AssertionError("work started for bad input")
+    monkeypatch.setattr(gj.involute, "loaded_te_map", forbidden)
+    monkeypatch.setattr(gj.involute, "line_tca", forbidden)
+    rc, out, err = _call(argv)
+    assert rc == 2 and match in err and err.count("\n") == 1, err
+
+
+# ------------------------------------------------------- side, misalignment, arcsec
+
+def _two_sided(tmp_path):
+    """A design whose pinion flanks differ: drive tip relief 8 um, coast 2 um over
+    other lengths (the side must reach the model)."""
+    text = gj.io.read_toml(EXAMPLE)
+    mg = text["microgeometry"]
+    pin = mg.pop("pinion")
+    mg["pinion_drive"] = dict(pin)
+    mg["pinion_coast"] = dict(pin, tip_relief_um=2.0, tip_relief_length_mm=1.0)
+    path = tmp_path / "two_sided.toml"
+    path.write_text(gj.io.dumps_toml(text))
+    return str(path)
+
+
+def test_side_and_misalignment_reach_the_model(tmp_path):
+    """``line_tca``, `gearjax tca` and `gearjax efficiency` on the coast side of a design
+    whose coast flank differs, at a mesh misalignment, against ``loaded_te_map`` with
+    that side and misalignment (the library route of `gearjax loaded`); the arcsec
+    columns of the gear's base radius.  Catches: the side or the misalignment dropped
+    on the way (the drive side's, or the aligned mesh's, numbers), the loaded TE of
+    ``line_tca`` at f_ma = 0, the efficiency's arcsec of r_b1."""
+    path = _two_sided(tmp_path)
+    design = gj.load_design(path)
+    kw = dict(positions=8, slices=6)
+    m = gj.involute.loaded_te_map(design, [200.0], [-12.0], side="coast", **kw)
+    md = gj.involute.loaded_te_map(design, [200.0], [-12.0], side="drive", **kw)
+    assert abs(float(m.te_ptp_um[0, 0]) - float(md.te_ptp_um[0, 0])) > 1e-3
+    r = gj.involute.line_tca(design, torques_Nm=[200.0], side="coast", misalignment_um=-12.0,
+                             **kw)
+    assert float(r.te_loaded_ptp_um[0]) == pytest.approx(float(m.te_ptp_um[0, 0]), rel=1e-10)
+    assert float(r.ptp_um) == pytest.approx(float(m.te_unloaded_ptp_um[0, 0]), rel=1e-10)
+    rc, out, err = _call(["tca", path, *SMALL, "--side", "coast", "--misalignment-um", "-12",
+                          "--torque-Nm", "200", "--json"])
+    assert rc == 0, err
+    t = strict_json(out)
+    assert t["loaded"]["te_ptp_um"][0] == pytest.approx(float(m.te_ptp_um[0, 0]), rel=1e-10)
+    assert t["ptp_um"] == pytest.approx(float(m.te_unloaded_ptp_um[0, 0]), rel=1e-10)
+    rc, out, err = _call(["efficiency", path, "--torque-Nm", "200", *LUBE, *SMALL, "--side",
+                          "coast", "--misalignment-um", "-12", "--json"])
+    assert rc == 0, err
+    e = strict_json(out)
+    assert e["te_loaded_ptp_um"][0] == pytest.approx(float(m.te_ptp_um[0, 0]), rel=1e-10)
+    rb2 = float(gj.involute.pair_geometry(design.design.pair)["rb2"])
+    assert e["te_loaded_ptp_arcsec"][0] == pytest.approx(
+        1e-3 * e["te_loaded_ptp_um"][0] / rb2 / gj.ARCSEC, rel=1e-12)
+    assert e["modifications"]["pinion"]["tip_relief"] == 2.0
+
+
+@pytest.mark.parametrize("argv, match", [
+    (["tca", "example:khk_spur_12x24", "--misalignment-um", "5"], "--misalignment-um = 5"),
+    (["tca", "example:khk_spur_12x24", "--slices", "6"], "--slices = 6"),
+])
+def test_line_options_refused_for_a_point_contact_tca(argv, match):
+    """Catches: a line-contact option silently ignored by the point-contact TCA."""
+    rc, out, err = _call(argv)
+    assert rc == 2 and match in err and err.count("\n") == 1, err
+
+
+def test_tca_plot_without_torques(tmp_path):
+    """The figure of the unloaded TCA alone (no loaded TE to draw).  Catches: the figure
+    taking every result for a loaded one (an empty torque array is not None)."""
+    png = tmp_path / "u.png"
+    rc, out, err = _call(["tca", EXAMPLE, *SMALL, "--plot", str(png)])
+    assert rc == 0, err
+    assert png.stat().st_size > 10_000

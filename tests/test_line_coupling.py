@@ -487,6 +487,10 @@ def test_cli_flag_reaches_the_model_and_is_checked(monkeypatch):
     m = gj.involute.loaded_te_map(gj.load_design(ex), [200.0], positions=8, slices=6,
                                   coupling_length_mm=3.0)
     assert js["te_ptp_um"][0][0] == pytest.approx(float(m.te_ptp_um[0, 0]), rel=1e-12)
+    # p_max is where the coupling shows at this aligned point (the TE p-t-p hardly moves)
+    assert js["p_max_MPa"][0][0] == pytest.approx(float(m.p_max[0, 0]), rel=1e-12)
+    w = gj.involute.loaded_te_map(gj.load_design(ex), [200.0], positions=8, slices=6)
+    assert abs(float(w.p_max[0, 0]) - float(m.p_max[0, 0])) > 1.0
     monkeypatch.setattr(gj.involute, "loaded_te_map",
                         lambda *a, **k: pytest.fail("computed on bad input"))
     for bad in ("-1", "abc", "2000"):
@@ -518,3 +522,45 @@ def test_loads_continuous_as_a_piece_enters_the_path():
         F = np.asarray(r.load)
         jumps.append(np.abs(F[:, 1] - F[:, 0]).max())
     assert jumps[1] < 1e-3 and jumps[1] < 10 * jumps[0] + 1e-6, jumps
+
+
+def test_complementarity_residual_is_its_definition():
+    """The reported residual of a wrong active set against its definition by hand,
+    ``max(max(-P)/W, max(-g)/(delta - min e))``, where the wrong set leaves points
+    interpenetrating (the gap term decides).  Planted bugs caught: the
+    interpenetration scaled by the load instead of the compression (a residual 2000x too
+    small that would pass a wrong set as converged), a tensile load not counted."""
+    e = jnp.array([0.0, 0.0, 0.01, 0.02])
+    k = jnp.full(4, 1e3)
+    link = jnp.array([1e3, 1e3, 1e3, 0.0])
+    W = 100.0
+    sol = coupled_solve(e, k, link, W, jnp.asarray(0.005), 0)     # the set {0, 1}, kept
+    P, w, d = (np.asarray(a) for a in (sol.load, sol.w, sol.delta))
+    g = w + np.asarray(e) - d
+    assert g[2] < -1e-3                      # point 2 interpenetrates: the set is wrong
+    want = max(np.max(np.maximum(-P, 0.0)) / W, np.max(np.maximum(-g, 0.0)) / (d - 0.0))
+    assert float(sol.residual) == pytest.approx(want, rel=1e-12) and want > 0.1
+    assert not bool(sol.converged)
+
+
+def test_coupled_mesh_stiffness_is_dW_by_d_delta():
+    """The mesh stiffness of the coupled contact under a misalignment and modifications
+    (the active set not the whole line) against the difference quotient of the load
+    over the approach between two torques 1e-6 apart (same active set): c_gamma =
+    cos^2(beta_b) (dW/d delta) / b.  Planted bug caught: the Winkler slope (sum of the
+    loaded slices' k), which the coupling changes where the contact is partial.  (ISO
+    6336 compliance: constant per slice; Weber's contact term depends on the load, so
+    there dW/d delta between two torques also holds the change of k.)"""
+    pair = _pair(*HELICAL)
+    geo = gj.involute.pair_geometry(pair)
+    rb1, cb = float(geo["rb1"]), math.cos(float(geo["beta_b"]))
+    T, h = 200e3, 1e-6
+    r0 = _run(pair, B_HEL, _hel_mods(), T, 15.0, 12, LAM)
+    r1 = _run(pair, B_HEL, _hel_mods(), T * (1.0 + h), 15.0, 12, LAM)
+    assert bool(np.all(r0.converged)) and bool(np.all(r1.converged))
+    dW = T * h / (rb1 * cb ** 2)
+    dd = 1e-3 * (np.asarray(r1.te_loaded_um) - np.asarray(r0.te_loaded_um))      # mm
+    fd = cb ** 2 * dW / dd / B_HEL * 1e-3
+    np.testing.assert_allclose(np.asarray(r0.mesh_stiffness), fd, rtol=1e-5)
+    w = _run(pair, B_HEL, _hel_mods(), T, 15.0, 12, 0.0)
+    assert np.max(np.abs(np.asarray(w.mesh_stiffness) / fd - 1.0)) > 1e-3   # coupling acts

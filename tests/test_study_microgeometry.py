@@ -420,19 +420,20 @@ def test_sensitivity_of_line_outputs_against_central_differences(capsys):
     of ``loaded_te_map`` on design files with the field moved (a second route), at one
     torque and misalignment; the values equal the map's; elasticities by definition.
     Planted bugs caught: a derivative dropped or of the wrong field, the torque or the
-    misalignment of the command not reaching the model, the line options ignored."""
+    misalignment of the command not reaching the model (or its sign lost: -5 um here),
+    the line options ignored."""
     rc = main(["sensitivity", "example:helical_microgeometry", "--outputs", ",".join(LINE_SENS),
-               "--params", ",".join(SENS_FIELDS), "--torque-Nm", "300", "--f-ma-um", "5",
+               "--params", ",".join(SENS_FIELDS), "--torque-Nm", "300", "--f-ma-um", "-5",
                "--positions", str(POSITIONS), "--slices", str(SLICES), "--json"])
     assert rc == 0
     rep = json.loads(capsys.readouterr().out)
-    assert rep["scenario"] == {"torque_Nm": 300.0, "f_ma_um": 5.0, "positions": POSITIONS,
+    assert rep["scenario"] == {"torque_Nm": 300.0, "f_ma_um": -5.0, "positions": POSITIONS,
                                "slices": SLICES}
     x0 = {"microgeometry.pinion.tip_relief_um": 8.0, "microgeometry.pinion.lead_crowning_um": 6.0,
           "microgeometry.gear.tip_relief_length_mm": 2.5}
 
     def outputs(values):
-        m = loaded_te_map(_design_with(values), [300.0], [5.0], positions=POSITIONS,
+        m = loaded_te_map(_design_with(values), [300.0], [-5.0], positions=POSITIONS,
                           slices=SLICES, temperature_um=0.02)
         return np.array([float(m.te_ptp_smooth_um[0, 0]), float(m.te_mean_um[0, 0])])
 
@@ -502,3 +503,34 @@ def test_a_scenario_with_one_unconverged_position_is_flagged(problem):
     assert not f[1]["converged"] and f[1]["n_valid"] == bad.shape[1] - 1
     assert all(g["converged"] and g["n_valid"] == bad.shape[1] for k, g in enumerate(f)
                if k != 1)
+
+
+def test_sweep_flags_are_each_rows_own():
+    """The per-row flags and valid counts of a chunk (``chunk_flags``), on a line study's
+    outputs laid out by hand: row 1 has one unconverged position in scenario 0, row 2 one
+    invalid friction point's position in scenario 1.  Catches: a row's flags or counts
+    read from another row (row 0's), or from the loads where the efficiency's validity
+    decides."""
+    from types import SimpleNamespace
+    from typing import NamedTuple
+
+    from gearjax.studies.sweep import chunk_flags
+
+    class Res(NamedTuple):
+        converged: np.ndarray
+
+    class Eff(NamedTuple):
+        valid: np.ndarray
+
+    conv = np.ones((3, 2, 5), bool)
+    conv[1, 0, 2] = False
+    valid = conv.copy()
+    valid[2, 1, 4] = False
+    prob = SimpleNamespace(route="line", scenarios=[{}, {}])
+    fl, nv = chunk_flags(prob, Res(conv), None)
+    assert fl["converged"] == [[True, True], [False, True], [True, True]]
+    assert nv == [[5, 5], [4, 5], [5, 5]]
+    fl, nv = chunk_flags(prob, Res(conv), Eff(valid))
+    assert fl["converged"] == [[True, True], [False, True], [True, False]]
+    assert nv == [[5, 5], [4, 5], [5, 4]]
+    assert not any(any(r) for r in fl["edge_contact"])

@@ -1176,11 +1176,20 @@ def build_cases() -> list[Case]:
             ("positions", ["--positions", "2"], "too few positions"),
             ("slices", ["--slices", "1e6"], "too many slices"),
             ("misalignment", ["--misalignment-um", "inf"], "an infinite misalignment"),
+            ("coupling_negative", ["--coupling-length-mm", "-1"], "a negative coupling length"),
+            ("coupling_word", ["--coupling-length-mm", "modulus"], "a coupling length word "
+                                                                   "other than 'module'"),
             ("plot_dir", ["--plot", "{tmp}/no/such/dir/t.png"], "a missing plot directory")):
         add(f"tca.microgeometry.{cid}", ["tca", "example:helical_microgeometry", *extra],
             "refuse", why)
     add("tca.inline.torque", ["tca", TCA_INV, "--torque-Nm", "100"], "refuse",
         "--torque-Nm is of the line contact only")
+    add("tca.inline.coupling", ["tca", TCA_INV, "--coupling-length-mm", "2"], "refuse",
+        "--coupling-length-mm is of the line contact only")
+    add("tca.ok.microgeometry_coupled",
+        ["tca", "example:helical_microgeometry", *small, "--torque-Nm", "200",
+         "--coupling-length-mm", "module", "--json"], "ok",
+        "the loaded TE with the slices coupled along the face (lambda = m_n)")
     add("efficiency.ok.microgeometry",
         ["efficiency", "example:helical_microgeometry", *_argv(eff), *small, "--json"], "ok",
         "the line-contact efficiency of the modified flanks, JSON")
@@ -1188,6 +1197,13 @@ def build_cases() -> list[Case]:
         ["efficiency", "example:helical_microgeometry",
          *_argv(eff, {"--torque-Nm": "50:400:4"}), *small, "--plot", "{tmp}/e.png"], "ok",
         "a torque range: a row per torque, and the figure")
+    add("efficiency.ok.microgeometry_coupled",
+        ["efficiency", "example:helical_microgeometry", *_argv(eff), *small,
+         "--coupling-length-mm", "3", "--json"], "ok",
+        "the line-contact efficiency with the slices coupled along the face")
+    add("efficiency.spur.coupling", ["efficiency", TCA_INV, *_argv(eff),
+                                     "--coupling-length-mm", "module"], "refuse",
+        "--coupling-length-mm for a pair of the point-contact chain")
     for cid, over, extra, why in (
             ("count0", {"--torque-Nm": "50:200:0"}, [], "a torque range of COUNT 0"),
             ("torque_big", {"--torque-Nm": "1e7"}, [], "a torque out of range"),
@@ -1196,6 +1212,7 @@ def build_cases() -> list[Case]:
             ("pairs", {}, ["--pairs", "3"], "point-contact pairs"),
             ("E_prime", {}, ["--E-prime-MPa", "2e5"], "the material is the design's"),
             ("ehl_check", {}, ["--ehl-check", "3"], "the point-contact EHL check"),
+            ("coupling_nan", {}, ["--coupling-length-mm", "nan"], "a NaN coupling length"),
             ("rpm_missing", {"--rpm": None}, [], "no speed")):
         add(f"efficiency.microgeometry.{cid}",
             ["efficiency", "example:helical_microgeometry", *_argv(eff, over), *extra],

@@ -41,7 +41,8 @@ from gearjax.commands.ehl_check import (EHL_CHECK_KEYS_DOC, add_ehl_check_option
 from gearjax.commands.friction import PLOT_SUFFIXES, add_lubricant_options, lubricant_from_args
 from gearjax.commands.line_efficiency import (LINE_EFFICIENCY_KEYS_DOC, line_contact_design,
                                               refuse_line_options, run_line_efficiency)
-from gearjax.commands.line_tca import CYCLE_WHY, MIS_WHY, check_line_values
+from gearjax.commands.line_tca import (CYCLE_WHY, MIS_WHY, add_coupling_option,
+                                       check_line_values)
 from gearjax.commands.loaded import parse_torques
 
 EFFICIENCY_KEYS_DOC = """JSON keys (K tooth pairs, M positions over one mesh cycle = one pinion pitch):
@@ -153,6 +154,7 @@ def register(sub):
     p.add_argument("--misalignment-um", type=float, default=None,
                    help=f"pairs in line contact only: mesh misalignment f_ma (um over the "
                         f"face width, in [{mlo:g}, {mhi:g}]; default 0)")
+    add_coupling_option(p, "pairs in line contact only: ")
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.add_argument("--plot", default=None,
                    help="write load share, mu and P_f along the mesh (.png, .pdf or .svg); a "

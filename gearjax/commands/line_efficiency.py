@@ -28,7 +28,8 @@ LINE_EFFICIENCY_KEYS_DOC = """JSON keys of a pair in line contact (a design with
 or an unmodified helical pair; T torques):
   input                 the options as given (design, side, torque_Nm, rpm, oil,
                         sigma_um, asperity options, fc, film, viscosity, compliance,
-                        positions, slices, misalignment_um) plus the oil's eta0_Pas,
+                        positions, slices, misalignment_um, coupling_length_mm: the
+                        value used, 'module' resolved) plus the oil's eta0_Pas,
                         alpha_per_GPa, tau0_MPa and the material of the design
                         (E_prime_MPa, youngs_modulus_MPa, poisson, material_source)
   model                 "line contact": the thin-slice line contact of
@@ -69,7 +70,8 @@ def line_contact_design(design) -> bool:
 
 def refuse_line_options(args, torques) -> None:
     """For a design of the point-contact chain: one torque, no line-contact option."""
-    for flag, v in (("--slices", args.slices), ("--misalignment-um", args.misalignment_um)):
+    for flag, v in (("--slices", args.slices), ("--misalignment-um", args.misalignment_um),
+                    ("--coupling-length-mm", args.coupling_length_mm)):
         if v is not None:
             raise ValueError(f"{flag} = {v}: applies to pairs in line contact (a design with "
                              "[microgeometry], or an unmodified helical pair) only; this "
@@ -86,16 +88,19 @@ def run_line_efficiency(args, design, torques, rpm, oil, surf, caught, point_onl
     import gearjax as gj
     from gearjax.commands import print_json, warn_nonfinite
     from gearjax.commands.line_tca import check_line_options
+    from gearjax.commands.loaded import resolve_coupling
     from gearjax.progress import Progress
 
-    positions, slices, _, f_ma = check_line_options(args, point_only)
+    positions, slices, _, f_ma, coupling = check_line_options(args, point_only)
+    coupling = resolve_coupling(coupling, design)
     with Progress(1, "efficiency") as bar, bar.phase(
             f"{args.side} side: loaded line contact and friction, {len(torques)} torque(s), "
             f"{positions} positions x {slices} slices"):
         res = gj.involute.loaded_te_map(
             design, torques, [f_ma], side=args.side, positions=positions, slices=slices,
             compliance=args.compliance, pinion_rpm=rpm, oil=oil, surface=surf,
-            viscosity_model=args.viscosity, film_method=args.film)
+            viscosity_model=args.viscosity, film_method=args.film,
+            coupling_length_mm=coupling)
         bar.update()
     mat = gj.pair_material(design)
     rb2 = float(gj.involute.pair_geometry(getattr(design, "design", design).pair)["rb2"])
@@ -108,7 +113,7 @@ def run_line_efficiency(args, design, torques, rpm, oil, surf, caught, point_onl
            "sigma_um": args.sigma_um, "asperity_density_per_mm2": args.asperity_density_per_mm2,
            "asperity_radius_um": args.asperity_radius_um, "fc": args.fc, "film": args.film,
            "viscosity": args.viscosity, "compliance": args.compliance, "positions": positions,
-           "slices": slices, "misalignment_um": f_ma,
+           "slices": slices, "misalignment_um": f_ma, "coupling_length_mm": coupling,
            "E_prime_MPa": float(mat.e_prime_MPa),
            "youngs_modulus_MPa": float(mat.youngs_modulus_MPa), "poisson": float(mat.poisson),
            "material_source": mat.source}
@@ -155,7 +160,8 @@ def _print_table(out, args) -> None:
     print(f"# mesh efficiency, line contact {args.design} ({args.side}); n1 = {inp['rpm']:g} "
           f"rpm, oil {args.oil or 'custom'}, sigma = {args.sigma_um:g} um; f_ma "
           f"{inp['misalignment_um']:g} um; {inp['positions']} positions x {inp['slices']} "
-          f"slices, compliance {inp['compliance']}")
+          f"slices, compliance {inp['compliance']}, coupling length "
+          f"{inp['coupling_length_mm']:g} mm")
     print(f"# material: E' = {inp['E_prime_MPa']:.0f} MPa (E = {inp['youngs_modulus_MPa']:.0f} "
           f"MPa, nu = {inp['poisson']:g}; {inp['material_source']})")
     print(f"{'torque[Nm]':>11s} {'P_in[W]':>10s} {'P_loss[W]':>10s} {'eta[%]':>9s} "

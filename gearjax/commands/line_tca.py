@@ -22,7 +22,8 @@ import numpy as np
 LINE_TCA_KEYS_DOC = """JSON keys of a design with [microgeometry] (line contact; M positions per
 base pitch, T torques; with --side both the side keys are under "drive" and "coast"):
   input            the options as given (design, side, positions, slices,
-                   misalignment_um, torque_Nm)
+                   misalignment_um, torque_Nm, coupling_length_mm: the value used,
+                   'module' resolved)
   model            "line contact": the thin-slice line contact of docs/microgeometry.md
   phi1_rad         (M,) pinion angle of each mesh position, s0 / r_b1 (rad; 0: pair 0
                    at the pitch point)
@@ -73,6 +74,19 @@ def add_line_options(p) -> None:
     p.add_argument("--misalignment-um", type=float, default=None,
                    help=f"[microgeometry] designs only: mesh misalignment f_ma (um over the "
                         f"face width, in [{mlo:g}, {mhi:g}]; default 0)")
+    add_coupling_option(p, "[microgeometry] designs only, the loaded TE: ")
+
+
+def add_coupling_option(p, lead: str) -> None:
+    """``--coupling-length-mm`` of a command's line-contact route (``lead``: to whom it
+    applies), as in ``gearjax loaded``."""
+    import gearjax as gj
+    clo, chi = gj.involute.COUPLING_LENGTH_RANGE_MM
+    p.add_argument("--coupling-length-mm", default=None,
+                   help=f"{lead}coupling length of the slices along the face (mm, in "
+                        f"[{clo:g}, {chi:g}]) or 'module' (the normal module): a Pasternak "
+                        "foundation along each tooth pair's face; default 0, independent "
+                        "slices (Winkler)")
 
 
 def line_route(text: str) -> bool:
@@ -93,7 +107,8 @@ def line_route(text: str) -> bool:
 def refuse_line_options(args) -> None:
     """The line-contact options given for a design without ``[microgeometry]``: one line."""
     for flag, v in (("--slices", args.slices), ("--torque-Nm", args.torque_Nm),
-                    ("--misalignment-um", args.misalignment_um)):
+                    ("--misalignment-um", args.misalignment_um),
+                    ("--coupling-length-mm", args.coupling_length_mm)):
         if v is not None:
             raise ValueError(f"{flag} = {v}: applies to involute designs with "
                              "[microgeometry] tables (the line contact) only; this design "
@@ -111,10 +126,13 @@ def modifications(design, side) -> dict:
 
 
 def check_line_values(args) -> None:
-    """The values of ``--slices`` and ``--misalignment-um`` when given (one line each),
-    for a command that learns its route only from the design."""
+    """The values of ``--slices``, ``--misalignment-um`` and ``--coupling-length-mm`` when
+    given (one line each), for a command that learns its route only from the design."""
     import gearjax as gj
+    from gearjax.commands.loaded import parse_coupling
     from gearjax.errors import check_int, check_range
+    if args.coupling_length_mm is not None:
+        parse_coupling(args.coupling_length_mm)
     if args.slices is not None:
         check_int("--slices", args.slices, lo=1, hi=400)
     if args.misalignment_um is not None:
@@ -123,10 +141,12 @@ def check_line_values(args) -> None:
 
 
 def check_line_options(args, point_only) -> tuple:
-    """``(positions, slices, torques, f_ma)`` of the line route, checked (one line each);
-    ``point_only``: ``(flag, given, why)`` of options the line contact does not take."""
+    """``(positions, slices, torques, f_ma, coupling)`` of the line route, checked (one
+    line each; ``coupling`` None for ``module``, :func:`gearjax.commands.loaded.
+    resolve_coupling`); ``point_only``: ``(flag, given, why)`` of options the line
+    contact does not take."""
     import gearjax as gj
-    from gearjax.commands.loaded import parse_torques
+    from gearjax.commands.loaded import parse_coupling, parse_torques
     from gearjax.errors import check_int, check_range
     from gearjax.io import check_output_path
 
@@ -142,9 +162,11 @@ def check_line_options(args, point_only) -> tuple:
     f_ma = 0.0 if args.misalignment_um is None else check_range(
         "--misalignment-um", args.misalignment_um, *gj.involute.MISALIGNMENT_RANGE_UM,
         unit="um")
+    coupling = parse_coupling("0" if args.coupling_length_mm is None
+                              else args.coupling_length_mm)
     if args.plot:
         check_output_path(args.plot, "--plot", PLOT_SUFFIXES)
-    return positions, slices, torques, f_ma
+    return positions, slices, torques, f_ma, coupling
 
 
 def _side_json(r, design, side) -> dict:
@@ -179,12 +201,15 @@ def run_line_tca(args) -> int:
     from gearjax.commands import print_json, warn_nonfinite
     from gearjax.progress import Progress
 
-    positions, slices, torques, f_ma = check_line_options(args, (
+    from gearjax.commands.loaded import resolve_coupling
+
+    positions, slices, torques, f_ma, coupling = check_line_options(args, (
         ("--misalign", bool(args.misalign.strip()), MIS_WHY),
         ("--pitches", args.pitches is not None, CYCLE_WHY),
         ("--kinematics", args.kinematics, "the velocities along the contact lines are "
                                           "those of `gearjax efficiency`")))
     design = gj.load_design(args.design)
+    coupling = resolve_coupling(coupling, design)
     sides = ["drive", "coast"] if args.side == "both" else [args.side]
     results = {}
     with Progress(len(sides), "tca") as bar:
@@ -193,7 +218,7 @@ def run_line_tca(args) -> int:
                            f"slices" + (f", {len(torques)} torque(s)" if torques else "")):
                 results[side] = gj.involute.line_tca(
                     design, torques_Nm=torques, side=side, misalignment_um=f_ma,
-                    positions=positions, slices=slices)
+                    positions=positions, slices=slices, coupling_length_mm=coupling)
             bar.update()
     outs = {sd: _side_json(r, design, sd) for sd, r in results.items()}
     warns = list(gj.involute.resolution_warnings(design, slices))
@@ -219,7 +244,7 @@ def run_line_tca(args) -> int:
                          "check the design\n")
         status = 3
     inp = {"design": args.design, "side": args.side, "positions": positions, "slices": slices,
-           "misalignment_um": f_ma, "torque_Nm": torques}
+           "misalignment_um": f_ma, "torque_Nm": torques, "coupling_length_mm": coupling}
     tail = {"warnings": warns, "plot": args.plot}
     if args.json:
         body = outs[sides[0]] if len(sides) == 1 else outs

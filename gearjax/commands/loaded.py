@@ -121,6 +121,22 @@ def _number(flag, text, lo, hi, unit):
     return check_range(flag, v, lo, hi, unit=unit)
 
 
+def parse_coupling(text: str):
+    """``--coupling-length-mm``: a length in :data:`gearjax.involute.
+    COUPLING_LENGTH_RANGE_MM` (mm; 0: the Winkler slices) or ``module`` (returned as
+    None: the design's normal module, :func:`resolve_coupling` once it is read)."""
+    import gearjax as gj
+    if text.strip() == "module":
+        return None
+    return _number("--coupling-length-mm", text, *gj.involute.COUPLING_LENGTH_RANGE_MM, "mm")
+
+
+def resolve_coupling(value, design) -> float:
+    """The coupling length (mm) of :func:`parse_coupling`'s ``value`` for ``design``."""
+    import gearjax as gj
+    return gj.involute.module_coupling_length(design) if value is None else value
+
+
 def parse_torques(text: str, lo: float, hi: float) -> list:
     """``--torque-Nm``: a comma list or ``START:STOP:COUNT`` (module docstring)."""
     text = text.strip()
@@ -202,18 +218,14 @@ def run(args) -> int:
         oil, surf, _ = lubricant_from_args(args)
         lube = dict(pinion_rpm=args.rpm, oil=oil, surface=surf,
                     viscosity_model=args.viscosity, film_method=args.film)
-    by_module = args.coupling_length_mm.strip() == "module"
-    if not by_module:
-        coupling = _number("--coupling-length-mm", args.coupling_length_mm,
-                           *gj.involute.COUPLING_LENGTH_RANGE_MM, "mm")
+    coupling = parse_coupling(args.coupling_length_mm)
     design = (involute_design(args.design)[1] if is_involute(args.design)
               else gj.load_design(args.design))
     if not isinstance(design, (gj.involute.InvoluteFile, gj.involute.InvoluteTCA)):
         raise ValueError(f"DESIGN {args.design!r} is not an involute pair: `gearjax loaded` "
                          "analyses spur and helical involute pairs ([design] kind = "
                          "'involute' or involute:...)")
-    if by_module:
-        coupling = gj.involute.module_coupling_length(design)
+    coupling = resolve_coupling(coupling, design)
     with Progress(1, "loaded") as bar, bar.phase(
             f"{args.side} side: loaded line contact, {len(torques)} torque(s) x "
             f"{len(mis)} misalignment(s), {positions} positions x {slices} slices"):

@@ -39,9 +39,9 @@ def sensitivities(design_source: str, outputs, params, *, side: str = "drive",
 
     ``operating``: torque_Nm, pinion_rpm, oil, sigma_um (loaded outputs); ``scenario``:
     dE_mm, dP_mm, dG_mm, dSigma_deg (TCA outputs) or f_ma_um (line-contact outputs);
-    ``line``: positions, slices (line-contact outputs).  Returns ``{"outputs", "params", "values" (n_out,),
-    "fields" (n_par,), "jacobian" (n_out, n_par), "elasticity" (n_out, n_par; NaN where
-    undefined)}`` (NumPy arrays)."""
+    ``line``: positions, slices (line-contact outputs).  Returns ``{"outputs", "params",
+    "values" (n_out,), "fields" (n_par,), "jacobian" (n_out, n_par), "elasticity" (n_out,
+    n_par; NaN where undefined)}`` (NumPy arrays)."""
     from gearjax.studies.quantities import QUANTITIES, uses_mask
     from gearjax.studies.study_run import grid_size, quantity_jacobian, set_up, start_point
 

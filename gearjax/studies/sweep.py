@@ -54,7 +54,8 @@ from gearjax.studies.end_checks import scenario_flags, scenario_of
 from gearjax.studies.study_run import Problem, combine, evaluator, set_scales
 
 __all__ = ["SweepResult", "set_up_sweep", "check_design_count", "sample_points",
-           "sweep_program", "run_sweep", "npz_columns", "chunk_size", "steady_rate", "best_row",
+           "sweep_program", "run_sweep", "chunk_flags", "npz_columns", "chunk_size",
+           "steady_rate", "best_row",
            "file_units", "sweep_constraints", "MAX_DESIGNS", "FLAG_KEYS"]
 
 #: most designs one sweep may ask for (a grid's points ** n_variables included)
@@ -219,17 +220,11 @@ def run_sweep(prob: Problem, U, chunk: int = 16, devices=None, progress=None) ->
         if eff is not None and prob.route == "tca":
             eff = eff.n_valid
         Q, res, eff = jax.tree_util.tree_map(lambda v: v[:k], _to_host((Q, res, eff)))
-        for i in range(k):
-            row_eff = None if eff is None else scenario_of(eff, i)
-            if prob.route == "tca" and row_eff is not None:
-                row_eff = _Counts(row_eff)
-            one = scenario_flags(prob, scenario_of(res, i), row_eff)
-            for key in FLAG_KEYS:
-                # a flag a route does not have (the line contact and the kinematics
-                # have no edge contact) is False
-                flags[key].append([f.get(key, False) for f in one])
-            if "n_valid" in one[0]:
-                nval.append([f["n_valid"] for f in one])
+        rows_flags, rows_valid = chunk_flags(prob, res, eff)
+        for key in FLAG_KEYS:
+            flags[key] += rows_flags[key]
+        if rows_valid is not None:
+            nval += rows_valid
         vals.append(Q)
         if first is None:
             first = time.time() - t0
@@ -244,6 +239,27 @@ def run_sweep(prob: Problem, U, chunk: int = 16, devices=None, progress=None) ->
     n_valid = np.asarray(nval, int) if nval else None
     return SweepResult(U, file_units(prob, U), values, flags, n_valid, ok, feasible, J, seconds,
                        first, nd, c)
+
+
+def chunk_flags(prob: Problem, res, eff):
+    """``(flags, n_valid)`` of a chunk's rows on the host: ``flags[key]`` one list per row
+    of the scenarios' :data:`FLAG_KEYS` (a flag a route does not have -- the line
+    contact and the kinematics have no edge contact -- is False), ``n_valid`` one list
+    per row of the scenarios' valid positions (None where the route counts none).
+    ``res``, ``eff``: the program's outputs with a leading row axis (a loaded TCA
+    study's ``eff``: its ``n_valid`` counts alone)."""
+    flags, nval = {key: [] for key in FLAG_KEYS}, []
+    n = jax.tree_util.tree_leaves(res)[0].shape[0]
+    for i in range(n):
+        row_eff = None if eff is None else scenario_of(eff, i)
+        if prob.route == "tca" and row_eff is not None:
+            row_eff = _Counts(row_eff)
+        one = scenario_flags(prob, scenario_of(res, i), row_eff)
+        for key in FLAG_KEYS:
+            flags[key].append([f.get(key, False) for f in one])
+        if "n_valid" in one[0]:
+            nval.append([f["n_valid"] for f in one])
+    return flags, (nval if nval else None)
 
 
 class _Counts(NamedTuple):

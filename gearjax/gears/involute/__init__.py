@@ -6,7 +6,8 @@ file (``[design] kind = "involute"``, :class:`InvoluteFile`), the kinematics alo
 the path of contact.  Its TCA runs through :func:`gearjax.run_tca` like every family.
 The flank micro-geometry (:class:`MicroGeometry`, :func:`flank_removal_um`) and the
 loaded line contact of spur and helical pairs (:func:`line_contact`,
-:func:`loaded_te_map`, the unloaded TCA of the modified flanks :func:`line_tca`) are this family's own (docs/microgeometry.md).
+:func:`loaded_te_map`, the unloaded TCA of the modified flanks :func:`line_tca`) are
+this family's own (docs/microgeometry.md).
 """
 
 from gearjax.gears.involute.geometry import (InvolutePair, generated_flank, pair_geometry,

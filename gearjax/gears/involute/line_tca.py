@@ -155,12 +155,14 @@ def _program(blank, teeth, b, mods, f_ma, E, nu, torques_Nmm, opts, drive):
 
 
 def line_tca(design, *, torques_Nm=(), side="drive", misalignment_um=0.0, positions=32,
-             slices=20, compliance="weber", mods=None) -> LineTCA:
+             slices=20, compliance="weber", mods=None, coupling_length_mm=0.0) -> LineTCA:
     """The unloaded TCA of ``design`` (an involute design file, its ``[microgeometry]``
     tables, or an :class:`~gearjax.gears.involute.tca.InvoluteTCA` with ``mods``) by the
     thin-slice line contact, and the loaded TE at each of ``torques_Nm`` (pinion, N m;
     may be empty) -- :class:`LineTCA` (module docstring).  ``positions`` per base pitch,
-    ``slices`` across the face; one compiled program per option set and torque count."""
+    ``slices`` across the face; ``coupling_length_mm`` the Pasternak coupling of the slices
+    along the face for the loaded TE (0: Winkler; the unloaded TE does not depend on it);
+    one compiled program per option set and torque count."""
     T = np.atleast_1d(np.asarray(torques_Nm, float)) if np.size(torques_Nm) else np.zeros(0)
     if T.ndim != 1:
         raise ValueError("torques_Nm must be a 1-D list of torques (N m)")
@@ -168,7 +170,7 @@ def line_tca(design, *, torques_Nm=(), side="drive", misalignment_um=0.0, positi
         check_range("torques_Nm", t, *TORQUE_RANGE_NM, unit="N m")
     f = check_range("misalignment_um", misalignment_um, *MISALIGNMENT_RANGE_UM, unit="um")
     pair, b, mods, mat = line_design(design, mods, side)
-    opts = line_options(pair, b, positions, slices, compliance)
+    opts = line_options(pair, b, positions, slices, compliance, coupling_length_mm)
     out = call(_program, *_split(pair), b, mods, f, mat.youngs_modulus_MPa, mat.poisson,
                jnp.asarray(1e3 * T), opts=opts, drive=side == "drive")
     return LineTCA(*out[:17], jnp.asarray(T), *out[17:])
