@@ -7,9 +7,7 @@ the design-file parsing (member and flank tables, shapes, refusals), the refusal
 point-contact TCA of a design with micro-geometry, and refusals of bad input
 before any JAX work.  Each test's docstring names the planted bug it catches."""
 
-import contextlib
 import copy
-import io
 import os
 import re
 
@@ -17,9 +15,10 @@ import numpy as np
 import pytest
 
 import gearjax as gj
-from gearjax.cli import build_parser, main
+from gearjax.cli import build_parser
 from gearjax.commands.loaded import JSON_KEYS_DOC, parse_torques
 from gearjax.gears.involute.design_file import read_involute
+from cli_call import cli_call
 from strict_json import strict_json
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -28,14 +27,7 @@ SMALL = ["--positions", "8", "--slices", "6"]
 OPS = ["--torque-Nm", "50,200", "--misalignment-um", "0,10"]
 
 
-def _call(argv):
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        try:
-            rc = main(argv)
-        except SystemExit as exc:          # argparse's refusals (one line, status 2)
-            rc = exc.code
-    return rc, out.getvalue(), err.getvalue()
+_call = cli_call
 
 
 _strict = strict_json

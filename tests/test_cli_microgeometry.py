@@ -6,8 +6,6 @@ Kept cheap: 8 or 16 positions, a few slices, and each compiled program shared by
 tests that need it (module fixtures).  Each test's docstring names the planted bug it
 catches."""
 
-import contextlib
-import io
 import math
 import re
 
@@ -15,9 +13,9 @@ import numpy as np
 import pytest
 
 import gearjax as gj
-from gearjax.cli import main
 from gearjax.commands.line_efficiency import LINE_EFFICIENCY_KEYS_DOC
 from gearjax.commands.line_tca import LINE_TCA_KEYS_DOC
+from cli_call import cli_call
 from strict_json import strict_json
 
 EXAMPLE = "example:helical_microgeometry"
@@ -29,14 +27,7 @@ SPUR = "involute:z1=20,z2=40,m=4,alpha=20,b=30"
 C_A = 8.0
 
 
-def _call(argv):
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        try:
-            rc = main(argv)
-        except SystemExit as exc:          # argparse's refusals (one line, status 2)
-            rc = exc.code
-    return rc, out.getvalue(), err.getvalue()
+_call = cli_call
 
 
 def _keys(doc, indent="  "):
