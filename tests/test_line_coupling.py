@@ -27,6 +27,7 @@ import pytest
 from scipy.optimize import brentq
 
 import gearjax as gj
+from cli_call import cli_call
 from gearjax.gears.involute.face_coupling import coupled_solve
 from gearjax.gears.involute.geometry import pair_geometry
 from gearjax.gears.involute.line_load import (LineLoadOptions, line_load_traced, pair_range,
@@ -459,17 +460,7 @@ def test_study_route_takes_the_coupling_length(tmp_path):
     assert np.max(np.abs(np.asarray(w.te_ptp_um) - np.asarray(m.te_ptp_um))) > 1e-3
 
 
-def _cli(argv):
-    import contextlib
-    import io
-    from gearjax.cli import main
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        try:
-            rc = main(argv)
-        except SystemExit as exc:
-            rc = exc.code
-    return rc, out.getvalue(), err.getvalue()
+_cli = cli_call
 
 
 def test_cli_flag_reaches_the_model_and_is_checked(monkeypatch):
