@@ -366,6 +366,7 @@ def test_coupling_length_reaches_the_tca_and_efficiency_routes():
     assert rc == 0, err
     t = strict_json(out)
     assert t["input"]["coupling_length_mm"] == lam
+    assert sum("coupled along the face" in w for w in t["warnings"]) == 1
     m = gj.involute.loaded_te_map(design, [200.0], [0.0], positions=8, slices=6,
                                   coupling_length_mm=lam)
     w = gj.involute.loaded_te_map(design, [200.0], [0.0], positions=8, slices=6)

@@ -475,6 +475,9 @@ def test_cli_flag_reaches_the_model_and_is_checked(monkeypatch):
     assert rc == 0, err
     js = json.loads(out)
     assert js["input"]["coupling_length_mm"] == pytest.approx(3.0)
+    # the slice dependence of p_max and K_Hbeta with coupling is said (and only then)
+    assert sum("coupled along the face" in w for w in js["warnings"]) == 1
+    assert "--slices" in err and "grow with the slice count (6 here)" in err
     m = gj.involute.loaded_te_map(gj.load_design(ex), [200.0], positions=8, slices=6,
                                   coupling_length_mm=3.0)
     assert js["te_ptp_um"][0][0] == pytest.approx(float(m.te_ptp_um[0, 0]), rel=1e-12)

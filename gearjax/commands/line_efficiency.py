@@ -128,7 +128,7 @@ def run_line_efficiency(args, design, torques, rpm, oil, surf, caught, point_onl
            "converged": np.asarray(res.converged, bool)[:, 0].tolist(),
            "modifications": modifications(design, args.side),
            "warnings": [str(w.message) for w in caught], "plot": args.plot}
-    out["warnings"] += gj.involute.resolution_warnings(design, slices)
+    out["warnings"] += gj.involute.resolution_warnings(design, slices, coupling)
     bad = [t for t, ok in zip(out["torque_Nm"], out["converged"]) if not ok]
     for t in bad:
         out["warnings"].append(f"{args.side} side: the loaded line contact or its friction at "

@@ -221,7 +221,8 @@ def run_line_tca(args) -> int:
                     positions=positions, slices=slices, coupling_length_mm=coupling)
             bar.update()
     outs = {sd: _side_json(r, design, sd) for sd, r in results.items()}
-    warns = list(gj.involute.resolution_warnings(design, slices))
+    warns = list(gj.involute.resolution_warnings(design, slices,
+                                                  coupling if torques else 0.0))
     bad = []
     for sd, o in outs.items():
         if o["loaded"] is not None:

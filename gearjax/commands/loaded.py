@@ -252,7 +252,7 @@ def run(args) -> int:
         "modifications": _modifications(design, args.side),
         "warnings": [], "plot": args.plot,
     }
-    out["warnings"] += gj.involute.resolution_warnings(design, slices)
+    out["warnings"] += gj.involute.resolution_warnings(design, slices, coupling)
     bad = [(T, a) for i, j, T, a in _rows(out) if not out["converged"][i][j]]
     for T, a in bad:
         out["warnings"].append(f"{args.side} side: the loaded contact at {T:g} N m, f_ma "

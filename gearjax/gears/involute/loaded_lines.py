@@ -83,22 +83,33 @@ def line_design(design, mods=None, side: str = "drive"):
 COARSE_SLICE_SHARE = 0.25
 
 
-def resolution_warnings(design, slices) -> list:
+def resolution_warnings(design, slices, coupling_length_mm=0.0) -> list:
     """Warning lines (no output) when the face is cut too coarsely for the helix: a
     slice's contact-line piece spans ``dy tan(beta_b)`` of the path of contact, and
     beyond :data:`COARSE_SLICE_SHARE` of it the load along a line is resolved by a few
-    pieces only (the results converge with more slices; docs/microgeometry.md)."""
+    pieces only (the results converge with more slices; docs/microgeometry.md).  With
+    the slices coupled along the face (``coupling_length_mm`` > 0) also the line that
+    p_max and K_Hbeta depend on the slice count: the Pasternak foundation's concentrated
+    forces at the compressed ends of a line and at the start of a linear relief sit in
+    single slices (:mod:`gearjax.gears.involute.face_coupling`)."""
     pair, b, _, _ = line_design(design)
     geo = pair_geometry(pair)
+    out = []
+    if float(coupling_length_mm) > 0.0:
+        out.append(f"with the slices coupled along the face (coupling length "
+                   f"{float(coupling_length_mm):g} mm) p_max and K_Hbeta hold the "
+                   "foundation's concentrated end and relief-start forces in single slices "
+                   f"and grow with the slice count ({int(slices)} here): compare them at the "
+                   "same --slices; the loaded TE and the loads converge")
     span = float(b) / int(slices) * float(np.tan(float(geo["beta_b"])))
     path = float(geo["rho_E"] - geo["rho_A"])
     if span <= COARSE_SLICE_SHARE * path:
-        return []
+        return out
     need = int(np.ceil(float(b) * float(np.tan(float(geo["beta_b"])))
                        / (COARSE_SLICE_SHARE * path)))
-    return [f"a face slice's contact line spans {span:.3g} mm of the {path:.3g} mm path of "
-            f"contact (more than {COARSE_SLICE_SHARE:g} of it): the load along the contact "
-            f"lines is coarsely resolved; use at least {need} slices"]
+    return out + [f"a face slice's contact line spans {span:.3g} mm of the {path:.3g} mm "
+                  f"path of contact (more than {COARSE_SLICE_SHARE:g} of it): the load along "
+                  f"the contact lines is coarsely resolved; use at least {need} slices"]
 
 
 def line_options(pair, b, positions, slices, compliance,
