@@ -376,6 +376,16 @@ def test_coupling_length_reaches_the_tca_and_efficiency_routes():
     assert abs(float(m.p_max[0, 0]) - float(w.p_max[0, 0])) > 1.0     # the coupling acts
     r = gj.involute.line_tca(design, positions=8, slices=6)
     np.testing.assert_allclose(t["te_um"], np.asarray(r.te_um), atol=1e-12)
+    # the compliance model of the loaded TE
+    rc, out, err = _call(["tca", EXAMPLE, *SMALL, "--torque-Nm", "200", "--compliance",
+                          "iso6336", "--json"])
+    assert rc == 0, err
+    iso = gj.involute.loaded_te_map(design, [200.0], [0.0], positions=8, slices=6,
+                                    compliance="iso6336")
+    assert strict_json(out)["input"]["compliance"] == "iso6336"
+    assert strict_json(out)["loaded"]["te_ptp_um"][0] == pytest.approx(
+        float(iso.te_ptp_um[0, 0]), rel=1e-9)
+    assert abs(float(iso.te_mean_um[0, 0]) - float(w.te_mean_um[0, 0])) > 1e-3
     rc, out, err = _call(["efficiency", EXAMPLE, "--torque-Nm", "200", *LUBE, *SMALL,
                           "--coupling-length-mm", "2.5", "--json"])
     assert rc == 0, err
@@ -391,6 +401,7 @@ def test_coupling_length_reaches_the_tca_and_efficiency_routes():
 
 @pytest.mark.parametrize("argv, match", [
     (["tca", "example:khk_spur_12x24", "--coupling-length-mm", "2"], "--coupling-length-mm = 2"),
+    (["tca", "example:khk_spur_12x24", "--compliance", "iso6336"], "--compliance = iso6336"),
     (["tca", EXAMPLE, "--torque-Nm", "200", "--coupling-length-mm", "-1"],
      "--coupling-length-mm = -1"),
     (["tca", EXAMPLE, "--coupling-length-mm", "modul"], "--coupling-length-mm: 'modul'"),

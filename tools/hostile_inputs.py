@@ -1186,10 +1186,16 @@ def build_cases() -> list[Case]:
         "--torque-Nm is of the line contact only")
     add("tca.inline.coupling", ["tca", TCA_INV, "--coupling-length-mm", "2"], "refuse",
         "--coupling-length-mm is of the line contact only")
-    add("tca.ok.microgeometry_coupled",
+    add("tca.inline.compliance", ["tca", TCA_INV, "--compliance", "iso6336"], "refuse",
+        "--compliance is of the line contact's loaded TE only")
+    add("tca.microgeometry.compliance=steel", ["tca", "example:helical_microgeometry",
+                                               "--compliance", "steel"], "refuse",
+        "an unknown compliance model")
+    add("tca.microgeometry_coupled",
         ["tca", "example:helical_microgeometry", *small, "--torque-Nm", "200",
-         "--coupling-length-mm", "module", "--json"], "ok",
-        "the loaded TE with the slices coupled along the face (lambda = m_n)")
+         "--coupling-length-mm", "module", "--json"], "flag",
+        "the loaded TE with the slices coupled along the face (lambda = m_n): the warning "
+        "that p_max and K_Hbeta grow with the slice count")
     add("efficiency.ok.microgeometry",
         ["efficiency", "example:helical_microgeometry", *_argv(eff), *small, "--json"], "ok",
         "the line-contact efficiency of the modified flanks, JSON")
@@ -1197,10 +1203,11 @@ def build_cases() -> list[Case]:
         ["efficiency", "example:helical_microgeometry",
          *_argv(eff, {"--torque-Nm": "50:400:4"}), *small, "--plot", "{tmp}/e.png"], "ok",
         "a torque range: a row per torque, and the figure")
-    add("efficiency.ok.microgeometry_coupled",
+    add("efficiency.microgeometry_coupled",
         ["efficiency", "example:helical_microgeometry", *_argv(eff), *small,
-         "--coupling-length-mm", "3", "--json"], "ok",
-        "the line-contact efficiency with the slices coupled along the face")
+         "--coupling-length-mm", "3", "--json"], "flag",
+        "the line-contact efficiency with the slices coupled along the face: the warning "
+        "that p_max and K_Hbeta grow with the slice count")
     add("efficiency.spur.coupling", ["efficiency", TCA_INV, *_argv(eff),
                                      "--coupling-length-mm", "module"], "refuse",
         "--coupling-length-mm for a pair of the point-contact chain")

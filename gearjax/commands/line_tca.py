@@ -23,7 +23,7 @@ LINE_TCA_KEYS_DOC = """JSON keys of a design with [microgeometry] (line contact;
 base pitch, T torques; with --side both the side keys are under "drive" and "coast"):
   input            the options as given (design, side, positions, slices,
                    misalignment_um, torque_Nm, coupling_length_mm: the value used,
-                   'module' resolved)
+                   'module' resolved, compliance)
   model            "line contact": the thin-slice line contact of docs/microgeometry.md
   phi1_rad         (M,) pinion angle of each mesh position, s0 / r_b1 (rad; 0: pair 0
                    at the pitch point)
@@ -75,6 +75,10 @@ def add_line_options(p) -> None:
                    help=f"[microgeometry] designs only: mesh misalignment f_ma (um over the "
                         f"face width, in [{mlo:g}, {mhi:g}]; default 0)")
     add_coupling_option(p, "[microgeometry] designs only, the loaded TE: ")
+    p.add_argument("--compliance", choices=list(gj.loading.COMPLIANCE_MODELS), default=None,
+                   help="[microgeometry] designs only, the loaded TE: tooth compliance per "
+                        "unit length of contact line, weber (default) or iso6336, as "
+                        "gearjax loaded")
 
 
 def add_coupling_option(p, lead: str) -> None:
@@ -108,7 +112,8 @@ def refuse_line_options(args) -> None:
     """The line-contact options given for a design without ``[microgeometry]``: one line."""
     for flag, v in (("--slices", args.slices), ("--torque-Nm", args.torque_Nm),
                     ("--misalignment-um", args.misalignment_um),
-                    ("--coupling-length-mm", args.coupling_length_mm)):
+                    ("--coupling-length-mm", args.coupling_length_mm),
+                    ("--compliance", args.compliance)):
         if v is not None:
             raise ValueError(f"{flag} = {v}: applies to involute designs with "
                              "[microgeometry] tables (the line contact) only; this design "
@@ -218,7 +223,8 @@ def run_line_tca(args) -> int:
                            f"slices" + (f", {len(torques)} torque(s)" if torques else "")):
                 results[side] = gj.involute.line_tca(
                     design, torques_Nm=torques, side=side, misalignment_um=f_ma,
-                    positions=positions, slices=slices, coupling_length_mm=coupling)
+                    positions=positions, slices=slices, coupling_length_mm=coupling,
+                    compliance=args.compliance or "weber")
             bar.update()
     outs = {sd: _side_json(r, design, sd) for sd, r in results.items()}
     warns = list(gj.involute.resolution_warnings(design, slices,
@@ -245,7 +251,8 @@ def run_line_tca(args) -> int:
                          "check the design\n")
         status = 3
     inp = {"design": args.design, "side": args.side, "positions": positions, "slices": slices,
-           "misalignment_um": f_ma, "torque_Nm": torques, "coupling_length_mm": coupling}
+           "misalignment_um": f_ma, "torque_Nm": torques, "coupling_length_mm": coupling,
+           "compliance": args.compliance or "weber"}
     tail = {"warnings": warns, "plot": args.plot}
     if args.json:
         body = outs[sides[0]] if len(sides) == 1 else outs
