@@ -215,6 +215,7 @@ def run_line_tca(args) -> int:
                                           "those of `gearjax efficiency`")))
     design = gj.load_design(args.design)
     coupling = resolve_coupling(coupling, design)
+    compliance = args.compliance or "weber"
     sides = ["drive", "coast"] if args.side == "both" else [args.side]
     results = {}
     with Progress(len(sides), "tca") as bar:
@@ -224,7 +225,7 @@ def run_line_tca(args) -> int:
                 results[side] = gj.involute.line_tca(
                     design, torques_Nm=torques, side=side, misalignment_um=f_ma,
                     positions=positions, slices=slices, coupling_length_mm=coupling,
-                    compliance=args.compliance or "weber")
+                    compliance=compliance)
             bar.update()
     outs = {sd: _side_json(r, design, sd) for sd, r in results.items()}
     warns = list(gj.involute.resolution_warnings(design, slices,
@@ -252,7 +253,7 @@ def run_line_tca(args) -> int:
         status = 3
     inp = {"design": args.design, "side": args.side, "positions": positions, "slices": slices,
            "misalignment_um": f_ma, "torque_Nm": torques, "coupling_length_mm": coupling,
-           "compliance": args.compliance or "weber"}
+           "compliance": compliance}
     tail = {"warnings": warns, "plot": args.plot}
     if args.json:
         body = outs[sides[0]] if len(sides) == 1 else outs

@@ -113,7 +113,10 @@ def line_tca_traced(pair, b, mods, f_ma, opts, E, nu, drive, torques_Nmm):
     geo = pair_geometry(pair)
     rb1, rb2, beta_b = geo["rb1"], geo["rb2"], geo["beta_b"]
     p_bt = 2.0 * jnp.pi * rb1 / pair.z1
-    r = line_load_traced(pair, b, mods, _NOMINAL_NMM, f_ma, opts, E, nu, drive)
+    # the separations do not depend on the load nor on the foundation: the unloaded
+    # pass without the coupled contact solve
+    r = line_load_traced(pair, b, mods, _NOMINAL_NMM, f_ma, opts._replace(coupling_length=0.0),
+                         E, nu, drive)
     K, M, N = r.separation_um.shape
     sep = r.separation_um
     te = r.te_unloaded_um

@@ -256,8 +256,6 @@ def loaded_te_map(design, torques_Nm, misalignments_um=(0.0,), *, mods=None, sid
     for a in A:
         check_range("misalignments_um", a, *MISALIGNMENT_RANGE_UM, unit="um")
     check_range("temperature_um", temperature_um, 0.0, 10.0, lo_open=True, unit="um")
-    check_range("coupling_length_mm", coupling_length_mm, *COUPLING_LENGTH_RANGE_MM,
-                unit="mm")
     pair, b, mods, mat = line_design(design, mods, side)
     rpm = None
     if pinion_rpm is not None:
