@@ -677,15 +677,14 @@ def test_involute_mesh_teeth_by_hand():
 # preset bevel: the virtual cylindrical teeth of ISO 10300-1 by hand
 # ---------------------------------------------------------------------------------
 
-def test_preset_bevel_virtual_teeth_by_hand():
+def test_preset_bevel_virtual_teeth_by_hand(pb_run):
     """MeshTeeth of the preset-TE bevel pair against ISO 10300-1 by hand: pitch
     angles, mean cone distance R_m = A_o - b/2, m_mn = 2 R_m sin(delta1) cos(beta)/z1,
     z_vn = z / (cos(delta) cos^2(beta_vb) cos(beta)), the load radius r_v = z_vn m_mn/2
-    + h, the heights over m_mn and the loaded width min(2 a, b)."""
+    + h, the heights over m_mn and the loaded width min(2 a, b).  On the TCA of the
+    loaded run below (the family's default grid; one TCA program for the module)."""
     from gearjax.gears.preset_bevel.mesh import preset_mesh_teeth
-    des = gj.load_design("example:preset_te_bevel_10x30").design
-    res = gj.run_tca(des, side="drive", steps_per_pitch=16, half_pitches=1.0, n_pairs=3,
-                     kinematics=False)
+    des, (_, res) = pb_run
     t = preset_mesh_teeth(des, res, True)
     z1, z2 = des.z1, des.z2
     S, beta, an = float(des.shaft_angle), float(des.beta), float(des.alpha_n)

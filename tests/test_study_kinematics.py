@@ -8,6 +8,7 @@ central differences of the study's own program; the hypoid design-file reader fo
 written ``[blank]`` table.  The packaged study runs once (module fixture)."""
 
 import math
+import re
 
 import jax
 import jax.numpy as jnp
@@ -317,3 +318,46 @@ def test_blank_failure_fails_the_acceptance_flags(monkeypatch):
     monkeypatch.setattr(type(d), "blank_input", lambda self: flat)
     with pytest.raises(ValueError, match="blank.offset_mm must be > 0"):
         kinematics_chain(d, read_study("example:hypoid_cutter_radius"))
+
+
+def _numbers(text, label):
+    """The floats printed on the line that starts with ``label``."""
+    line = next(ln for ln in text.splitlines() if ln.startswith(label))
+    return [float(x) for x in re.findall(r"[-+]?\d+\.\d+(?:e[-+]?\d+)?", line[len(label):])]
+
+
+def test_hypoid_design_notebook_synthesis_and_packaged_study(tmp_path):
+    """notebooks/09_hypoid_design.ipynb: the local synthesis of the spiral-bevel pinion
+    meets its six targets and the independent TCA agrees (the tolerances of
+    tests/test_synthesis.py); the packaged study ``hypoid_cutter_radius`` (run end to end
+    only here) converges on the KKT test, is accepted, ends on the corner of its box with
+    every constraint inactive and a lower max |SRR|, and SLSQP on the same gradients
+    reaches the same point (docs/optimize.md)."""
+    from notebook_run import images, run_notebook
+    nb, text = run_notebook("09_hypoid_design", tmp_path)
+    assert images(nb) == 2, text[-2000:]
+    m = re.search(r"converged: (\d+) iterations", text)
+    assert m and int(m.group(1)) <= 15, text[:2000]
+    assert _numbers(text, "largest scaled residual per step:")[-1] <= 1e-3
+    tol = {"xi1 (face)": 1e-4, "h1 (mm)": 1e-3, "TE level (arcsec)": 1e-2,
+           "TE apex (arcsec)": 1e-2, "path angle (deg)": 1e-2, "semi-major (mm)": 1e-3}
+    for label, t in tol.items():
+        want, got = _numbers(text, label)
+        assert abs(got - want) <= t, (label, want, got)
+    xi, h, h_t = _numbers(text, "bearing xi1")
+    assert abs(xi) < 0.01 and abs(h - h_t) < 0.05
+    for drop in _numbers(text, "TE drop half a pitch from the apex:"):
+        assert abs(drop - 8.0) < 0.5
+    # the packaged cutter-settings study
+    kkt = re.search(r"KKT: stationarity ([0-9.e+-]+), feasibility ([0-9.e+-]+)", text)
+    assert float(kkt.group(1)) <= 1e-4 and float(kkt.group(2)) <= 1e-4
+    assert "accepted: True []" in text and "SLSQP accepted: True" in text
+    for field, end in (("cutter_radius", 130.0), ("blade_angle_delta", 3.0),
+                       ("cutter_shift", 5.0)):
+        assert _numbers(text, field)[1] == pytest.approx(end, abs=1e-6), field
+    start, end = _numbers(text, "kin_max_abs_srr")
+    assert end < 0.95 * start
+    assert _numbers(text, "multipliers of the constraints:") == [0.0, 0.0, 0.0]
+    assert _numbers(text, "largest difference of the end settings")[0] <= 1e-6
+    al, sq = _numbers(text, "objective: augmented Lagrangian")
+    assert al == pytest.approx(sq, abs=1e-9)
