@@ -55,7 +55,7 @@ import numpy as np
 from jax.custom_derivatives import SymbolicZero
 
 __all__ = ["NewtonResult", "newton_solve", "implicit_solution", "split_derivative",
-           "implicit_root"]
+           "implicit_root", "solve_small"]
 
 
 class NewtonResult(NamedTuple):
@@ -102,14 +102,38 @@ def _jacobian(f, x):
     return _value_and_jacobian(f, x)[1]
 
 
-def _lin_solve(J, b):
-    """``J^-1 b``; a division for a 1 x 1 system (no LU factorisation).  (One LU
-    factorisation per Newton step, reused by the line search's corrections through
-    ``lax.linalg.triangular_solve``, ran the jitted involute TCA 11 % slower on the
-    CPU than solving anew each time.)"""
-    if J.shape[0] == 1:
-        return b / J[0, 0]
-    return jnp.linalg.solve(J, b)
+def solve_small(A, b):
+    """``A^-1 b`` for a square ``A`` (n x n) and ``b`` of shape (n,) or (n, k).
+
+    n <= 3 in closed form, ``adj(A) b / det(A)`` (Cramer's rule: for n = 3 the columns
+    of ``adj(A)`` are the cross products of A's rows, ``det A = a_0 . (a_1 x a_2)``),
+    a few fused multiply-adds instead of an LU factorisation and two triangular solves;
+    larger systems by ``jnp.linalg.solve``.  A singular ``A`` gives non-finite values,
+    as the factorisation does.  The per-point systems of the flank, blank and edge
+    solves are 2 x 2 and 3 x 3, and so are the Weingarten maps' ``J^T J``; measured on
+    the 2-core CPU: the 41 x 21 hypoid flank grid 5.8 -> 3.6 ms, the spur TCA of
+    benchmarks/bench_tca.py 26.5 -> 21.4 ms (benchmarks/results).  Round-off differs
+    from the factorisation's; for n = 2 the rule is forward stable (Higham, Accuracy
+    and Stability of Numerical Algorithms, 2nd ed., §1.10).  (One LU factorisation per
+    Newton step, reused by the line search's corrections through
+    ``lax.linalg.triangular_solve``, ran the jitted involute TCA 11 % slower on the CPU
+    than solving anew each time.)"""
+    n = A.shape[0]
+    if n == 1:
+        return b / A[0, 0]
+    if n == 2:
+        adj = (jnp.stack([A[1, 1], -A[1, 0]]), jnp.stack([-A[0, 1], A[0, 0]]))
+        det = A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]
+    elif n == 3:
+        adj = (jnp.cross(A[1], A[2]), jnp.cross(A[2], A[0]), jnp.cross(A[0], A[1]))
+        det = jnp.dot(A[0], adj[0])
+    else:
+        return jnp.linalg.solve(A, b)
+    # adj[j] is column j of adj(A): x = sum_j adj[:, j] b_j / det
+    tail = (1,) * (b.ndim - 1)
+    return sum(jnp.reshape(c, (n,) + tail) * b[j] for j, c in enumerate(adj)) / det
+
+
 
 
 def _loop(F, tol, xtol, max_steps, max_halvings, ls, x0, theta):
@@ -146,7 +170,7 @@ def _loop(F, tol, xtol, max_steps, max_halvings, ls, x0, theta):
         # traced here and in the line search, not a third time before the loop
         fx, J = _value_and_jacobian(f, x)
         res = residual(fx)
-        dx = _lin_solve(J, -fx)
+        dx = solve_small(J, -fx)
         ok = jnp.all(jnp.isfinite(dx))
         dx = jnp.where(ok, dx, 0.0)
 
@@ -175,7 +199,7 @@ def _loop(F, tol, xtol, max_steps, max_halvings, ls, x0, theta):
             if natural:
                 # Deuflhard's natural monotonicity test: the simplified Newton
                 # correction J(x)^-1 F(x_new) is shorter than the step
-                theta_n = jnp.linalg.norm(_lin_solve(J, fn))
+                theta_n = jnp.linalg.norm(solve_small(J, fn))
                 theta_n = jnp.where(jnp.isfinite(theta_n), theta_n, jnp.inf)
             else:
                 theta_n = jnp.asarray(jnp.inf, x.dtype)
@@ -231,7 +255,7 @@ def _implicit_tangent(F, xs, theta, theta_dot):
 
     J = _jacobian(fx, jnp.reshape(xs, (-1,)))
     _, f_dot = jax.jvp(f_theta, tuple(leaves[i] for i in nz), tuple(t_leaves[i] for i in nz))
-    return jnp.reshape(-_lin_solve(J, f_dot), shape)
+    return jnp.reshape(-solve_small(J, f_dot), shape)
 
 
 def _solve_jvp(F, tol, xtol, max_steps, max_halvings, ls, primals, tangents):

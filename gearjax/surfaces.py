@@ -46,7 +46,7 @@ from typing import Callable, NamedTuple
 import jax
 import jax.numpy as jnp
 
-from gearjax.newton import NewtonResult, with_value, newton_solve
+from gearjax.newton import NewtonResult, with_value, newton_solve, solve_small
 
 __all__ = [
     "tangents", "unit_normal", "point_and_normal", "fundamental_forms", "weingarten",
@@ -131,7 +131,7 @@ def weingarten(r: Callable, uv):
     """
     uv = jnp.asarray(uv, float)
     Jn, (J, _, _) = jax.jacfwd(_normal_and_first_order(r), has_aux=True)(uv)
-    return Jn @ jnp.linalg.solve(J.T @ J, J.T)
+    return Jn @ solve_small(J.T @ J, J.T)
 
 
 def _principal_from_W(n, W, ru):
@@ -162,7 +162,7 @@ def local_geometry(r: Callable, uv) -> LocalGeometry:
     uv = jnp.asarray(uv, float)
     Jn, (J, p, n) = jax.jacfwd(_normal_and_first_order(r), has_aux=True)(uv)
     ru, rv = J[:, 0], J[:, 1]
-    W = Jn @ jnp.linalg.solve(J.T @ J, J.T)
+    W = Jn @ solve_small(J.T @ J, J.T)
     k1, k2, e1, e2 = _principal_from_W(n, W, ru)
     return LocalGeometry(p, n, ru, rv, W, k1, k2, e1, e2)
 
@@ -418,6 +418,6 @@ def _generated_local_geometry_at(surf: GeneratedSurface, uv, psi) -> LocalGeomet
     n = N / jnp.linalg.norm(N)
     sgn = jnp.sign(jnp.dot(n, nt))
     Jn = sgn * (D[:3, :2] + jnp.outer(D[:3, 2], psi_uv))
-    W = Jn @ jnp.linalg.solve(J.T @ J, J.T)
+    W = Jn @ solve_small(J.T @ J, J.T)
     k1, k2, e1, e2 = _principal_from_W(n, W, ru)
     return LocalGeometry(r, n, ru, rv, W, k1, k2, e1, e2)

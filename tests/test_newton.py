@@ -5,7 +5,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from gearjax.newton import implicit_solution, newton_solve, split_derivative
+from gearjax.newton import implicit_solution, newton_solve, solve_small, split_derivative
 
 
 def cube_root_system(x, th):
@@ -290,3 +290,26 @@ def test_split_derivative_continuation_matches_newton_through_a_scan():
     # frozen cuts every derivative through the closure
     assert float(jax.grad(lambda b: split_derivative(lambda z, tt: F(z, tt, b), jnp.asarray(0.5),
                                                      1.0)[0](1.0, 1.0))(a)) == 0.0
+
+
+@pytest.mark.parametrize("n", [1, 2, 3, 4])
+def test_small_solve_is_the_factorised_solve(n):
+    """solve_small (closed form for n <= 3) against numpy's LU solve on a seeded sweep
+    of well-conditioned and badly scaled systems, vector and matrix right-hand sides;
+    jitted and vmapped; a singular matrix gives non-finite values (the Newton step's
+    failure test relies on it)."""
+    rng = np.random.default_rng(n)
+    for k in range(20):
+        A = rng.normal(size=(n, n)) + 3.0 * np.eye(n)
+        A = A * 10.0 ** rng.uniform(-3, 3, size=(n, 1))       # rows of other units
+        for b in (rng.normal(size=n), rng.normal(size=(n, 3))):
+            ref = np.linalg.solve(A, b)
+            got = np.asarray(jax.jit(solve_small)(jnp.asarray(A), jnp.asarray(b)))
+            np.testing.assert_allclose(got, ref, rtol=1e-11, atol=1e-13 * np.abs(ref).max())
+    As = rng.normal(size=(5, n, n)) + 3.0 * np.eye(n)
+    bs = rng.normal(size=(5, n))
+    np.testing.assert_allclose(np.asarray(jax.vmap(solve_small)(As, bs)),
+                               np.linalg.solve(As, bs[..., None])[..., 0], rtol=1e-11)
+    S = np.ones((n, n))
+    if n > 1:
+        assert not np.all(np.isfinite(np.asarray(solve_small(jnp.asarray(S), jnp.ones(n)))))
