@@ -71,6 +71,7 @@ import numpy as np
 from gearjax.tca.edge_contact import CORNER_KINDS, EDGE_NAMES, FACE_END_KINDS, TIP_KINDS
 from gearjax.fields import strong_float64
 from gearjax.frames import matrix_z
+from gearjax.newton import solve_small
 from gearjax.surfaces import local_geometry
 from gearjax.tca.path import (ARCSEC, ContactPath, MultiPair, contact_equations, contact_system,
                               relative_curvature)
@@ -215,7 +216,7 @@ def contact_velocity(r, n, W1, W2, e, k2, c):
     v12 = w1 - m21 * w2_unit
     rhs = jnp.cross(m21 * k2 - ez, n) + W2 @ v12
     B, A = relative_curvature(n, W1, W2, e)            # B = -A^T (W1 - W2) A
-    y = jnp.linalg.solve(-B, A.T @ rhs)
+    y = solve_small(-B, A.T @ rhs)
     return w1 + A @ y, m21
 
 
