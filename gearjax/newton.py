@@ -111,13 +111,13 @@ def solve_small(A, b):
     larger systems by ``jnp.linalg.solve``.  A singular ``A`` gives non-finite values,
     as the factorisation does.  The per-point systems of the flank, blank and edge
     solves are 2 x 2 and 3 x 3, and so are the Weingarten maps' ``J^T J``; measured on
-    the 2-core CPU: the 41 x 21 hypoid flank grid 5.8 -> 3.6 ms, the spur TCA of
-    benchmarks/bench_tca.py 26.5 -> 21.4 ms (benchmarks/results).  Round-off differs
-    from the factorisation's; for n = 2 the rule is forward stable (Higham, Accuracy
-    and Stability of Numerical Algorithms, 2nd ed., §1.10).  (One LU factorisation per
-    Newton step, reused by the line search's corrections through
-    ``lax.linalg.triangular_solve``, ran the jitted involute TCA 11 % slower on the CPU
-    than solving anew each time.)"""
+    the 2-core CPU: the 41 x 21 hypoid flank grid 5.8 -> 2.9-3.6 ms, 2e4 Weingarten maps
+    6.3 -> 2.1 ms (docs/hypoid.md, Benchmark; the TCA and the efficiency chain, whose
+    time is in the 5 x 5 contact system, unchanged within the machine's noise).  Round-off
+    differs from the factorisation's; for n = 2 the rule is forward stable
+    ([Higham2002]).  (One LU factorisation per Newton step, reused by the line search's
+    corrections through ``lax.linalg.triangular_solve``, ran the jitted involute TCA 11 %
+    slower on the CPU than solving anew each time.)"""
     n = A.shape[0]
     if n == 1:
         return b / A[0, 0]
