@@ -134,8 +134,6 @@ def solve_small(A, b):
     return sum(jnp.reshape(c, (n,) + tail) * b[j] for j, c in enumerate(adj)) / det
 
 
-
-
 def _loop(F, tol, xtol, max_steps, max_halvings, ls, x0, theta):
     """Damped Newton iterations on the flattened unknown; ``ls = (natural, floor)`` the
     line-search options of :func:`newton_solve` (``natural_monotonicity``,
