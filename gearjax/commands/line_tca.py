@@ -204,9 +204,8 @@ def run_line_tca(args) -> int:
     options checked, then the design read, then the work."""
     import gearjax as gj
     from gearjax.commands import print_json, warn_nonfinite
-    from gearjax.progress import Progress
-
     from gearjax.commands.loaded import resolve_coupling
+    from gearjax.progress import Progress
 
     positions, slices, torques, f_ma, coupling = check_line_options(args, (
         ("--misalign", bool(args.misalign.strip()), MIS_WHY),

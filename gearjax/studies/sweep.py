@@ -55,8 +55,8 @@ from gearjax.studies.study_run import Problem, combine, evaluator, set_scales
 
 __all__ = ["SweepResult", "set_up_sweep", "check_design_count", "sample_points",
            "sweep_program", "run_sweep", "chunk_flags", "npz_columns", "chunk_size",
-           "steady_rate", "best_row",
-           "file_units", "sweep_constraints", "MAX_DESIGNS", "FLAG_KEYS"]
+           "steady_rate", "best_row", "file_units", "sweep_constraints", "MAX_DESIGNS",
+           "FLAG_KEYS"]
 
 #: most designs one sweep may ask for (a grid's points ** n_variables included)
 MAX_DESIGNS = 1_000_000
