@@ -63,18 +63,47 @@ def pytest_configure(config):
     os.environ["JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS"] = "0"
 
 
+def _memory_maps():
+    """The process's number of memory maps and its limit (``None`` where /proc does not
+    say: then the caches are cleared after every module)."""
+    try:
+        with open("/proc/self/maps", "rb") as f:
+            n = sum(1 for _ in f)
+        with open("/proc/sys/vm/max_map_count") as f:
+            return n, int(f.read())
+    except (OSError, ValueError):
+        return None
+
+
+#: clear JAX's caches after a module once the process holds this share of its map limit
+MAP_SHARE = 0.3
+
+
 @pytest.fixture(autouse=True, scope="module")
 def _release_compiled_code():
-    """Drop JAX's compiled executables after each test module.
+    """Drop JAX's compiled executables after a test module when they hold too many maps.
 
     One pytest process compiles several hundred XLA executables (the TCA, synthesis
     and kinematics tests compile large nested implicit solves); LLVM maps code
     sections for each, and a full run exhausted the process's memory-map limit
-    (``vm.max_map_count``, 65530 here) and aborted in a late compile.  Clearing the
-    caches between modules keeps the mapping count bounded, at the price of
-    recompiling what two modules would otherwise share.
+    (``vm.max_map_count``, 65530 here) and aborted in a late compile.  After a module
+    whose process then holds more than :data:`MAP_SHARE` of that limit the caches are
+    cleared (after every module where the count cannot be read); below it, the next
+    module finds the programs, traces and small eager operations of the earlier ones
+    in memory instead of tracing, lowering and reading them back from the persistent
+    cache again (docs/testing.md).  A test that needs cold caches asks for the
+    ``cold_jax_caches`` fixture.
     """
     yield
+    maps = _memory_maps()
+    if maps is None or maps[0] > MAP_SHARE * maps[1]:
+        jax.clear_caches()
+
+
+@pytest.fixture
+def cold_jax_caches():
+    """JAX's caches cleared before the test (it counts traces or compilations of
+    library programs that an earlier module of the same process may have run)."""
     jax.clear_caches()
 
 

@@ -162,12 +162,12 @@ def test_prefetch_then_submit_waits_for_the_same_compilation(compile_log):
     assert not ca._RUNNING
 
 
-def test_hypoid_mean_points_prefetched_as_they_run(monkeypatch, compile_log):
+def test_hypoid_mean_points_prefetched_as_they_run(monkeypatch, compile_log, cold_jax_caches):
     """The hypoid set-up starts compiling its mean-point programs before the blank is
     computed (``mean_points_ahead``); they must be the programs ``mean_points`` then
     submits and calls: the same abstract signatures (a crossing point of another dtype
     or weak type, or another flank, would compile a second program): two traces, one
-    per member (JAX's caches are cleared between test modules)."""
+    per member (JAX's caches cleared before the test)."""
     from gearjax.gears.hypoid.pair import mean_points, mean_points_ahead, pair_flanks
     monkeypatch.setattr(ca, "_STARTED", set())     # as in a fresh process
     keys = []
