@@ -63,40 +63,45 @@ def pytest_configure(config):
     os.environ["JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS"] = "0"
 
 
-def _memory_maps():
-    """The process's number of memory maps and its limit (``None`` where /proc does not
-    say: then the caches are cleared after every module)."""
+def _held_too_much():
+    """True when the process holds more than :data:`MAP_SHARE` of its memory-map limit or
+    more than :data:`RSS_LIMIT` bytes resident; also where /proc does not say."""
     try:
         with open("/proc/self/maps", "rb") as f:
-            n = sum(1 for _ in f)
+            maps = sum(1 for _ in f)
         with open("/proc/sys/vm/max_map_count") as f:
-            return n, int(f.read())
-    except (OSError, ValueError):
-        return None
+            limit = int(f.read())
+        with open("/proc/self/statm") as f:
+            rss = int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+    except (OSError, ValueError, IndexError):
+        return True
+    return maps > MAP_SHARE * limit or rss > RSS_LIMIT
 
 
-#: clear JAX's caches after a module once the process holds this share of its map limit
+#: clear JAX's caches after a module once the process holds this share of its map
+#: limit, or this many bytes resident (clearing after every module, a worker peaked at
+#: 3.1 GB in a full run; with the map bound alone at 6.6 GB)
 MAP_SHARE = 0.3
+RSS_LIMIT = 4 * 2**30
 
 
 @pytest.fixture(autouse=True, scope="module")
 def _release_compiled_code():
-    """Drop JAX's compiled executables after a test module when they hold too many maps.
+    """Drop JAX's compiled executables after a test module when they hold too much.
 
     One pytest process compiles several hundred XLA executables (the TCA, synthesis
     and kinematics tests compile large nested implicit solves); LLVM maps code
     sections for each, and a full run exhausted the process's memory-map limit
     (``vm.max_map_count``, 65530 here) and aborted in a late compile.  After a module
-    whose process then holds more than :data:`MAP_SHARE` of that limit the caches are
-    cleared (after every module where the count cannot be read); below it, the next
-    module finds the programs, traces and small eager operations of the earlier ones
-    in memory instead of tracing, lowering and reading them back from the persistent
-    cache again (docs/testing.md).  A test that needs cold caches asks for the
-    ``cold_jax_caches`` fixture.
+    whose process then holds more than :data:`MAP_SHARE` of that limit or more than
+    :data:`RSS_LIMIT` resident, the caches are cleared (after every module where /proc
+    cannot be read); below both, the next module finds the programs, traces and small
+    eager operations of the earlier ones in memory instead of tracing, lowering and
+    reading them back from the persistent cache again (docs/testing.md).  A test that
+    needs cold caches asks for the ``cold_jax_caches`` fixture.
     """
     yield
-    maps = _memory_maps()
-    if maps is None or maps[0] > MAP_SHARE * maps[1]:
+    if _held_too_much():
         jax.clear_caches()
 
 
