@@ -12,7 +12,10 @@ The first fixed-step kernel (commit afbe9cf: 48-node shear rule, pow-based film
 formulas, 32-node load-sharing steps) measured 0.26 s of CPU per 1e5 points forward
 (3.8e5 points per CPU-second) and 0.70 s gradient; stages 0.029 (Hertz), 0.113
 (load sharing), 0.152 (shear) s of CPU per 1e5 points, in the same window as the
-current figures of docs/friction.md.
+current figures of docs/friction.md.  The third pass (2026-11-29: the AGM unrolled and
+the shear rule node by node for batches of 4096 points or more) took 1e5 points from
+7.4e5 to 1.2e6 points/s forward and 2.8e5 to 4.1e5 gradient (docs/friction.md).  The
+stage rows run the same routes as the kernel (same array sizes).
 
 ``--devices N`` (N > 1) sets ``XLA_FLAGS=--xla_force_host_platform_device_count=N``
 before JAX starts and shards the points over the N CPU devices (a deployment option

@@ -227,6 +227,12 @@ def test_shear_integral_matches_graded_composite_rule(model):
                   axis=1) + np.arcsinh(X0 * np.exp(150.0)) * (1 - h * h) / 2)
     got = np.asarray(jax.jit(shear_integral, static_argnums=3)(pf, X0, oil, model))
     np.testing.assert_allclose(got, ref, rtol=2e-9)   # observed 3.9e-10 / 4.7e-10
+    # the fused route of large batches (>= FUSED_MIN_POINTS points: the nodes unrolled)
+    # against the same reference: the sweep three times over
+    oil3 = Oil(*(jnp.tile(v, 3) for v in (oil.eta0, oil.z)), oil.tau0, oil.rho0)
+    got3 = np.asarray(jax.jit(shear_integral, static_argnums=3)(np.tile(pf, 3), np.tile(X0, 3),
+                                                                 oil3, model))
+    np.testing.assert_allclose(got3, np.tile(ref, 3), rtol=2e-9)
     # odd in X0 (signed sliding speeds in mesh arrays), as asinh
     neg = np.asarray(jax.jit(shear_integral, static_argnums=3)(pf, -X0, oil, model))
     np.testing.assert_allclose(neg, -got, rtol=1e-14)
@@ -235,3 +241,87 @@ def test_shear_integral_matches_graded_composite_rule(model):
     assert float(shear_integral(1500.0, 0.0, oil1, model)) == 0.0
     d = jax.grad(lambda x: shear_integral(1500.0, x, oil1, model))(0.0)
     assert np.isfinite(float(d)) and float(d) > 1.0
+
+
+@pytest.mark.parametrize("model", ["roelands", "barus"])
+def test_fused_large_batch_route_is_the_stacked_rule(model):
+    """From FUSED_MIN_POINTS points on, the shear rule runs node by node (one fused
+    loop) with its own derivative rule (the partials in closed form, a custom JVP), and
+    the AGM of the Hertz ellipse is unrolled.  Against the points x nodes route of
+    small batches on the same 5000 points (p_f 0-4 GPa, X0 0 and 1e-10..1e5, per-point
+    η0 and z): the value, the forward derivative along each of p_f, X0, η0, z, the
+    reverse gradient and a second derivative in p_f; and the fused route's derivative
+    along each input against central differences of its own values; and the unrolled
+    AGM of the Hertz ellipse against the loop, bit for bit.  Planted bugs caught
+    (tools/mutations/tribology.toml, shear-fused-*): a wrong factor in a partial of
+    either viscosity law, the tail's X0 slope dropped, the large-argument form of the
+    asinh slope replaced by the plain one, the tangents of η0 and z swapped.  (The cap's
+    zero slope inside the loop is not reachable: the nodes lie inside [0, h], below
+    the cap.)"""
+    from gearjax.contact import FUSED_MIN_POINTS, hertz_exact
+    from gearjax.tribology import friction
+    n = 5000
+    assert n >= FUSED_MIN_POINTS
+    rng = np.random.default_rng(11)
+    pf = jnp.asarray(np.concatenate([rng.uniform(0, 4000, n - 100), np.zeros(50),
+                                     rng.uniform(100, 2000, 50)]))
+    X0 = jnp.asarray(np.concatenate([10 ** rng.uniform(-10, 5, n - 50), np.zeros(50)]))
+    eta0 = jnp.asarray(10 ** rng.uniform(-2.5, 0.5, n))
+    z = jnp.asarray(rng.uniform(0.3, 1.0, n))
+
+    def route(fn):
+        def J(p, x, e, zz):
+            return fn(model, p, x, Oil(e, zz, jnp.asarray(TAU0), jnp.asarray(880.0)))
+        return J
+
+    fused, stacked = route(friction._shear_rule), route(friction._shear_stacked)
+    args = (pf, X0, eta0, z)
+    v_f, v_s = jax.jit(fused)(*args), jax.jit(stacked)(*args)
+    np.testing.assert_allclose(np.asarray(v_f), np.asarray(v_s), rtol=1e-13, atol=1e-300)
+    def jvps(fn):   # the derivative along each input, one program per route
+        def all_four(*a):
+            return [jax.jvp(fn, a, tuple(jnp.ones_like(x) if j == i else jnp.zeros_like(x)
+                                         for j, x in enumerate(a)))[1] for i in range(4)]
+        return jax.jit(all_four)(*args)
+
+    value = jax.jit(fused)
+    for i, (d_f, d_s) in enumerate(zip(jvps(fused), jvps(stacked))):
+        assert np.all(np.isfinite(np.asarray(d_f))), i
+        np.testing.assert_allclose(np.asarray(d_f), np.asarray(d_s), rtol=1e-11, atol=0,
+                                   err_msg=str(i))
+        # central differences of the fused values (relative step 1e-6; points where
+        # the value moves well above its round-off; not at X0 = 0, where a step of any
+        # size leaves the linear part of asinh(X0 e^L) for e^L up to e^150)
+        step = 1e-6 * jnp.where(args[i] != 0.0, jnp.abs(args[i]), 1e-3)
+        shift = [tuple(a + sgn * step if j == i else a for j, a in enumerate(args))
+                 for sgn in (1.0, -1.0)]
+        cd = (value(*shift[0]) - value(*shift[1])) / (2.0 * step)
+        ok = np.asarray((jnp.abs(d_f * step) > 1e-7 * jnp.abs(v_f)) & (X0 != 0.0))
+        assert ok.sum() > n // 5, i
+        np.testing.assert_allclose(np.asarray(cd)[ok], np.asarray(d_f)[ok], rtol=1e-5,
+                                   err_msg=str(i))
+    g_f = jax.jit(jax.grad(lambda *a: jnp.sum(fused(*a)), argnums=(0, 1, 2, 3)))(*args)
+    g_s = jax.jit(jax.grad(lambda *a: jnp.sum(stacked(*a)), argnums=(0, 1, 2, 3)))(*args)
+    for a, b in zip(g_f, g_s):
+        np.testing.assert_allclose(np.asarray(a), np.asarray(b), rtol=1e-11, atol=0)
+    # second derivative in p_f (the partials are themselves differentiable)
+    h_f = jax.jit(jax.grad(lambda *a: jnp.sum(jax.jvp(
+        fused, a, (jnp.ones_like(pf), *(jnp.zeros_like(v) for v in a[1:])))[1])))(*args)
+    h_s = jax.jit(jax.grad(lambda *a: jnp.sum(jax.jvp(
+        stacked, a, (jnp.ones_like(pf), *(jnp.zeros_like(v) for v in a[1:])))[1])))(*args)
+    # (entries many orders below the largest lose digits to cancellation in both routes:
+    # Barus, entries of 1e-17 against a largest of 1.5e-4 differ by 2e-19; so the bound
+    # is also relative to the largest)
+    np.testing.assert_allclose(np.asarray(h_f), np.asarray(h_s), rtol=1e-8,
+                               atol=1e-10 * float(jnp.max(jnp.abs(h_s))))
+    if model == "barus":
+        return
+    # the Hertz ellipse: the unrolled AGM of a large batch is the loop's, bit for bit
+    F = jnp.asarray(rng.uniform(10, 1e4, n))
+    Rx = jnp.asarray(rng.uniform(1, 50, n))
+    Ry = Rx * jnp.asarray(10 ** rng.uniform(-3, 4, n))
+    big = jax.jit(lambda *a: hertz_exact(*a, 226374.0))(F, Rx, Ry)
+    one = jax.jit(jax.vmap(lambda *a: hertz_exact(*a, 226374.0)))(F, Rx, Ry)
+    for name in ("a", "b", "p_max", "approach"):
+        np.testing.assert_array_equal(np.asarray(getattr(big, name)),
+                                      np.asarray(getattr(one, name)), err_msg=name)
