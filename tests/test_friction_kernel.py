@@ -248,14 +248,15 @@ def test_fused_large_batch_route_is_the_stacked_rule(model):
     """From FUSED_MIN_POINTS points on, the shear rule runs node by node (one fused
     loop) with its own derivative rule (the partials in closed form, a custom JVP), and
     the AGM of the Hertz ellipse is unrolled.  Against the points x nodes route of
-    small batches on the same 5000 points (p_f 0-4 GPa, X0 0 and 1e-10..1e5, per-point
-    η0 and z): the value, the forward derivative along each of p_f, X0, η0, z, the
+    small batches on the same 5000 points (p_f 0-4 GPa, |X0| 0 and 1e-10..1e5 of either
+    sign, per-point η0 and z): the value, the forward derivative along each of p_f, X0, η0, z, the
     reverse gradient and a second derivative in p_f; and the fused route's derivative
     along each input against central differences of its own values; and the unrolled
     AGM of the Hertz ellipse against the loop, bit for bit.  Planted bugs caught
     (tools/mutations/tribology.toml, shear-fused-*): a wrong factor in a partial of
     either viscosity law, the tail's X0 slope dropped, the large-argument form of the
-    asinh slope replaced by the plain one, the tangents of η0 and z swapped.  (The cap's
+    asinh slope replaced by the plain one or without its sign (negative X0), the tangents
+    of η0 and z swapped.  (The cap's
     zero slope inside the loop is not reachable: the nodes lie inside [0, h], below
     the cap.)"""
     from gearjax.contact import FUSED_MIN_POINTS, hertz_exact
@@ -265,7 +266,9 @@ def test_fused_large_batch_route_is_the_stacked_rule(model):
     rng = np.random.default_rng(11)
     pf = jnp.asarray(np.concatenate([rng.uniform(0, 4000, n - 100), np.zeros(50),
                                      rng.uniform(100, 2000, 50)]))
-    X0 = jnp.asarray(np.concatenate([10 ** rng.uniform(-10, 5, n - 50), np.zeros(50)]))
+    # a third of the Eyring arguments negative (signed sliding speeds: J is odd in X0)
+    sign = np.where(rng.uniform(size=n - 50) < 1 / 3, -1.0, 1.0)
+    X0 = jnp.asarray(np.concatenate([sign * 10 ** rng.uniform(-10, 5, n - 50), np.zeros(50)]))
     eta0 = jnp.asarray(10 ** rng.uniform(-2.5, 0.5, n))
     z = jnp.asarray(rng.uniform(0.3, 1.0, n))
 
