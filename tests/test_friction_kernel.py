@@ -249,16 +249,15 @@ def test_fused_large_batch_route_is_the_stacked_rule(model):
     loop) with its own derivative rule (the partials in closed form, a custom JVP), and
     the AGM of the Hertz ellipse is unrolled.  Against the points x nodes route of
     small batches on the same 5000 points (p_f 0-4 GPa, |X0| 0 and 1e-10..1e5 of either
-    sign, per-point η0 and z): the value, the forward derivative along each of p_f, X0, η0, z, the
-    reverse gradient and a second derivative in p_f; and the fused route's derivative
-    along each input against central differences of its own values; and the unrolled
-    AGM of the Hertz ellipse against the loop, bit for bit.  Planted bugs caught
-    (tools/mutations/tribology.toml, shear-fused-*): a wrong factor in a partial of
-    either viscosity law, the tail's X0 slope dropped, the large-argument form of the
-    asinh slope replaced by the plain one or without its sign (negative X0), the tangents
-    of η0 and z swapped.  (The cap's
-    zero slope inside the loop is not reachable: the nodes lie inside [0, h], below
-    the cap.)"""
+    sign, per-point η0 and z): the value, the forward derivative along each of p_f, X0,
+    η0, z, the reverse gradient and a second derivative in p_f; and the fused route's
+    derivative along each input against central differences of its own values; and the
+    unrolled AGM of the Hertz ellipse against the loop, bit for bit.  Planted bugs
+    caught (tools/mutations/tribology.toml, shear-fused-*): a wrong factor in a partial
+    of either viscosity law, the tail's X0 slope dropped, the large-argument form of the
+    asinh slope replaced by the plain one or without its sign (negative X0), the
+    tangents of η0 and z swapped.  (The cap's zero slope inside the loop is not
+    reachable: the nodes lie inside [0, h], below the cap.)"""
     from gearjax.contact import FUSED_MIN_POINTS, hertz_exact
     from gearjax.tribology import friction
     n = 5000
@@ -279,15 +278,16 @@ def test_fused_large_batch_route_is_the_stacked_rule(model):
 
     fused, stacked = route(friction._shear_rule), route(friction._shear_stacked)
     args = (pf, X0, eta0, z)
-    v_f, v_s = jax.jit(fused)(*args), jax.jit(stacked)(*args)
+    value = jax.jit(fused)
+    v_f, v_s = value(*args), jax.jit(stacked)(*args)
     np.testing.assert_allclose(np.asarray(v_f), np.asarray(v_s), rtol=1e-13, atol=1e-300)
+
     def jvps(fn):   # the derivative along each input, one program per route
         def all_four(*a):
             return [jax.jvp(fn, a, tuple(jnp.ones_like(x) if j == i else jnp.zeros_like(x)
                                          for j, x in enumerate(a)))[1] for i in range(4)]
         return jax.jit(all_four)(*args)
 
-    value = jax.jit(fused)
     for i, (d_f, d_s) in enumerate(zip(jvps(fused), jvps(stacked))):
         assert np.all(np.isfinite(np.asarray(d_f))), i
         np.testing.assert_allclose(np.asarray(d_f), np.asarray(d_s), rtol=1e-11, atol=0,
