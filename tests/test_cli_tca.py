@@ -86,6 +86,10 @@ def test_hypoid_design_json_and_plot(capsys, tmp_path):
     # arcsec for the 8-arcsec parabola, widened by the 1-arcsec fit tolerance.
     assert 32 * 0.38 ** 2 - 1.0 < out["ptp_arcsec"] < 32 * 0.62 ** 2 + 1.0, out["ptp_arcsec"]
     assert all(v is not None for v, o in zip(out["ellipses"]["semi_major_mm"], on) if o)
+    # crossing flanks per point: on the flank without an ellipse (here: nowhere)
+    no_ellipse = np.array([v is None for v in out["ellipses"]["semi_major_mm"]])
+    assert out["flags"]["crossing_flanks"] == (on & no_ellipse).tolist()
+    assert out["quality"]["crossing_flanks"] is False
     assert png.read_bytes()[:4] == b"\x89PNG"
 
 

@@ -32,8 +32,10 @@ at every touching grid point the solve converged with ``residual < 1e-9`` and fi
 TE; ``flags()["converged"]`` is False exactly when the strict check of ``run_tca``
 (``gearjax.tca.path.check_on_flank_converged``) raises; a result with no flag raised
 (converged, reference on the flanks, no edge / face-end contact, contact ratio >= 1,
-TE peak-to-peak <= 60 arcsec) has finite TE over its whole touching span and a
-finite peak-to-peak.  Involute: the flag ``face_end_contact`` is raised exactly when
+TE peak-to-peak <= 60 arcsec, no load carried where the flanks cross) has finite TE over
+its whole touching span, a finite peak-to-peak and a contact ellipse (a definite relative
+curvature, by the ellipse's own route) wherever pair 0 carries the load at a surface
+contact.  Involute: the flag ``face_end_contact`` is raised exactly when
 the load-carrying pair 0 touches at a face end, checked from the contact point's own
 axial coordinate (|axial| = b/2 on pinion or gear, to 1e-6 mm), not from the
 library's edge classification.  Gradients: ``jax.grad`` of the TE peak-to-peak
@@ -133,7 +135,7 @@ def _check_result(res, tag):
     assert flags["converged"] == strict_ok, (tag, flags)
     clean = (flags["converged"] and flags["reference_on_flank"] and not flags["edge_contact"]
              and not flags["face_end_contact"] and not flags["low_contact_ratio"]
-             and not flags["large_te"])
+             and not flags["large_te"] and not flags["crossing_flanks"])
     if not clean:
         return "flagged"
     # looks valid: nothing may be silently wrong over the touching span
@@ -142,6 +144,11 @@ def _check_result(res, tag):
     span = slice(idx[0], idx[-1] + 1)
     assert np.all(conv[span]) and np.all(resid[span] < RESIDUAL_TOL), tag
     assert np.all(np.isfinite(te[span])), tag
+    # where pair 0 carries the load at a surface contact the flanks do not cross: the
+    # contact ellipse (its own route from the relative curvature) exists there (every
+    # fuzzed pair is in point contact: crowned involute pairs, bevel/hypoid)
+    carrying = np.asarray(res.on_flank) & res._carrying()
+    assert np.all(np.isfinite(np.asarray(path.semi_major)[carrying])), tag
     ptp = float(res.ptp)
     assert math.isfinite(ptp) and ptp >= 0.0, (tag, ptp)
     assert math.isfinite(float(res.contact_ratio)), tag
@@ -205,6 +212,7 @@ def test_hypoid_example_perturbations_are_valid_or_flagged(name, xs):
     pair, mis = _perturbed(f, xs)
     res = f(pair, mis)
     OUTCOMES[f"hypoid {name}: " + _check_result(res, (name, xs))] += 1
+    OUTCOMES[f"hypoid {name}: crossing_flanks raised"] += res.flags()["crossing_flanks"]
 
 
 @pytest.mark.parametrize("name", NO_FLANK_EXAMPLES)

@@ -10,6 +10,7 @@ import json
 import math
 import re
 
+import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
@@ -254,6 +255,69 @@ def test_continuous_te_ptp_meets_the_synthesis_target():
     assert abs(out["coast"][0] - 8.0) > 0.5
 
 
+def test_load_carried_where_the_flanks_cross_is_flagged():
+    """The ISO 10/41 pinion's edge of regression lies above its fillet boundary (an
+    undercut generated flank, docs/tca.md "Crossing flanks"): on the default grid the
+    drive path of pair 0 runs past it at its end.  The flag test of ``flanks_cross``
+    (indefinite relative curvature) marks exactly the on-flank points that the
+    independent route puts on the second sheet of the generated pinion flank (the sign
+    of (E_u x E_v) . n, test_tca_hypoid._sheet), and the ellipse route agrees (no
+    ellipse there).  Nominal: those points carry no load, no flag.  Under dE = +0.1 mm
+    the load-carrying part of the path reaches them: ``crossing_flanks`` is raised
+    (and a warning), where before this flag every other flag was clear and the TE
+    p-t-p (7.05 arcsec) looked valid.  Planted bugs caught: the determinant's sign or
+    tolerance, the carrying mask dropped or inverted, the flag left out of flags()."""
+    from gearjax.gears.hypoid.pair import flank_function
+    from test_tca_hypoid import _sheet
+    d = gj.load_design("example:hypoid_iso_10x41_synthesised")
+    zero = dict(dE=0.0, dP=0.0, dG=0.0, dSigma=0.0)
+    nom = gj.run_tca(d, side="drive")
+    mis = gj.run_tca(d, gj.Misalignment(**{**zero, "dE": 0.1}), side="drive")
+    pair = gj.hypoid.pair_flanks(d, "drive")
+    surf = flank_function(pair.pinion, pair.pinion_crossing)
+    sheet = jax.jit(jax.vmap(lambda uv: _sheet(surf, uv)))
+    for res, carried in ((nom, False), (mis, True)):
+        on = np.asarray(res.on_flank)
+        cross = np.asarray(res.flanks_cross)
+        s = np.asarray(sheet(res.path.uv1))
+        second = s * s[s.shape[0] // 2] < 0.0        # against the reference contact
+        assert np.array_equal(cross[on], second[on]) and second[on].sum() >= 2
+        assert np.all(np.isinf(np.asarray(res.path.semi_major)[cross & on]))
+        assert np.all(np.isfinite(np.asarray(res.path.semi_major)[on & ~cross]))
+        loaded = res._carrying() & on & cross
+        f = res.flags()
+        assert f.pop("crossing_flanks") is carried is bool(loaded.any())
+        assert not any(f[k] for k in ("edge_contact", "tip_contact", "face_end_contact",
+                                      "low_contact_ratio", "large_te"))
+        assert any("crossing flanks" in w for w in res.warnings()) is carried
+
+
+def test_sweep_rows_and_acceptance_refuse_crossing_flanks():
+    """A sweep row whose scenario carries load where the flanks cross is not ``ok``
+    (each of the three flags alone, and a non-finite quantity); an end design that
+    gains ``crossing_flanks`` is not accepted, one whose start had it already is."""
+    from gearjax.studies.end_checks import acceptance_reasons
+    from gearjax.studies.sweep import FLAG_KEYS, rows_ok
+    flags = {k: np.zeros((5, 2), bool) for k in FLAG_KEYS}
+    flags["converged"][:] = True
+    flags["converged"][1, 1] = False
+    flags["edge_contact"][2, 0] = True
+    flags["crossing_flanks"][3, 1] = True
+    values = np.ones((5, 2, 3))
+    values[4, 0, 2] = np.nan
+    assert rows_ok(flags, values).tolist() == [True, False, False, False, False]
+    opt = {"converged": True, "message": "converged"}
+    fl = {"converged": True, "edge_contact": False, "crossing_flanks": False}
+    gained = {**fl, "crossing_flanks": True}
+
+    def reasons(f0, f1):
+        return acceptance_reasons(opt, 0.0, 1e-6, None, 0.0, np.zeros(2), [f0], [f1])
+
+    assert reasons(fl, fl) == []
+    assert reasons(fl, gained) == ["scenario 1: the end design carries load where the flanks cross"]
+    assert reasons(gained, gained) == []
+
+
 def test_tooth_form_margins_agree_with_the_loader():
     """The traced margins say "valid" exactly where the loader's concrete checks accept
     the pair (undercut, pointed tip, involute and tip/fillet interference)."""
@@ -382,7 +446,8 @@ def test_sweep_on_four_devices_is_each_designs_own_tca_on_one(sweep_four):
         for key in FLAG_KEYS:
             assert bool(d[f"flag:{key}"][k, 0]) == fl[key], (k, key)
     v = d["values"][:, 0]
-    ok = np.isfinite(v).all(axis=1) & d["flag:converged"][:, 0] & ~d["flag:edge_contact"][:, 0]
+    ok = (np.isfinite(v).all(axis=1) & d["flag:converged"][:, 0] & ~d["flag:edge_contact"][:, 0]
+          & ~d["flag:crossing_flanks"][:, 0])
     assert np.array_equal(d["ok"], ok)
     # the study's constraints: contact ratio >= 1.25 and the tooth form (the fixed mask's
     # margin, which the study adds, is left out of a sweep)

@@ -95,7 +95,7 @@ def test_preset_parabola_is_followed(des, runs):
         assert res.flags() == dict(converged=True, reference_on_flank=True,
                                    edge_contact=False, face_end_contact=False,
                                    tip_contact=False, low_contact_ratio=False,
-                                   large_te=False)
+                                   large_te=False, crossing_flanks=False)
         # smooth transfer (curves cross inside the overlap), at +-half a pitch
         assert all(float(g) < 0.0 for g in A.transfer_gaps(res, 10, 16))
         mid = float(res.path.phi1[res.path.phi1.shape[0] // 2])

@@ -417,15 +417,14 @@ def _sheet(surf, uv):
     """Independent route to the sheet of a generated flank point: the sign of
     (E_u x E_v) . n, E(uv) = family(uv, psi(uv)) with psi_uv = -f_uv/f_psi from the
     meshing function f (Litvin & Fuentes, 2nd ed., §6.3); it changes sign at the edge
-    of regression."""
+    of regression.  Traceable (``jax.vmap`` over ``uv``)."""
     from gearjax.surfaces import _tool_at, meshing_function
     psi = surf.solve(uv).x
     P_uv, P_psi = jax.jacfwd(surf.family, argnums=(0, 1))(uv, psi)
     f_uv, f_psi = jax.jacfwd(lambda a, b: meshing_function(surf.family, a, b, surf.normal),
                              argnums=(0, 1))(uv, psi)
     E = P_uv - jnp.outer(P_psi, f_uv / f_psi)
-    return float(jnp.dot(jnp.cross(E[:, 0], E[:, 1]), _tool_at(surf.family, uv, psi,
-                                                                 surf.normal)[1]))
+    return jnp.dot(jnp.cross(E[:, 0], E[:, 1]), _tool_at(surf.family, uv, psi, surf.normal)[1])
 
 
 def test_edge_points_beyond_the_blade_tip_are_off_the_flank():

@@ -58,8 +58,64 @@ def test_flags_all_clear_for_a_hand_over_where_the_te_curves_cross():
     f = _result(*_crossing_case()).flags()
     assert f == dict(converged=True, reference_on_flank=True, edge_contact=False,
                      low_contact_ratio=False, face_end_contact=False, tip_contact=False,
-                     large_te=False)
+                     large_te=False, crossing_flanks=False)
     assert _result(*_crossing_case()).warnings() == []
+
+
+def _curved(res, B_at, normal=(0.0, 0.0, 1.0), carrying=(4, 5, 6)):
+    """``res`` with the unit normal ``normal`` and major direction e_x at every point, pair
+    0 the envelope's active pair at ``carrying`` and pinion Weingarten maps giving the
+    relative curvature ``B_at[i]`` (2x2, 1/mm; gear map 0): in the basis (e_x, n x e_x)
+    of :func:`~gearjax.tca.path.relative_curvature`, ``B = -A^T W1 A``."""
+    n = np.asarray(normal, float)
+    A = np.stack([[1.0, 0.0, 0.0], np.cross(n, [1.0, 0.0, 0.0])], axis=1)
+    W1 = np.stack([-A @ np.asarray(B_at[i], float) @ A.T for i in range(N)])
+    path = res.path._replace(normal=jnp.tile(jnp.asarray(n), (N, 1)),
+                             major_dir=jnp.tile(jnp.array([1.0, 0.0, 0.0]), (N, 1)),
+                             weingarten1=jnp.asarray(W1), weingarten2=jnp.zeros((N, 3, 3)))
+    active = np.where(np.isin(np.arange(N), carrying), 1, 0)
+    return TCAResult(path, res.margin, res.multi._replace(active=jnp.asarray(active)),
+                     {}, None, "drive", "test")
+
+
+def test_crossing_flanks_where_pair_0_carries_at_an_indefinite_relative_curvature():
+    """Hand-made paths with curvatures (docs/tca.md, "Crossing flanks"): the flag is
+    raised alone exactly when pair 0 carries the load at an on-flank point whose relative
+    curvature is indefinite -- whatever the sense of the normal, an off-diagonal B
+    included, a line contact (det B = 0 to round-off) not; an indefinite point that
+    carries no load, or lies off the flank, is marked per point but raises nothing.
+    Planted bugs caught: the sign of the determinant, a test of the diagonal alone, the
+    tolerance scaled wrongly, the carrying or on-flank mask dropped."""
+    base = _result(*_crossing_case())
+    good, saddle = np.diag([1.0, 2.0]), np.diag([1.0, -2.0])
+    skew = np.array([[1.0, 2.0], [2.0, 1.0]])               # det -3, both diagonals > 0
+    line = np.diag([-1e-12, 0.5])                            # a line contact's round-off
+
+    def run(bad, at, **kw):
+        B = [bad if i == at else good for i in range(N)]
+        r = _curved(base, B, **kw)
+        return np.asarray(r.flanks_cross), r.flags(), r.warnings()
+
+    clear = dict(converged=True, reference_on_flank=True, edge_contact=False,
+                 low_contact_ratio=False, face_end_contact=False, tip_contact=False,
+                 large_te=False, crossing_flanks=False)
+    cross, f, w = run(good, 5)
+    assert not cross.any() and f == clear and w == []
+    for bad, normal in ((saddle, (0.0, 0.0, 1.0)), (saddle, (0.0, 0.0, -1.0)),
+                        (skew, (0.0, 0.0, 1.0)), (-skew, (0.0, 1.0, 0.0))):
+        cross, f, w = run(bad, 5, normal=normal)
+        assert np.array_equal(np.nonzero(cross)[0], [5])
+        assert f == {**clear, "crossing_flanks": True}
+        assert len(w) == 1 and w[0].startswith("crossing flanks")
+    cross, f, w = run(line, 5)
+    assert not cross.any() and not f["crossing_flanks"] and w == []
+    cross, f, w = run(saddle, 8)                              # not carrying
+    assert np.array_equal(np.nonzero(cross)[0], [8]) and not f["crossing_flanks"]
+    margin = np.ones(N)
+    margin[4] = -0.1                                          # off the flank
+    off = _result(margin, *_crossing_case()[1:])
+    r = _curved(off, [saddle if i == 4 else good for i in range(N)])
+    assert bool(r.flanks_cross[4]) and not r.flags()["crossing_flanks"]
 
 
 def test_edge_contact_when_a_pair_leaves_its_flank_at_the_hand_over():

@@ -29,9 +29,10 @@ itself):
   values            (n, S, nq) the quantities at the S scenarios (order: quantities)
   q:QUANTITY        (n, S) one quantity's values
   flag:NAME         (n, S) the TCA's quality flags: converged, edge_contact, tip_contact,
-                    face_end_contact, low_contact_ratio, large_te
+                    face_end_contact, low_contact_ratio, large_te, crossing_flanks
   n_valid           (n, S) valid positions of the cycle (loaded studies only)
-  ok                (n,) every scenario converged without edge contact, every quantity finite
+  ok                (n,) every scenario converged without edge contact and without a load
+                    carried where the flanks cross, every quantity finite
   feasible          (n,) ok and every constraint of the study holds
   J                 (n,) the study's objective (scaled by row 0's values; lower is better)
   variables, units, quantities   names (units: "field" the field's own mm/rad/-, or "deg")

@@ -52,11 +52,16 @@ JSON_KEYS_DOC = """JSON keys:
                    flank boundaries), edge (pair 0 touches at an edge: a face end or a
                    tooth tip, no ellipse and no kinematics there), edge_end (null, or
                    which edge: "pinion toe", "pinion heel", "gear toe", "gear heel",
-                   "pinion tip", "gear tip"), off_flank
-                   (converged but outside a flank boundary: no contact of pair 0)
+                   "pinion tip", "gear tip", or a corner "pinion tip/toe corner" ...),
+                   off_flank
+                   (converged but outside a flank boundary: no contact of pair 0),
+                   crossing_flanks (an on_flank point where the flanks cross: relative
+                   curvature indefinite, e.g. past a generated flank's edge of regression)
   quality          {converged, reference_on_flank, edge_contact, face_end_contact,
-                   tip_contact, low_contact_ratio, large_te}: contact-quality flags of the side (each
-                   raised one is also a warning on stderr; large_te: TE p-t-p > 60 arcsec)
+                   tip_contact, low_contact_ratio, large_te, crossing_flanks}:
+                   contact-quality flags of the side (each raised one is also a warning on
+                   stderr; large_te: TE p-t-p > 60 arcsec; crossing_flanks: pair 0 carries
+                   the load at a crossing_flanks point)
   kinematics       with --kinematics: {u1_mm_s, u2_mm_s, u_e_mm_s, u_s_mm_s, srr, r_x_mm,
                    r_y_mm} per grid point (pinion = 1; per rad/s of pinion speed;
                    rolling direction across the contact ellipse; null off the flank)"""
@@ -148,6 +153,7 @@ def _side_json(res):
                      "semi_minor_mm": touched(path.semi_minor)},
         "flags": {"converged": conv.tolist(), "on_flank": on.tolist(),
                   "edge": edge.tolist(), "off_flank": (conv & ~touch).tolist(),
+                  "crossing_flanks": (on & np.asarray(res.flanks_cross)).tolist(),
                   "edge_end": [EDGE_NAMES[k] if e else None for k, e in zip(kinds, edge)]},
         "quality": res.flags(),
     }

@@ -6,7 +6,8 @@ trip, and the start/end quantity tables.
 ``scenarios``, ``study``, ``design``, ``fields``, ``soft``).  An end design is accepted
 only when :func:`acceptance_reasons` finds nothing: the optimiser met its stopping test,
 the constraints hold, the written design file reads back to the optimiser's fields, no
-scenario lost convergence or gained edge contact, no fewer positions are valid than at
+scenario lost convergence or gained edge contact or a load carried where the flanks
+cross, no fewer positions are valid than at
 the start, and (edge softening) the hard model's objective did not rise beyond the
 softened one's.  Units: those of the quantities (docs/optimize.md).
 """
@@ -79,6 +80,8 @@ def acceptance_reasons(opt: dict, feasibility: float, tol: float, file_error, di
             reasons.append(f"{where}: the end design's TCA did not converge")
         if b.get("edge_contact") and not a.get("edge_contact"):
             reasons.append(f"{where}: the end design has edge contact")
+        if b.get("crossing_flanks") and not a.get("crossing_flanks"):
+            reasons.append(f"{where}: the end design carries load where the flanks cross")
         if "n_valid" in b and b["n_valid"] < a["n_valid"]:
             reasons.append(f"{where}: fewer valid positions of the cycle at the end "
                            f"({b['n_valid']} < {a['n_valid']})")

@@ -56,13 +56,13 @@ from gearjax.studies.study_run import Problem, combine, evaluator, set_scales
 __all__ = ["SweepResult", "set_up_sweep", "check_design_count", "sample_points",
            "sweep_program", "run_sweep", "chunk_flags", "npz_columns", "chunk_size",
            "steady_rate", "best_row", "file_units", "sweep_constraints", "MAX_DESIGNS",
-           "FLAG_KEYS"]
+           "FLAG_KEYS", "rows_ok"]
 
 #: most designs one sweep may ask for (a grid's points ** n_variables included)
 MAX_DESIGNS = 1_000_000
 #: the TCA flags a sweep records per row and scenario
 FLAG_KEYS = ("converged", "edge_contact", "tip_contact", "face_end_contact",
-             "low_contact_ratio", "large_te")
+             "low_contact_ratio", "large_te", "crossing_flanks")
 
 
 def set_up_sweep(study) -> Problem:
@@ -233,8 +233,7 @@ def run_sweep(prob: Problem, U, chunk: int = 16, devices=None, progress=None) ->
     seconds = time.time() - t0
     values = np.concatenate(vals)
     flags = {k: np.asarray(v, bool) for k, v in flags.items()}       # (n, S): row, scenario
-    ok = (np.all(flags["converged"] & ~flags["edge_contact"], axis=1)
-          & np.all(np.isfinite(values), axis=(1, 2)))
+    ok = rows_ok(flags, values)
     J, feasible = _objective_and_feasibility(prob, values, ok)
     n_valid = np.asarray(nval, int) if nval else None
     return SweepResult(U, file_units(prob, U), values, flags, n_valid, ok, feasible, J, seconds,
@@ -260,6 +259,15 @@ def chunk_flags(prob: Problem, res, eff):
         if "n_valid" in one[0]:
             nval.append([f["n_valid"] for f in one])
     return flags, (nval if nval else None)
+
+
+def rows_ok(flags: dict, values: np.ndarray) -> np.ndarray:
+    """``ok`` per row: at every scenario converged, without edge contact and without a
+    load carried where the flanks cross (``flags[key]`` (n, S) bool, :data:`FLAG_KEYS`),
+    and every quantity finite (``values`` (n, S, nq))."""
+    return (np.all(flags["converged"] & ~flags["edge_contact"] & ~flags["crossing_flanks"],
+                   axis=1)
+            & np.all(np.isfinite(values), axis=(1, 2)))
 
 
 class _Counts(NamedTuple):

@@ -22,7 +22,7 @@ the kinematics at its contact points.
 
 :meth:`TCAResult.flags` gives the contact-quality flags on concrete results
 (converged, reference on the flank, edge contact -- at a flank boundary or a
-face end --, contact ratio below 1, a large TE).
+face end --, contact ratio below 1, a large TE, a load carried where the flanks cross).
 
 **Kinematics at the contact points** (:func:`contact_kinematics`).  Pinion =
 member 1 turning at 1 rad/s about its body z axis, gear = member 2 turning at the
@@ -352,6 +352,28 @@ class TCAResult:
             return jnp.zeros(self.path.phi1.shape, bool)
         return (self.margin >= 0.0) & self.path.converged & (self.path.edge_kind >= 0)
 
+    @property
+    def flanks_cross(self):
+        """(N,) the relative curvature tensor ``B`` of the flanks at pair 0's contact
+        point is indefinite, ``det B < -1e-9 (B_xx^2 + B_yy^2 + 2 B_xy^2)`` (the sign
+        does not depend on the sense of the normal): the gap between the flanks falls
+        below zero in some direction from the point, the flanks cross there and the
+        touching point is not a contact of the real flanks.  On a generated flank this
+        happens past its edge of regression, where the flank continued by the envelope
+        folds back onto a second sheet while the real tooth is undercut ([Litvin2004]
+        section 6.3; docs/tca.md, "Crossing flanks").  False where the path carries no
+        curvatures; a line contact (``det B = 0``) is not indefinite."""
+        p = self.path
+        if p.weingarten1 is None:
+            return jnp.zeros(p.phi1.shape, bool)
+
+        def indefinite(n, W1, W2, e):
+            B, _ = relative_curvature(n, W1, W2, e)
+            det = B[0, 0] * B[1, 1] - B[0, 1] ** 2
+            return det < -1e-9 * (B[0, 0] ** 2 + B[1, 1] ** 2 + 2.0 * B[0, 1] ** 2)
+
+        return jax.vmap(indefinite)(p.normal, p.weingarten1, p.weingarten2, p.major_dir)
+
     #: names of :meth:`objectives`, in order
     OBJECTIVES = ("ptp_arcsec", "mean_abs_srr", "max_abs_srr", "min_r_x_mm", "path_position")
 
@@ -435,6 +457,10 @@ class TCAResult:
         large_te : the TE envelope's peak-to-peak exceeds :data:`LARGE_TE_ARCSEC`
             (60 arcsec): far above the 5-15 arcsec of a designed parabolic TE, a
             sign of a mismatched pair or a bearing that is not where it should be.
+        crossing_flanks : pair 0 carries the load (it is the active pair of the
+            envelope) at a surface contact where the flanks cross (:attr:`flanks_cross`:
+            e.g. past the edge of regression of a generated pinion flank, an undercut
+            tooth): the TE there is not that of the real flanks.
         """
         conv = np.asarray(self.path.converged)
         on = np.asarray(self.on_flank | self.edge_points)     # pair 0 touches
@@ -484,7 +510,16 @@ class TCAResult:
                     edge_contact=bool(edge) or face_end or tip, face_end_contact=face_end,
                     tip_contact=tip,
                     low_contact_ratio=not (np.isfinite(cr) and cr >= 1.0),
-                    large_te=bool(np.isfinite(ptp) and ptp > LARGE_TE_ARCSEC))
+                    large_te=bool(np.isfinite(ptp) and ptp > LARGE_TE_ARCSEC),
+                    crossing_flanks=bool(np.any(self._carrying()
+                                                & np.asarray(self.on_flank & self.flanks_cross))))
+
+    def _carrying(self) -> np.ndarray:
+        """(N,) tooth pair 0 carries the load: it touches and is the envelope's active
+        pair (concrete)."""
+        inside = np.asarray(self.multi.inside)
+        k0 = inside.shape[0] // 2
+        return inside[k0] & (np.asarray(self.multi.active) == k0)
 
     def edges_loaded(self) -> list[str]:
         """Names (:data:`gearjax.tca.edge_contact.EDGE_NAMES`) of the edges (face ends and
@@ -494,8 +529,7 @@ class TCAResult:
         if kinds is None:
             return []
         kinds = np.asarray(kinds)
-        k0 = np.asarray(self.multi.inside).shape[0] // 2
-        carrying = np.asarray(self.multi.inside)[k0] & (np.asarray(self.multi.active) == k0)
+        carrying = self._carrying()
         return [EDGE_NAMES[k] for k in sorted(set(kinds[carrying & (kinds >= 0)].tolist()))]
 
     def face_ends_loaded(self) -> list[str]:
@@ -528,6 +562,10 @@ class TCAResult:
             out.append(f"contact ratio {cr:.3f} below 1" if np.isfinite(cr) else
                        "contact ratio not found: tooth pair 0 does not both enter and leave "
                        "the flanks within the grid (widen it, e.g. --pitches 2)")
+        if f["crossing_flanks"]:
+            out.append("crossing flanks: tooth pair 0 carries the load where the flanks cross "
+                       "(relative curvature indefinite, e.g. past the edge of regression of "
+                       "an undercut generated flank); the TE there is not that of real flanks")
         if f["large_te"]:
             out.append(f"TE peak-to-peak {float(self.multi.ptp) / ARCSEC:.1f} arcsec above "
                        f"{LARGE_TE_ARCSEC:.0f} arcsec: a mismatched pair or a misplaced bearing")
