@@ -212,7 +212,13 @@ def test_hypoid_example_perturbations_are_valid_or_flagged(name, xs):
     pair, mis = _perturbed(f, xs)
     res = f(pair, mis)
     OUTCOMES[f"hypoid {name}: " + _check_result(res, (name, xs))] += 1
-    OUTCOMES[f"hypoid {name}: crossing_flanks raised"] += res.flags()["crossing_flanks"]
+    fl = res.flags()
+    OUTCOMES[f"hypoid {name}: crossing_flanks raised"] += fl["crossing_flanks"]
+    # raised alone: a result that passed as valid before the flag existed
+    OUTCOMES[f"hypoid {name}: crossing_flanks alone"] += (
+        fl["crossing_flanks"] and fl["converged"] and fl["reference_on_flank"]
+        and not any(v for k, v in fl.items()
+                    if k not in ("converged", "reference_on_flank", "crossing_flanks")))
 
 
 @pytest.mark.parametrize("name", NO_FLANK_EXAMPLES)

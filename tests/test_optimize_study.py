@@ -255,7 +255,7 @@ def test_continuous_te_ptp_meets_the_synthesis_target():
     assert abs(out["coast"][0] - 8.0) > 0.5
 
 
-def test_load_carried_where_the_flanks_cross_is_flagged():
+def test_load_carried_on_crossing_flanks_is_flagged():
     """The ISO 10/41 pinion's edge of regression lies above its fillet boundary (an
     undercut generated flank, docs/tca.md "Crossing flanks"): on the default grid the
     drive path of pair 0 runs past it at its end.  The flag test of ``flanks_cross``

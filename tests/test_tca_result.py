@@ -109,6 +109,15 @@ def test_crossing_flanks_where_pair_0_carries_at_an_indefinite_relative_curvatur
         assert len(w) == 1 and w[0].startswith("crossing flanks")
     cross, f, w = run(line, 5)
     assert not cross.any() and not f["crossing_flanks"] and w == []
+    # the tolerance does not depend on the tangent basis: a line contact with round-off
+    # (eigenvalues 2 and -1.5e-9: det -3e-9 against the bound -1e-9 (4 + ...)) is not
+    # crossing however its line lies, eigenvalues 2 and -2.5e-9 (det -5e-9) are
+    for delta, crossing in ((1.5e-9, False), (2.5e-9, True)):
+        for angle in (0.0, 0.3, np.pi / 4):
+            c, s_ = np.cos(angle), np.sin(angle)
+            R = np.array([[c, -s_], [s_, c]])
+            cross, f, w = run(R @ np.diag([2.0, -delta]) @ R.T, 5)
+            assert bool(cross[5]) is crossing and f["crossing_flanks"] is crossing, (delta, angle)
     cross, f, w = run(saddle, 8)                              # not carrying
     assert np.array_equal(np.nonzero(cross)[0], [8]) and not f["crossing_flanks"]
     margin = np.ones(N)
@@ -116,6 +125,26 @@ def test_crossing_flanks_where_pair_0_carries_at_an_indefinite_relative_curvatur
     off = _result(margin, *_crossing_case()[1:])
     r = _curved(off, [saddle if i == 4 else good for i in range(N)])
     assert bool(r.flanks_cross[4]) and not r.flags()["crossing_flanks"]
+
+
+def test_tca_json_marks_crossing_flanks_at_on_flank_points_only():
+    """``gearjax tca --json``: ``flags.crossing_flanks`` per grid point is ``on_flank &
+    flanks_cross`` -- a crossing curvature at an edge point (no surface contact there)
+    or off the flank is not marked; ``quality.crossing_flanks`` is the flag."""
+    from gearjax.commands.tca import _side_json
+    saddle, good = np.diag([1.0, -2.0]), np.diag([1.0, 2.0])
+    margin = np.ones(N)
+    margin[9] = -0.1                                          # off the flank
+    r = _curved(_result(margin, *_crossing_case()[1:]),
+                [saddle if i in (4, 6, 9) else good for i in range(N)])
+    kind = np.full(N, -1)
+    kind[6] = 0                                               # an edge point (pinion toe)
+    r = TCAResult(r.path._replace(edge_kind=jnp.asarray(kind)), r.margin, r.multi, {},
+                  None, "drive", "test")
+    out = _side_json(r)
+    assert out["flags"]["crossing_flanks"] == [i == 4 for i in range(N)]
+    assert out["flags"]["edge"] == [i == 6 for i in range(N)]
+    assert out["quality"]["crossing_flanks"] is True
 
 
 def test_edge_contact_when_a_pair_leaves_its_flank_at_the_hand_over():

@@ -280,6 +280,7 @@ def run(args) -> int:
         conv = np.asarray(out["flags"]["converged"])
         on = np.asarray(out["flags"]["on_flank"])
         edge = np.asarray(out["flags"]["edge"])
+        cross = np.asarray(out["flags"]["crossing_flanks"])
         te = np.array([np.nan if v is None else v for v in out["te_arcsec"]])
         touch = on | edge
         sm = np.where(touch, np.asarray(path.semi_major), np.nan)
@@ -292,8 +293,8 @@ def run(args) -> int:
               f"{'2a[mm]':>8s} {'2b[mm]':>8s} flag")
         phi1 = np.asarray(path.phi1)
         for i in range(len(phi1)):
-            flag = ("ok" if on[i] else "edge" if edge[i] else "off" if conv[i]
-                    else "no-conv")
+            flag = ("cross" if cross[i] else "ok" if on[i] else "edge" if edge[i]
+                    else "off" if conv[i] else "no-conv")
             print(f"{math.degrees(float(phi1[i])):10.4f} {_cell(te[i], 11, 5)} "
                   f"{_cell(ax[i], 9, 4)} {_cell(rad[i], 9, 4)} "
                   f"{_cell(2 * sm[i], 8, 4)} {_cell(2 * sn[i], 8, 4)} {flag}")

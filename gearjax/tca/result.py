@@ -69,6 +69,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from gearjax.tca.edge_contact import CORNER_KINDS, EDGE_NAMES, FACE_END_KINDS, TIP_KINDS
+from gearjax.errors import any_traced
 from gearjax.fields import strong_float64
 from gearjax.frames import matrix_z
 from gearjax.newton import solve_small
@@ -286,6 +287,28 @@ def contact_kinematics(r1: Callable, r2: Callable, asm: Assembly, mis: Misalignm
     return ContactKinematics(*out)
 
 
+def _flanks_cross(xp, path):
+    """:attr:`TCAResult.flanks_cross` with the array module ``xp`` (``jnp`` traced, ``np``
+    on concrete arrays: no dispatch per operation).  ``B = -A^T (W1 - W2) A`` in the
+    basis ``A = [a1, n x a1]``, ``a1`` the major direction projected on the tangent plane
+    (:func:`~gearjax.tca.path.relative_curvature`, vectorised over the points)."""
+    if path.weingarten1 is None:
+        return xp.zeros(path.phi1.shape, bool)
+    n, e = xp.asarray(path.normal), xp.asarray(path.major_dir)
+    W = xp.asarray(path.weingarten1) - xp.asarray(path.weingarten2)
+    a1 = e - xp.sum(e * n, axis=-1, keepdims=True) * n
+    a1 = a1 / xp.linalg.norm(a1, axis=-1, keepdims=True)
+    a2 = xp.cross(n, a1)
+
+    def form(u, v):
+        return -xp.einsum("ni,nij,nj->n", u, W, v)
+
+    bxx, byy = form(a1, a1), form(a2, a2)
+    bxy = 0.5 * (form(a1, a2) + form(a2, a1))
+    with np.errstate(invalid="ignore"):
+        return bxx * byy - bxy ** 2 < -1e-9 * (bxx ** 2 + byy ** 2 + 2.0 * bxy ** 2)
+
+
 class MaskCheck(NamedTuple):
     """:meth:`TCAResult.mask_check`: mask points off the flank and a smooth penalty."""
 
@@ -362,17 +385,9 @@ class TCAResult:
         happens past its edge of regression, where the flank continued by the envelope
         folds back onto a second sheet while the real tooth is undercut ([Litvin2004]
         section 6.3; docs/tca.md, "Crossing flanks").  False where the path carries no
-        curvatures; a line contact (``det B = 0``) is not indefinite."""
-        p = self.path
-        if p.weingarten1 is None:
-            return jnp.zeros(p.phi1.shape, bool)
-
-        def indefinite(n, W1, W2, e):
-            B, _ = relative_curvature(n, W1, W2, e)
-            det = B[0, 0] * B[1, 1] - B[0, 1] ** 2
-            return det < -1e-9 * (B[0, 0] ** 2 + B[1, 1] ** 2 + 2.0 * B[0, 1] ** 2)
-
-        return jax.vmap(indefinite)(p.normal, p.weingarten1, p.weingarten2, p.major_dir)
+        curvatures; a line contact (``det B = 0``) is not indefinite.  Traceable (a NumPy
+        array on a concrete result: no program is compiled for it)."""
+        return _flanks_cross(jnp if any_traced(self.path) else np, self.path)
 
     #: names of :meth:`objectives`, in order
     OBJECTIVES = ("ptp_arcsec", "mean_abs_srr", "max_abs_srr", "min_r_x_mm", "path_position")
@@ -511,8 +526,8 @@ class TCAResult:
                     tip_contact=tip,
                     low_contact_ratio=not (np.isfinite(cr) and cr >= 1.0),
                     large_te=bool(np.isfinite(ptp) and ptp > LARGE_TE_ARCSEC),
-                    crossing_flanks=bool(np.any(self._carrying()
-                                                & np.asarray(self.on_flank & self.flanks_cross))))
+                    crossing_flanks=bool(np.any(self._carrying() & np.asarray(self.on_flank)
+                                                & self.flanks_cross)))
 
     def _carrying(self) -> np.ndarray:
         """(N,) tooth pair 0 carries the load: it touches and is the envelope's active
