@@ -290,6 +290,18 @@ def test_load_carried_on_crossing_flanks_is_flagged():
         assert not any(f[k] for k in ("edge_contact", "tip_contact", "face_end_contact",
                                       "low_contact_ratio", "large_te"))
         assert any("crossing flanks" in w for w in res.warnings()) is carried
+    # the study quantity: the definiteness passes through 0 at the edge of regression,
+    # linearly in the path position (a principal curvature through infinity), and its
+    # smooth minimum over the nominal on-flank points lies within T ln n below the least
+    from gearjax.studies.quantities import DEFINITENESS_TEMPERATURE, QUANTITIES
+    from gearjax.tca.result import curvature_definiteness
+    on = np.asarray(nom.on_flank)
+    q = np.asarray(curvature_definiteness(nom.path))[on]
+    assert np.array_equal(q < -1e-9, np.asarray(nom.flanks_cross)[on]) and q.min() < 0.0
+    step = np.diff(q[-6:])                    # the last on-flank points: through the edge
+    assert np.all(step < 0.0) and step.max() / step.min() > 0.9, step
+    smin = float(QUANTITIES["min_definiteness"].fn(nom, None, on, None))
+    assert q.min() - DEFINITENESS_TEMPERATURE * np.log(on.sum()) <= smin <= q.min()
 
 
 def test_sweep_rows_and_acceptance_refuse_crossing_flanks():

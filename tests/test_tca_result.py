@@ -3,6 +3,7 @@ contact points against the closed form of an involute spur pair, the one entry p
 
 import math
 
+import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
@@ -125,6 +126,45 @@ def test_crossing_flanks_where_pair_0_carries_at_an_indefinite_relative_curvatur
     off = _result(margin, *_crossing_case()[1:])
     r = _curved(off, [saddle if i == 4 else good for i in range(N)])
     assert bool(r.flanks_cross[4]) and not r.flags()["crossing_flanks"]
+
+
+def test_curvature_definiteness_closed_form_and_central_differences():
+    """``curvature_definiteness`` = l1 l2/(l1^2 + l2^2) of the principal relative
+    curvatures, whatever the sense of the normal and the tangent basis (closed form on
+    hand-made B); its derivative w.r.t. the Weingarten map and the normal (the study
+    quantity's gradient flows through them) against central differences."""
+    from gearjax.tca.result import curvature_definiteness
+    base = _result(*_crossing_case())
+    for l1, l2 in ((1.0, 2.0), (1.0, -2.0), (3e-4, 0.05), (0.0, 1.0)):
+        for angle, normal in ((0.0, (0.0, 0.0, 1.0)), (0.7, (0.0, 0.0, -1.0)),
+                              (np.pi / 4, (0.0, 1.0, 0.0))):
+            c, s_ = np.cos(angle), np.sin(angle)
+            R = np.array([[c, -s_], [s_, c]])
+            r = _curved(base, [R @ np.diag([l1, l2]) @ R.T] * N, normal=normal)
+            q = np.asarray(curvature_definiteness(r.path))
+            np.testing.assert_allclose(q, l1 * l2 / (l1 ** 2 + l2 ** 2), rtol=1e-12, atol=1e-16)
+    rng = np.random.default_rng(3)
+    W = rng.normal(size=(N, 3, 3))
+    n = rng.normal(size=(N, 3))
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    p0 = _curved(base, [np.diag([1.0, 2.0])] * N).path
+
+    def total(W1, normal):
+        p = p0._replace(weingarten1=W1, normal=normal)
+        return jnp.sum(jnp.arange(1.0, N + 1.0) * curvature_definiteness(p))
+
+    gW, gn = jax.grad(total, argnums=(0, 1))(jnp.asarray(W), jnp.asarray(n))
+    h = 1e-6
+    for idx in ((0, 0, 0), (3, 1, 2), (7, 2, 1)):
+        e = np.zeros_like(W)
+        e[idx] = h
+        cd = (float(total(W + e, n)) - float(total(W - e, n))) / (2 * h)
+        assert float(gW[idx]) == pytest.approx(cd, rel=1e-6, abs=1e-9)
+    for idx in ((2, 0), (5, 2)):
+        e = np.zeros_like(n)
+        e[idx] = h
+        cd = (float(total(W, n + e)) - float(total(W, n - e))) / (2 * h)
+        assert float(gn[idx]) == pytest.approx(cd, rel=1e-6, abs=1e-9)
 
 
 def test_tca_json_marks_crossing_flanks_at_on_flank_points_only():

@@ -305,6 +305,25 @@ QUANTITIES["tip_thickness_mm"] = Quantity(
     ("involute",))
 
 
+#: temperature of the smooth minimum of the curvature definiteness (dimensionless; the
+#: minimum lies below the true one by at most T ln n)
+DEFINITENESS_TEMPERATURE = 1e-4
+
+
+def _min_definiteness(res, eff, mask, pair):
+    from gearjax.tca.result import curvature_definiteness
+    return smooth_min(curvature_definiteness(res.path), mask & res.path.converged,
+                      DEFINITENESS_TEMPERATURE)
+
+
+QUANTITIES["min_definiteness"] = Quantity(
+    "", False, True, DEFINITENESS_TEMPERATURE,
+    "smallest definiteness det B/(B_xx^2 + B_yy^2 + 2 B_xy^2) of the flanks' relative "
+    "curvature over the start design's on-flank points (smooth min): about R_x/R_y where "
+    "small, 0 in line contact, < 0 where the flanks cross (past an edge of regression)",
+    _min_definiteness)
+
+
 QUANTITIES["bearing_reach_mm"] = Quantity(
     "mm", False, False, None,
     "VH-CATT pairs: how far the contact ellipse reaches from the face middle at the "

@@ -287,13 +287,12 @@ def contact_kinematics(r1: Callable, r2: Callable, asm: Assembly, mis: Misalignm
     return ContactKinematics(*out)
 
 
-def _flanks_cross(xp, path):
-    """:attr:`TCAResult.flanks_cross` with the array module ``xp`` (``jnp`` traced, ``np``
-    on concrete arrays: no dispatch per operation).  ``B = -A^T (W1 - W2) A`` in the
-    basis ``A = [a1, n x a1]``, ``a1`` the major direction projected on the tangent plane
-    (:func:`~gearjax.tca.path.relative_curvature`, vectorised over the points)."""
-    if path.weingarten1 is None:
-        return xp.zeros(path.phi1.shape, bool)
+def _relative_forms(xp, path):
+    """``(B_xx, B_yy, B_xy)`` (N,) of the relative curvature ``B = -A^T (W1 - W2) A`` in
+    the basis ``A = [a1, n x a1]``, ``a1`` the major direction projected on the tangent
+    plane (:func:`~gearjax.tca.path.relative_curvature`, vectorised over the points),
+    with the array module ``xp`` (``jnp`` traced, ``np`` on concrete arrays: no dispatch
+    per operation)."""
     n, e = xp.asarray(path.normal), xp.asarray(path.major_dir)
     W = xp.asarray(path.weingarten1) - xp.asarray(path.weingarten2)
     a1 = e - xp.sum(e * n, axis=-1, keepdims=True) * n
@@ -303,10 +302,32 @@ def _flanks_cross(xp, path):
     def form(u, v):
         return -xp.einsum("ni,nij,nj->n", u, W, v)
 
-    bxx, byy = form(a1, a1), form(a2, a2)
-    bxy = 0.5 * (form(a1, a2) + form(a2, a1))
+    return form(a1, a1), form(a2, a2), 0.5 * (form(a1, a2) + form(a2, a1))
+
+
+def _flanks_cross(xp, path):
+    """:attr:`TCAResult.flanks_cross` with the array module ``xp``."""
+    if path.weingarten1 is None:
+        return xp.zeros(path.phi1.shape, bool)
+    bxx, byy, bxy = _relative_forms(xp, path)
     with np.errstate(invalid="ignore"):
         return bxx * byy - bxy ** 2 < -1e-9 * (bxx ** 2 + byy ** 2 + 2.0 * bxy ** 2)
+
+
+def curvature_definiteness(path):
+    """(N,) ``det B / (B_xx^2 + B_yy^2 + 2 B_xy^2)`` of the flanks' relative curvature at
+    the path's points (traceable; dimensionless, in [-1/2, 1/2]; NaN where the path
+    carries no curvatures).  With principal relative curvatures ``l1, l2`` it is
+    ``l1 l2 / (l1^2 + l2^2)``: independent of the sense of the normal and of the tangent
+    basis; about ``l_min / l_max = R_x / R_y = (b/a)^2`` of the contact ellipse where
+    small; 0 in line contact; negative where the flanks cross (:attr:`TCAResult.
+    flanks_cross` is ``< -1e-9``).  Through an edge of regression one principal
+    curvature of the generated flank passes through infinity and this ratio passes
+    smoothly through 0 (docs/tca.md, "Crossing flanks")."""
+    if path.weingarten1 is None:
+        return jnp.full(path.phi1.shape, jnp.nan)
+    bxx, byy, bxy = _relative_forms(jnp, path)
+    return (bxx * byy - bxy ** 2) / (bxx ** 2 + byy ** 2 + 2.0 * bxy ** 2)
 
 
 class MaskCheck(NamedTuple):
