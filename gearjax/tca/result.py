@@ -305,13 +305,20 @@ def _relative_forms(xp, path):
     return form(a1, a1), form(a2, a2), 0.5 * (form(a1, a2) + form(a2, a1))
 
 
-def _flanks_cross(xp, path):
-    """:attr:`TCAResult.flanks_cross` with the array module ``xp``."""
+def _definiteness(xp, path):
+    """:func:`curvature_definiteness` with the array module ``xp``."""
     if path.weingarten1 is None:
-        return xp.zeros(path.phi1.shape, bool)
+        return xp.full(path.phi1.shape, np.nan)
     bxx, byy, bxy = _relative_forms(xp, path)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return (bxx * byy - bxy ** 2) / (bxx ** 2 + byy ** 2 + 2.0 * bxy ** 2)
+
+
+def _flanks_cross(xp, path):
+    """:attr:`TCAResult.flanks_cross` with the array module ``xp`` (False where the
+    definiteness is NaN: no curvatures, or B = 0)."""
     with np.errstate(invalid="ignore"):
-        return bxx * byy - bxy ** 2 < -1e-9 * (bxx ** 2 + byy ** 2 + 2.0 * bxy ** 2)
+        return _definiteness(xp, path) < -1e-9
 
 
 def curvature_definiteness(path):
@@ -324,10 +331,7 @@ def curvature_definiteness(path):
     flanks_cross` is ``< -1e-9``).  Through an edge of regression one principal
     curvature of the generated flank passes through infinity and this ratio passes
     smoothly through 0 (docs/tca.md, "Crossing flanks")."""
-    if path.weingarten1 is None:
-        return jnp.full(path.phi1.shape, jnp.nan)
-    bxx, byy, bxy = _relative_forms(jnp, path)
-    return (bxx * byy - bxy ** 2) / (bxx ** 2 + byy ** 2 + 2.0 * bxy ** 2)
+    return _definiteness(jnp, path)
 
 
 class MaskCheck(NamedTuple):
