@@ -174,11 +174,17 @@ def spur(tmp_path_factory):
                       rb1=float(geo["rb1"]), rb2=float(geo["rb2"]), eps=eps)
 
 
+TIE_MM = 1e-9      # mm: round-off between two routes to s_A, far below a position step
+
+
 def _closed_form(s0, g):
     """TE0(s0) = C_a max((rho_P + s_low - xi_s) / L_a, 0), s_low = s_A + mod(s0 - s_A,
-    p_bt): the lowest pair on the path has the least relief."""
+    p_bt): the lowest pair on the path has the least relief.  The first position is the
+    path's start s_A itself (a pair there touches); this s_A and the library's differ by
+    round-off (1e-15 mm, by machine), so a position less than TIE_MM short of a whole
+    number of pitches from s_A counts as at it."""
     s_A = g["rho_A"] - g["rho_P"]
-    s_low = s_A + np.mod(np.asarray(s0) - s_A, g["p_bt"])
+    s_low = s_A + np.mod(np.asarray(s0) - s_A + TIE_MM, g["p_bt"]) - TIE_MM
     L_a = g["rho_E"] - g["xi_s"]
     return C_A * np.maximum((g["rho_P"] + s_low - g["xi_s"]) / L_a, 0.0)
 
