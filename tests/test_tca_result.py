@@ -167,6 +167,34 @@ def test_curvature_definiteness_closed_form_and_central_differences():
         assert float(gn[idx]) == pytest.approx(cd, rel=1e-6, abs=1e-9)
 
 
+def test_min_definiteness_skips_failed_solves_and_paths_without_curvatures():
+    """The study quantity ``min_definiteness`` is the smooth minimum over the mask's
+    *converged* points: a failed solve with a crossing curvature inside the mask does not
+    enter it (bounds of the smooth minimum of equal values: q - T ln n <= . <= q).  A path
+    that carries no curvatures has no definiteness (NaN) and no crossing point.  The
+    quantity is offered for every family (each path carries its curvatures)."""
+    from gearjax.studies.quantities import DEFINITENESS_TEMPERATURE, QUANTITIES
+    from gearjax.tca.result import curvature_definiteness
+    base = _result(*_crossing_case())
+    assert base.path.weingarten1 is None
+    assert np.all(np.isnan(np.asarray(curvature_definiteness(base.path))))
+    assert not np.asarray(base.flanks_cross).any() and not base.flags()["crossing_flanks"]
+    good, saddle = np.diag([1.0, 2.0]), np.diag([1.0, -2.0])       # 0.4 and -0.4
+    r = _curved(base, [saddle if i == 5 else good for i in range(N)])
+    conv = np.ones(N, bool)
+    conv[5] = False
+    failed = r.__class__(r.path._replace(converged=jnp.asarray(conv)), r.margin, r.multi,
+                         r.coords, r.kinematics, r.side, r.family)
+    mask = np.ones(N, bool)
+    q = QUANTITIES["min_definiteness"]
+    T = DEFINITENESS_TEMPERATURE
+    assert q.families == ()
+    v = float(q.fn(failed, None, jnp.asarray(mask), None))
+    assert 0.4 - T * np.log(N - 1) - 1e-12 <= v <= 0.4
+    v = float(q.fn(r, None, jnp.asarray(mask), None))                 # converged: it counts
+    assert v == pytest.approx(-0.4, abs=1e-12)
+
+
 def test_tca_json_marks_crossing_flanks_at_on_flank_points_only():
     """``gearjax tca --json``: ``flags.crossing_flanks`` per grid point is ``on_flank &
     flanks_cross`` -- a crossing curvature at an edge point (no surface contact there)
