@@ -147,10 +147,11 @@ def te_ptp_continuous(res):
         & jnp.all(gaps < 0.0) & (m.contact_ratio >= 1.0))
     t = jnp.where(found, t, t_grid)          # no NaN in the branch not taken
     at = jax.vmap(te0)(t)
-    # min(x, y) = (x + y - |x - y|) / 2: one sign decides both weights of the derivative
-    # (jnp.minimum's tie rule compares each operand with the result, and where XLA
-    # evaluates the two operands of an exact tie -- a symmetric TE -- with different
-    # round-off, the weights summed to 1/2 or 3/2 in a jitted reverse-mode program)
+    # min(x, y) = (x + y - |x - y|) / 2: one sign decides both weights of the derivative.
+    # The two values always tie in exact arithmetic (the hand-over out of pair 0 is the
+    # one into it a pitch later); jnp.minimum's tie rule compares each operand with the
+    # result, and where XLA evaluated the two with different round-off (a jitted
+    # reverse-mode program on an AMD EPYC CPU) the weights summed to 1/2 or 3/2.
     bottom = 0.5 * (sgn * (at[0] + at[1]) - jnp.abs(at[0] - at[1]))
     lo, up = jnp.minimum(t[0], t[1]), jnp.maximum(t[0], t[1])
     window = ok & (phi >= lo) & (phi <= up)         # pair 0 carries the load
