@@ -180,11 +180,11 @@ def test_min_definiteness_skips_failed_solves_and_paths_without_curvatures():
     assert np.all(np.isnan(np.asarray(curvature_definiteness(base.path))))
     assert not np.asarray(base.flanks_cross).any() and not base.flags()["crossing_flanks"]
     good, saddle = np.diag([1.0, 2.0]), np.diag([1.0, -2.0])       # 0.4 and -0.4
-    r = _curved(base, [saddle if i == 5 else good for i in range(N)])
+    B_at = [saddle if i == 5 else good for i in range(N)]
+    r = _curved(base, B_at)
     conv = np.ones(N, bool)
     conv[5] = False
-    failed = r.__class__(r.path._replace(converged=jnp.asarray(conv)), r.margin, r.multi,
-                         r.coords, r.kinematics, r.side, r.family)
+    failed = _curved(_result(*_crossing_case(), converged=conv), B_at)
     mask = np.ones(N, bool)
     q = QUANTITIES["min_definiteness"]
     T = DEFINITENESS_TEMPERATURE
