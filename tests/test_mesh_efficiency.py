@@ -519,7 +519,8 @@ def test_plausibility_thresholds_on_synthetic_positions():
     """Each check at its documented threshold on a synthetic cycle (one position
     failing one check each).  Planted bugs caught: a check dropped or with a flipped
     comparison, eta = 0 or eta > 1 accepted, an unloaded contact's value counted, a
-    NaN passing, a deflection limit not scaled by the pitch."""
+    NaN passing, a deflection limit not scaled by the pitch, a contact with a
+    vanishing share of the load checked (or one with a small real share not)."""
     from gearjax.loading.efficiency_checks import (DEFLECTION_MAX_PITCH, HERTZ_SIZE_MAX, MU_MAX,
                                                    P_MAX_LIMIT_MPA, plausibility)
     pitch = 2 * np.pi / 20
@@ -542,14 +543,25 @@ def test_plausibility_thresholds_on_synthetic_positions():
     np.testing.assert_array_equal(p.deflection, [1, 1, 1, 1, 1, 1, 0, 1])
     np.testing.assert_array_equal(p.contact, [1, 1, 1, 1, 1, 1, 1, 0])
     np.testing.assert_array_equal(p.all, [1, 1, 0, 0, 0, 0, 0, 0])
+    # a contact with a vanishing share of the position's load (a pair entering its
+    # flank under the soft active set: 4.5e-31 N beside 8782 N, mu 1.2e5 on the ISO
+    # 10/41 study) is not checked; one with 1e-6 of it is; a NaN load elsewhere at the
+    # position does not exempt the others
+    load = jnp.array([[8782.0, 8782.0, 8782.0, 8782.0, np.nan],
+                      [4.5e-31, 8782.0 * 1e-6, 8782.0 * 0.5e-9, 8782.0 * 2e-9, 1.0]])
+    mu = jnp.array([[0.05] * 5, [1.2e5, 0.31, 1.2e5, 0.31, 0.31]])
+    p = plausibility(jnp.full(5, 0.98), mu, load, jnp.full((2, 5), 1e3), jnp.zeros(5), pitch,
+                     jnp.full((2, 5), 0.1), jnp.full((2, 5), 10.0))
+    np.testing.assert_array_equal(p.mu, [1, 0, 1, 0, 0])
 
 
 def test_implausible_results_are_flagged_and_not_valid(spur, iso_run):
     """The iso run's result with planted implausible values, through
     ``efficiency_warnings`` (concrete, no new program): a warning line per failed
-    check naming the threshold; a film below FILM_MIN_MM warns.  Planted bugs caught:
-    a check that never fires on a real result's fields (wrong field, wrong axis), a
-    warning line without the value."""
+    check naming the threshold; a film below FILM_MIN_MM warns, not at a contact with a
+    vanishing share of the load.  Planted bugs caught: a check that never fires on a
+    real result's fields (wrong field, wrong axis), a warning line without the value,
+    the warnings' notion of a loaded contact not that of ``plausibility``."""
     from gearjax.loading.mesh_efficiency import FILM_MIN_MM
     from gearjax.loading.efficiency_checks import MU_MAX, P_MAX_LIMIT_MPA
     eff, res = iso_run
@@ -567,6 +579,20 @@ def test_implausible_results_are_flagged_and_not_valid(spur, iso_run):
     # the spur run's own contacts are far inside Hertz theory (half-width / R_x)
     hw = np.asarray(eff.loaded.semi_minor) / np.asarray(eff.r_x)
     assert np.max(hw[np.asarray(eff.loaded.load) > 0]) < 0.1
+    # a contact with a vanishing share of its position's load (a pair entering its
+    # flank under the soft active set) is not a loaded contact for the warnings either:
+    # an absurd mu and a 1 nm film there raise nothing
+    F = np.asarray(eff.loaded.load)
+    k, m = np.argwhere(F == 0.0)[0]
+    F2 = F.copy()
+    F2[k, m] = 4.5e-31
+    mu2 = np.asarray(eff.friction.mu).copy()
+    mu2[k, m] = 1.2e5
+    h2 = np.asarray(eff.friction.h_c).copy()
+    h2[k, m] = 1e-6
+    tiny = eff._replace(loaded=eff.loaded._replace(load=jnp.asarray(F2)),
+                        friction=eff.friction._replace(mu=jnp.asarray(mu2), h_c=jnp.asarray(h2)))
+    assert efficiency_warnings(tiny, res) == efficiency_warnings(eff, res)
 
 
 def test_cycle_is_one_pitch_starting_half_a_pitch_before_the_reference(spur, iso_run):

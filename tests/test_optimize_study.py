@@ -265,7 +265,8 @@ def test_load_carried_on_crossing_flanks_is_flagged():
     ellipse there).  Nominal: those points carry no load, no flag.  Under dE = +0.1 mm
     the load-carrying part of the path reaches them: ``crossing_flanks`` is raised
     (and a warning), where before this flag every other flag was clear and the TE
-    p-t-p (7.05 arcsec) looked valid.  Planted bugs caught: the determinant's sign or
+    p-t-p (7.05 arcsec) looked valid.  The study quantity ``handover_definiteness``
+    changes sign with the flag.  Planted bugs caught: the determinant's sign or
     tolerance, the carrying mask dropped or inverted, the flag left out of flags()."""
     from gearjax.gears.hypoid.pair import flank_function
     from test_tca_hypoid import _sheet
@@ -302,6 +303,12 @@ def test_load_carried_on_crossing_flanks_is_flagged():
     assert np.all(step < 0.0) and step.max() / step.min() > 0.9, step
     smin = float(QUANTITIES["min_definiteness"].fn(nom, None, on, None))
     assert q.min() - DEFINITENESS_TEMPERATURE * np.log(on.sum()) <= smin <= q.min()
+    # at the hand-overs (the ends of the carrying interval) the definiteness is >= 0
+    # exactly where the flag is clear: nominal 1.56e-3, under dE = +0.1 mm -6.5e-4
+    from gearjax.studies.quantities import handover_definiteness
+    for res, carried in ((nom, False), (mis, True)):
+        hd = float(handover_definiteness(res))
+        assert (hd < 0.0) is carried and abs(hd) > 1e-4, hd
 
 
 def test_sweep_rows_and_acceptance_refuse_crossing_flanks():

@@ -393,3 +393,70 @@ def test_continuous_te_ptp_is_exact_for_a_parabolic_te_wherever_the_grid_falls()
             want = a * (p / 2) ** 2 / gj.ARCSEC
             assert float(val) == pytest.approx(want, rel=1e-9), (frac, offset)
             assert float(der) == pytest.approx((p / 2) ** 2 / gj.ARCSEC, rel=1e-9)
+
+
+def test_handover_definiteness_at_the_continuous_hand_overs_wherever_the_grid_falls():
+    """``handover_definiteness`` on the parabolic-TE closed form (hand-overs at delta -+
+    p/2) with the curvature definiteness prescribed linear along the path, D(phi) = c
+    (phi_e - phi) (B = diag(1, l2), l2 the small root of D (1 + l2^2) = l2): the value is
+    the smooth minimum (T = 1e-4) of D at the two hand-overs, at 8 grid offsets, three
+    vertex positions and three slopes c; its derivative in delta is -c (both hand-overs
+    move with the vertex) and in c the softmin-weighted phi_e - t.  Planted bugs caught:
+    the grid's transfer angles instead of the continuous hand-overs (the value moves
+    with the offset), one hand-over only (either), the largest instead of the smallest,
+    the hand-overs held fixed in the derivative (d/d delta = 0), the interpolation's
+    origin a grid step off (``handovers`` itself is checked: delta -+ p/2).  A path
+    without curvatures, or without a transfer on the grid, gives NaN."""
+    import itertools
+
+    from gearjax.studies.quantities import (DEFINITENESS_TEMPERATURE, QUANTITIES,
+                                            handover_definiteness, handovers)
+    p = 2 * np.pi / 10
+    T = DEFINITENESS_TEMPERATURE
+    phi_e = 0.9 * p
+    q = QUANTITIES["handover_definiteness"]
+    assert q.families == () and not q.path and not q.loaded
+
+    def curved(res, c):
+        D = c * (phi_e - res.path.phi1)
+        l2 = 2.0 * D / (1.0 + jnp.sqrt(1.0 - 4.0 * D ** 2))      # small root, D = 0 safe
+        n = D.shape[0]
+        W1 = jnp.zeros((n, 3, 3)).at[:, 0, 0].set(-1.0).at[:, 1, 1].set(-l2)   # B = -W1
+        path = res.path._replace(normal=jnp.tile(jnp.array([0.0, 0.0, 1.0]), (n, 1)),
+                                 major_dir=jnp.tile(jnp.array([1.0, 0.0, 0.0]), (n, 1)),
+                                 weingarten1=W1, weingarten2=jnp.zeros((n, 3, 3)))
+        return TCAResult(path, res.margin, res.multi, {}, None, "drive", "test")
+
+    @jax.jit
+    def value_and_grads(c, delta, offset):
+        return jax.value_and_grad(lambda cc, dd: handover_definiteness(
+            curved(_parabolic_pair(dd, offset)[0], cc)), argnums=(0, 1))(c, delta)
+
+    # the definiteness falling along the path (lowest where pair 0 leaves), rising
+    # (lowest where it enters) and nearly level (both hand-overs weigh in the minimum)
+    for c, frac in itertools.product((0.05, -0.05, 2e-4), (0.0, 0.013, -0.041)):
+        delta = frac * p
+        t = np.array([delta - p / 2, delta + p / 2])
+        D = c * (phi_e - t)
+        m = D.min()
+        w = np.exp(-(D - m) / T)
+        want = m - T * np.log(w.sum())
+        w = w / w.sum()
+        for offset in np.linspace(0.0, 1.0, 8, endpoint=False):
+            val, (dc, dd) = value_and_grads(c, delta, offset)
+            assert float(val) == pytest.approx(want, rel=1e-10, abs=1e-14), (frac, offset)
+            assert float(dd) == pytest.approx(-c, rel=1e-8), (frac, offset)
+            assert float(dc) == pytest.approx(float(w @ (phi_e - t)), rel=1e-8), (frac, offset)
+            if c == 0.05 and offset in (0.0, 0.5):      # the hand-overs themselves
+                tt, found = handovers(_parabolic_pair(delta, offset)[0])
+                assert bool(found)
+                np.testing.assert_allclose(np.asarray(tt), t, rtol=0, atol=1e-12 * p)
+    assert np.isnan(float(handover_definiteness(_parabolic_pair(0.0, 0.3)[0])))
+    # no transfer found on the grid (NaN transfer angle): NaN, not the value at angle 0
+    res = curved(_parabolic_pair(0.0, 0.3)[0], 0.05)
+    assert np.isfinite(float(handover_definiteness(res)))
+    for transfer in ([np.nan, 0.3], [-0.3, np.nan]):
+        res_nt = TCAResult(res.path, res.margin,
+                           res.multi._replace(transfer_phi1=jnp.asarray(transfer)), {}, None,
+                           "drive", "test")
+        assert np.isnan(float(handover_definiteness(res_nt))), transfer

@@ -49,7 +49,7 @@ from gearjax.tca.multi_pair import interp_uniform, transfer_gaps
 from gearjax.tca.path import ARCSEC
 
 __all__ = ["Quantity", "QUANTITIES", "smooth_max", "smooth_min", "te_ptp_continuous",
-           "quantity_values",
+           "handovers", "handover_definiteness", "quantity_values",
            "needs_loaded", "uses_mask", "start_mask", "route_of", "LINE_QUANTITIES",
            "KIN_QUANTITIES", "KIN_SRR_T", "KIN_R_EFF_T_MM", "KIN_PHI_T"]
 
@@ -99,6 +99,45 @@ def _mid(res):
     return res.path.phi1.shape[0] // 2
 
 
+def _path_interpolant(path, values):
+    """``x -> values(x)``: quadratic interpolation of per-point ``values`` on the path's
+    uniform pinion-angle grid (:func:`gearjax.tca.multi_pair.interp_uniform`)."""
+    phi = path.phi1
+    h = phi[1] - phi[0]
+    return lambda x: interp_uniform(phi[0], h, values, x)
+
+
+def handovers(res):
+    """``(t, found)``: the pinion angles (rad, (2,)) where tooth pair 0 takes the load over
+    from pair -1 and hands it on to pair +1, at their continuous positions (traceable).
+
+    ``t`` solves ``TE_0(x) = TE_0(x + p)`` (entering) and ``TE_0(x) = TE_0(x - p)``
+    (leaving), pair +-1 being pair 0 shifted by a pitch ``p``: three Newton steps from
+    the grid's transfer angles on the quadratic interpolant of the path's TE, which
+    continues past the flank boundaries.  ``found`` (no derivative): both transfers are
+    on the grid, both continuous transfer gaps (:func:`gearjax.tca.multi_pair.
+    transfer_gaps`) are below 0 -- the curves cross inside the flanks -- and the contact
+    ratio is at least 1; otherwise (an edge hand-over, where the envelope jumps) ``t`` is
+    the grid's transfer angles (0 where none is found: no NaN enters a derivative)."""
+    m = res.multi
+    te0 = _path_interpolant(res.path, res.path.te)
+
+    def crossing(x, shift):
+        for _ in range(3):
+            d, dd = jax.jvp(lambda y: te0(y) - te0(y + shift), (x,), (jnp.ones_like(x),))
+            x = x - jnp.where(dd != 0.0, d / jnp.where(dd != 0.0, dd, 1.0), 0.0)
+        return x
+
+    t_grid = jnp.nan_to_num(m.transfer_phi1)
+    p = jnp.nan_to_num(m.pitch)
+    t = jnp.stack([crossing(t_grid[0], p), crossing(t_grid[1], -p)])
+    gaps = jnp.stack(transfer_gaps(res.path, res.margin, m))
+    found = jax.lax.stop_gradient(
+        jnp.all(jnp.isfinite(m.transfer_phi1)) & jnp.all(jnp.isfinite(t))
+        & jnp.all(gaps < 0.0) & (m.contact_ratio >= 1.0))
+    return jnp.where(found, t, t_grid), found          # no NaN in the branch not taken
+
+
 def te_ptp_continuous(res):
     """Peak-to-peak of the unloaded TE envelope (arcsec) with the hand-overs at their
     continuous positions (traceable).
@@ -122,30 +161,12 @@ def te_ptp_continuous(res):
     last grid point on the flank and the flank boundary).
     """
     m = res.multi
-    path = res.path
-    phi = path.phi1
+    phi = res.path.phi1
     env = m.envelope
     ok = jnp.isfinite(env)
     sgn = m.sign          # +1 when the envelope is the maximum over the pairs
-    h = phi[1] - phi[0]
-
-    def te0(x):
-        return interp_uniform(phi[0], h, path.te, x)
-
-    def crossing(x, shift):
-        for _ in range(3):
-            d, dd = jax.jvp(lambda y: te0(y) - te0(y + shift), (x,), (jnp.ones_like(x),))
-            x = x - jnp.where(dd != 0.0, d / jnp.where(dd != 0.0, dd, 1.0), 0.0)
-        return x
-
-    t_grid = jnp.nan_to_num(m.transfer_phi1)
-    p = jnp.nan_to_num(m.pitch)
-    t = jnp.stack([crossing(t_grid[0], p), crossing(t_grid[1], -p)])
-    gaps = jnp.stack(transfer_gaps(path, res.margin, m))
-    found = jax.lax.stop_gradient(
-        jnp.all(jnp.isfinite(m.transfer_phi1)) & jnp.all(jnp.isfinite(t))
-        & jnp.all(gaps < 0.0) & (m.contact_ratio >= 1.0))
-    t = jnp.where(found, t, t_grid)          # no NaN in the branch not taken
+    t, found = handovers(res)
+    te0 = _path_interpolant(res.path, res.path.te)
     at = jax.vmap(te0)(t)
     # min(x, y) = (x + y - |x - y|) / 2: one sign decides both weights of the derivative.
     # The two values always tie in exact arithmetic (the hand-over out of pair 0 is the
@@ -327,6 +348,35 @@ QUANTITIES["min_definiteness"] = Quantity(
     "curvature over the start design's on-flank points (smooth min): about R_x/R_y where "
     "small, 0 in line contact, < 0 where the flanks cross (past an edge of regression)",
     _min_definiteness)
+
+
+def handover_definiteness(res):
+    """Smooth minimum (:data:`DEFINITENESS_TEMPERATURE`) of the curvature definiteness
+    (:func:`gearjax.tca.result.curvature_definiteness`) at the two hand-overs of tooth
+    pair 0 (:func:`handovers`: continuous positions), by quadratic interpolation of the
+    per-point values (traceable; dimensionless).  Pair 0 carries the load between its
+    hand-overs; on a generated flank whose path runs towards an edge of regression the
+    definiteness falls along the path and passes through 0 there (docs/tca.md, "Crossing
+    flanks"), so ``>= 0`` at the hand-overs keeps the load-carrying part of the path
+    ahead of the crossing flanks while the path itself may run past them -- where
+    ``min_definiteness`` over every on-flank point would forbid that too.  It does not see
+    a minimum inside the carrying interval (the end checks' ``crossing_flanks`` flag
+    does).  NaN where a transfer is not found on the grid or the path carries no
+    curvatures (the step or the start is refused)."""
+    from gearjax.tca.result import curvature_definiteness
+    t, _ = handovers(res)
+    at = jax.vmap(_path_interpolant(res.path, curvature_definiteness(res.path)))(t)
+    ok = jnp.all(jnp.isfinite(res.multi.transfer_phi1)) & jnp.all(jnp.isfinite(at))
+    at = jnp.where(ok, at, 0.0)
+    return jnp.where(ok, smooth_min(at, jnp.ones(2, bool), DEFINITENESS_TEMPERATURE), jnp.nan)
+
+
+QUANTITIES["handover_definiteness"] = Quantity(
+    "", False, False, DEFINITENESS_TEMPERATURE,
+    "definiteness of the flanks' relative curvature (as min_definiteness) at tooth pair "
+    "0's two hand-overs (continuous positions; smooth min): >= 0 keeps the load-carrying "
+    "part of the path ahead of an edge of regression",
+    lambda res, eff, mask, pair: handover_definiteness(res))
 
 
 QUANTITIES["bearing_reach_mm"] = Quantity(
